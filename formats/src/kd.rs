@@ -1,0 +1,198 @@
+//! The compiled k-d tree. Its content depends only on the soup's triangle positions and
+//! the build parameters, so it is cached by `<geometry hash>-<params hash>.kd`.
+
+use crate::{envelope, Digest, FormatError};
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+pub const MAGIC: &[u8; 8] = b"UTKD\0\0\0\0";
+pub const VERSION: u32 = 1;
+
+/// SAH build parameters. They change the tree, so they are part of the cache key.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BuildParams {
+    /// Cost of one traversal step, relative to `intersect_cost`.
+    pub traversal_cost: f32,
+    /// Cost of one ray/triangle test.
+    pub intersect_cost: f32,
+    /// Fraction of the SAH cost forgiven when a split cuts off empty space (0–1).
+    pub empty_bonus: f32,
+    /// Depth bound; 0 means the default 8 + 1.3·log2(N).
+    pub max_depth: u32,
+    /// Make a leaf without trying to split at or below this many triangles.
+    pub leaf_size: u32,
+}
+
+impl Default for BuildParams {
+    fn default() -> Self {
+        BuildParams {
+            traversal_cost: 1.0,
+            intersect_cost: 1.5,
+            empty_bonus: 0.8,
+            max_depth: 0,
+            leaf_size: 1,
+        }
+    }
+}
+
+impl BuildParams {
+    /// First 8 bytes (16 hex digits) of BLAKE3 over the parameters' encoding: the second
+    /// half of a cache file name.
+    pub fn short_hash(&self) -> String {
+        let mut h = blake3::Hasher::new();
+        h.update(&VERSION.to_le_bytes());
+        h.update(&self.traversal_cost.to_le_bytes());
+        h.update(&self.intersect_cost.to_le_bytes());
+        h.update(&self.empty_bonus.to_le_bytes());
+        h.update(&self.max_depth.to_le_bytes());
+        h.update(&self.leaf_size.to_le_bytes());
+        h.finalize().to_hex()[..16].to_string()
+    }
+
+    /// Cache file name for a soup with this geometry hash.
+    pub fn cache_name(&self, geometry_hash: &Digest) -> String {
+        format!("{}-{}.kd", crate::hex(geometry_hash), self.short_hash())
+    }
+}
+
+/// Statistics measured on the built tree.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct TreeStats {
+    pub triangles: u64,
+    pub nodes: u64,
+    pub leaves: u64,
+    pub empty_leaves: u64,
+    pub max_depth: u32,
+    /// Triangle references in leaves (a triangle straddling a split is counted per leaf).
+    pub references: u64,
+    pub max_leaf_triangles: u32,
+    /// Expected cost of a random ray, in units of `intersect_cost` (SAH).
+    pub sah_cost: f64,
+    pub build_seconds: f64,
+}
+
+/// One 8-byte node, laid out as in pbrt-v3's KdTreeAccel.
+///
+/// * `flags & 3` is 0, 1, 2 for an interior node split on x, y, z, and 3 for a leaf.
+/// * Interior: `data` is the split coordinate (f32 bits); `flags >> 2` is the index of
+///   the child above the split; the child below is the next node in the array.
+/// * Leaf: `flags >> 2` is the number of triangles; `data` is the offset of its first
+///   triangle index in [`KdFile::leaf_tris`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct KdNode {
+    pub flags: u32,
+    pub data: u32,
+}
+
+impl KdNode {
+    pub const LEAF: u32 = 3;
+
+    pub fn interior(axis: u32, split: f32, above: u32) -> Self {
+        debug_assert!(axis < 3 && above < (1 << 30));
+        KdNode {
+            flags: axis | (above << 2),
+            data: split.to_bits(),
+        }
+    }
+    pub fn leaf(count: u32, offset: u32) -> Self {
+        debug_assert!(count < (1 << 30));
+        KdNode {
+            flags: Self::LEAF | (count << 2),
+            data: offset,
+        }
+    }
+    #[inline]
+    pub fn is_leaf(self) -> bool {
+        self.flags & 3 == Self::LEAF
+    }
+    #[inline]
+    pub fn axis(self) -> usize {
+        (self.flags & 3) as usize
+    }
+    #[inline]
+    pub fn split(self) -> f32 {
+        f32::from_bits(self.data)
+    }
+    #[inline]
+    pub fn above_child(self) -> u32 {
+        self.flags >> 2
+    }
+    #[inline]
+    pub fn count(self) -> u32 {
+        self.flags >> 2
+    }
+    #[inline]
+    pub fn offset(self) -> u32 {
+        self.data
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct KdFile {
+    /// The soup geometry this tree was built from; the renderer refuses any other soup.
+    pub geometry_hash: Digest,
+    pub params: BuildParams,
+    pub stats: TreeStats,
+    /// Bounds of all triangles: [min, max].
+    pub bounds: [Vec3; 2],
+    /// Node 0 is the root.
+    pub nodes: Vec<KdNode>,
+    /// Triangle indices (soup order) of all leaves, each leaf's run contiguous.
+    pub leaf_tris: Vec<u32>,
+}
+
+impl KdFile {
+    /// Check that every node reference stays inside the arrays, naming the first bad one.
+    pub fn validate(&self) -> Result<(), String> {
+        let n = self.nodes.len();
+        if n == 0 {
+            return Err("the tree has no nodes".into());
+        }
+        for (i, node) in self.nodes.iter().enumerate() {
+            if node.is_leaf() {
+                let end = node.offset() as u64 + node.count() as u64;
+                if end > self.leaf_tris.len() as u64 {
+                    return Err(format!("leaf {i} reaches past the triangle list"));
+                }
+            } else {
+                let above = node.above_child() as usize;
+                if above <= i + 1 || above >= n || i + 1 >= n {
+                    return Err(format!("node {i} points at child {above} of {n}"));
+                }
+            }
+        }
+        if let Some(&t) = self
+            .leaf_tris
+            .iter()
+            .find(|&&t| t as u64 >= self.stats.triangles)
+        {
+            return Err(format!(
+                "leaf triangle {t} is out of range ({} triangles)",
+                self.stats.triangles
+            ));
+        }
+        Ok(())
+    }
+
+    pub fn to_bytes(&self, path: &Path) -> Result<Vec<u8>, FormatError> {
+        envelope::encode(self, MAGIC, VERSION, path)
+    }
+
+    pub fn from_bytes(bytes: &[u8], path: &Path) -> Result<Self, FormatError> {
+        let kd: KdFile = envelope::decode(bytes, MAGIC, "k-d tree", VERSION, path)?;
+        kd.validate().map_err(|detail| FormatError::Corrupt {
+            path: path.to_path_buf(),
+            detail,
+        })?;
+        Ok(kd)
+    }
+
+    pub fn write(&self, path: &Path) -> Result<(), FormatError> {
+        envelope::write_atomic(path, &self.to_bytes(path)?)
+    }
+
+    pub fn read(path: &Path) -> Result<Self, FormatError> {
+        Self::from_bytes(&envelope::read_file(path)?, path)
+    }
+}

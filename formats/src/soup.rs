@@ -1,0 +1,330 @@
+//! The triangle soup: world-space geometry plus everything the renderer needs from the
+//! scene. Right-handed, Y up, metres (see DESIGN §3). Colours are linear RGB.
+
+use crate::{envelope, Digest, FormatError};
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+pub const MAGIC: &[u8; 8] = b"UTSOUP\0\0";
+pub const VERSION: u32 = 1;
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Soup {
+    /// Three world-space vertices per triangle, counter-clockwise seen from the front.
+    pub triangles: Vec<[Vec3; 3]>,
+    /// Per-vertex shading normals (unit length), parallel to `triangles`.
+    pub normals: Vec<[Vec3; 3]>,
+    /// Index into `materials`, one per triangle.
+    pub tri_material: Vec<u32>,
+    /// Index into `objects`, one per triangle.
+    pub tri_object: Vec<u32>,
+    pub objects: Vec<Object>,
+    pub materials: Vec<Material>,
+    pub lights: Vec<Light>,
+    pub camera: Camera,
+    pub environment: Environment,
+    /// Everything the converter approximated, skipped or guessed, one line each.
+    pub warnings: Vec<String>,
+    /// Degenerate triangles (zero area, repeated or collinear vertices) dropped.
+    pub dropped_degenerate: u64,
+    /// BLAKE3 of the positions in soup order (see [`geometry_hash`]).
+    pub geometry_hash: Digest,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Object {
+    /// GameObject name (hierarchy path segments joined by '/').
+    pub name: String,
+    /// Where its mesh came from: an asset path relative to the project, or `builtin:Cube` …
+    pub source: String,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Material {
+    pub name: String,
+    /// `.mat` path relative to the project, or `builtin:Default-Material`, or the OBJ's `.mtl`.
+    pub source: String,
+    /// `_Color` / `_BaseColor`, linear RGB.
+    pub color: Vec3,
+    /// `_Metallic`, 0–1.
+    pub metallic: f32,
+    /// `_Glossiness` / `_Smoothness`, 0–1.
+    pub smoothness: f32,
+    /// `_Reflectivity` when the material sets it: overrides metallic·smoothness.
+    pub reflectivity: Option<f32>,
+    /// `_EmissionColor` when emission is enabled, linear RGB (HDR, may exceed 1).
+    pub emission: Vec3,
+}
+
+impl Material {
+    /// Unity's Default-Material: white, non-metallic, smoothness 0.5.
+    pub fn unity_default() -> Self {
+        Material {
+            name: "Default-Material".into(),
+            source: "builtin:Default-Material".into(),
+            color: Vec3::ONE,
+            metallic: 0.0,
+            smoothness: 0.5,
+            reflectivity: None,
+            emission: Vec3::ZERO,
+        }
+    }
+
+    /// Lambert albedo: colour·(1 − metallic) (DESIGN §6).
+    pub fn albedo(&self) -> Vec3 {
+        self.color * (1.0 - self.metallic.clamp(0.0, 1.0))
+    }
+
+    /// Mirror reflectance, tinted by the colour: `_Reflectivity` if set, else
+    /// metallic·smoothness (DESIGN §6).
+    pub fn reflectance(&self) -> Vec3 {
+        let r = self
+            .reflectivity
+            .unwrap_or(self.metallic * self.smoothness)
+            .clamp(0.0, 1.0);
+        if self.reflectivity.is_some() {
+            Vec3::splat(r)
+        } else {
+            self.color * r
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Shadows {
+    None,
+    Hard,
+    Soft,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum LightKind {
+    /// Radiates in all directions from `position`, attenuated to zero at `range`.
+    Point,
+    /// A point light limited to a cone around `direction`; angles are full cone angles
+    /// in degrees (`inner_angle` ≤ `angle`; equal means a hard edge).
+    Spot { angle: f32, inner_angle: f32 },
+    /// Parallel light travelling along `direction`; no falloff.
+    Directional,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Light {
+    pub name: String,
+    pub kind: LightKind,
+    pub position: Vec3,
+    /// Unit vector the light shines along (Unity's local +Z, converted).
+    pub direction: Vec3,
+    /// Linear RGB.
+    pub color: Vec3,
+    pub intensity: f32,
+    /// Distance at which point and spot lights reach zero.
+    pub range: f32,
+    pub shadows: Shadows,
+    /// Soft shadows: emitter radius in metres (point, spot) or angular diameter in degrees
+    /// (directional).
+    pub shadow_radius: f32,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Projection {
+    /// Vertical field of view in degrees.
+    Perspective { fov_y: f32 },
+    /// Half of the view's height in metres.
+    Orthographic { half_height: f32 },
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Camera {
+    pub name: String,
+    pub position: Vec3,
+    /// Unit view direction.
+    pub forward: Vec3,
+    /// Unit up vector, orthogonal to `forward`. Image right is `forward × up`.
+    pub up: Vec3,
+    pub projection: Projection,
+    pub near: f32,
+}
+
+impl Camera {
+    /// Image-right direction. Because the soup is right-handed, `forward × up` points to
+    /// the right of the picture, exactly as Unity's +X does in the Game view.
+    pub fn right(&self) -> Vec3 {
+        self.forward.cross(self.up).normalize_or_zero()
+    }
+}
+
+impl Default for Camera {
+    /// Unity's new-scene camera: at (0, 1, −10) looking along +Z, 60° vertical FOV
+    /// (converted to soup space).
+    fn default() -> Self {
+        Camera {
+            name: "Default Camera".into(),
+            position: Vec3::new(0.0, 1.0, -10.0),
+            forward: Vec3::Z,
+            up: Vec3::Y,
+            projection: Projection::Perspective { fov_y: 60.0 },
+            near: 0.3,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ClearFlags {
+    Skybox,
+    SolidColor,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum AmbientMode {
+    /// One colour (`sky`) everywhere.
+    Flat,
+    /// Sky above, equator at the horizon, ground below, by the normal's Y.
+    Trilight,
+    /// Unity's skybox ambient, approximated as a trilight from the sky's colours.
+    Skybox,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Ambient {
+    pub mode: AmbientMode,
+    /// Linear RGB, already multiplied by the ambient intensity.
+    pub sky: Vec3,
+    pub equator: Vec3,
+    pub ground: Vec3,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Environment {
+    pub clear: ClearFlags,
+    /// The camera's solid background colour, linear RGB (used when `clear` is SolidColor).
+    pub background: Vec3,
+    pub ambient: Ambient,
+}
+
+impl Default for Environment {
+    fn default() -> Self {
+        Environment {
+            clear: ClearFlags::SolidColor,
+            background: Vec3::ZERO,
+            ambient: Ambient {
+                mode: AmbientMode::Flat,
+                sky: Vec3::ZERO,
+                equator: Vec3::ZERO,
+                ground: Vec3::ZERO,
+            },
+        }
+    }
+}
+
+/// BLAKE3 of the triangle positions in soup order, each coordinate as f32 little-endian.
+pub fn geometry_hash(triangles: &[[Vec3; 3]]) -> Digest {
+    let mut h = blake3::Hasher::new();
+    let mut buf = Vec::with_capacity(36 * 4096);
+    for chunk in triangles.chunks(4096) {
+        buf.clear();
+        for t in chunk {
+            for v in t {
+                for c in v.to_array() {
+                    buf.extend_from_slice(&c.to_le_bytes());
+                }
+            }
+        }
+        h.update(&buf);
+    }
+    *h.finalize().as_bytes()
+}
+
+impl Soup {
+    /// An empty soup with Unity's default camera and a black environment.
+    pub fn empty() -> Self {
+        Soup {
+            triangles: vec![],
+            normals: vec![],
+            tri_material: vec![],
+            tri_object: vec![],
+            objects: vec![],
+            materials: vec![],
+            lights: vec![],
+            camera: Camera::default(),
+            environment: Environment::default(),
+            warnings: vec![],
+            dropped_degenerate: 0,
+            geometry_hash: geometry_hash(&[]),
+        }
+    }
+
+    /// Recompute `geometry_hash` from the triangles (call after changing geometry).
+    pub fn seal(&mut self) {
+        self.geometry_hash = geometry_hash(&self.triangles);
+    }
+
+    /// Check the cross-references a reader relies on, naming the first bad one.
+    pub fn validate(&self) -> Result<(), String> {
+        let n = self.triangles.len();
+        if self.normals.len() != n || self.tri_material.len() != n || self.tri_object.len() != n {
+            return Err(format!(
+                "{n} triangles but {} normals, {} material indices, {} object indices",
+                self.normals.len(),
+                self.tri_material.len(),
+                self.tri_object.len()
+            ));
+        }
+        if let Some(i) = self
+            .tri_material
+            .iter()
+            .position(|&m| m as usize >= self.materials.len())
+        {
+            return Err(format!(
+                "triangle {i} names material {} of {}",
+                self.tri_material[i],
+                self.materials.len()
+            ));
+        }
+        if let Some(i) = self
+            .tri_object
+            .iter()
+            .position(|&o| o as usize >= self.objects.len())
+        {
+            return Err(format!(
+                "triangle {i} names object {} of {}",
+                self.tri_object[i],
+                self.objects.len()
+            ));
+        }
+        if let Some(i) = self
+            .triangles
+            .iter()
+            .position(|t| t.iter().any(|v| !v.is_finite()))
+        {
+            return Err(format!("triangle {i} has a non-finite vertex"));
+        }
+        if geometry_hash(&self.triangles) != self.geometry_hash {
+            return Err("geometry hash does not match the triangles".into());
+        }
+        Ok(())
+    }
+
+    pub fn to_bytes(&self, path: &Path) -> Result<Vec<u8>, FormatError> {
+        envelope::encode(self, MAGIC, VERSION, path)
+    }
+
+    pub fn from_bytes(bytes: &[u8], path: &Path) -> Result<Self, FormatError> {
+        let soup: Soup = envelope::decode(bytes, MAGIC, "soup", VERSION, path)?;
+        soup.validate().map_err(|detail| FormatError::Corrupt {
+            path: path.to_path_buf(),
+            detail,
+        })?;
+        Ok(soup)
+    }
+
+    /// Write atomically (temp file + rename).
+    pub fn write(&self, path: &Path) -> Result<(), FormatError> {
+        envelope::write_atomic(path, &self.to_bytes(path)?)
+    }
+
+    pub fn read(path: &Path) -> Result<Self, FormatError> {
+        Self::from_bytes(&envelope::read_file(path)?, path)
+    }
+}

@@ -1,0 +1,185 @@
+use formats::*;
+use glam::Vec3;
+use std::path::Path;
+
+fn sample_soup() -> Soup {
+    let mut s = Soup::empty();
+    s.triangles = vec![
+        [Vec3::ZERO, Vec3::X, Vec3::Y],
+        [Vec3::Z, Vec3::X, Vec3::ONE],
+    ];
+    s.normals = vec![[Vec3::Z; 3], [Vec3::Y; 3]];
+    s.tri_material = vec![0, 0];
+    s.tri_object = vec![0, 0];
+    s.objects = vec![Object {
+        name: "Cube".into(),
+        source: "builtin:Cube".into(),
+    }];
+    s.materials = vec![Material::unity_default()];
+    s.lights = vec![Light {
+        name: "Point Light".into(),
+        kind: LightKind::Spot {
+            angle: 30.0,
+            inner_angle: 20.0,
+        },
+        position: Vec3::new(1.0, 2.0, 3.0),
+        direction: -Vec3::Y,
+        color: Vec3::ONE,
+        intensity: 1.5,
+        range: 10.0,
+        shadows: Shadows::Soft,
+        shadow_radius: 0.1,
+    }];
+    s.warnings = vec!["a warning".into()];
+    s.seal();
+    s
+}
+
+fn sample_kd() -> KdFile {
+    KdFile {
+        geometry_hash: sample_soup().geometry_hash,
+        params: BuildParams::default(),
+        stats: TreeStats {
+            triangles: 2,
+            nodes: 3,
+            leaves: 2,
+            ..Default::default()
+        },
+        bounds: [Vec3::ZERO, Vec3::ONE],
+        nodes: vec![
+            KdNode::interior(0, 0.5, 2),
+            KdNode::leaf(1, 0),
+            KdNode::leaf(2, 1),
+        ],
+        leaf_tris: vec![0, 0, 1],
+    }
+}
+
+#[test]
+fn soup_round_trips_through_a_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("a.soup");
+    let s = sample_soup();
+    s.write(&path).unwrap();
+    assert_eq!(Soup::read(&path).unwrap(), s);
+    let bytes = std::fs::read(&path).unwrap();
+    assert_eq!(&bytes[..8], b"UTSOUP\0\0");
+    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 1);
+    // Nothing but the artifact is left in the folder (the temp file was renamed).
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+}
+
+#[test]
+fn kd_round_trips() {
+    let p = Path::new("t.kd");
+    let k = sample_kd();
+    assert_eq!(KdFile::from_bytes(&k.to_bytes(p).unwrap(), p).unwrap(), k);
+}
+
+#[test]
+fn truncated_foreign_old_and_corrupt_files_are_named_errors() {
+    let p = Path::new("scene.soup");
+    let good = sample_soup().to_bytes(p).unwrap();
+    let cases: Vec<(Vec<u8>, &str)> = vec![
+        (vec![], "empty"),
+        (good[..30].to_vec(), "truncated"),
+        (good[..good.len() - 1].to_vec(), "truncated"),
+        (
+            b"\x89PNG\r\n\x1a\nxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxx".to_vec(),
+            "not a soup",
+        ),
+        (sample_kd().to_bytes(p).unwrap(), "not a soup"),
+        (
+            {
+                let mut b = good.clone();
+                b[8] = 0;
+                b
+            },
+            "version 0",
+        ),
+        (
+            {
+                let mut b = good.clone();
+                let mid = b.len() / 2 + 10;
+                b[mid] ^= 0x40;
+                b
+            },
+            "checksum",
+        ),
+    ];
+    for (bytes, want) in cases {
+        let msg = Soup::from_bytes(&bytes, p).unwrap_err().to_string();
+        assert!(msg.starts_with("scene.soup:"), "{msg}");
+        assert!(msg.contains(want), "{msg} should mention {want}");
+    }
+}
+
+#[test]
+fn a_length_field_claiming_a_trillion_elements_fails_fast() {
+    // A valid frame whose payload claims 10^12 triangles: the checksum is recomputed so
+    // only the decoder stands between the claim and an allocation.
+    let p = Path::new("huge.soup");
+    let good = sample_soup().to_bytes(p).unwrap();
+    let mut payload = good[52..].to_vec();
+    payload[..8].copy_from_slice(&1_000_000_000_000u64.to_le_bytes());
+    let mut bytes = good[..20].to_vec();
+    bytes.extend_from_slice(blake3::hash(&payload).as_bytes());
+    bytes.extend_from_slice(&payload);
+    let msg = Soup::from_bytes(&bytes, p).unwrap_err().to_string();
+    assert!(msg.contains("does not decode"), "{msg}");
+}
+
+#[test]
+fn kd_with_a_dangling_child_is_refused() {
+    let p = Path::new("bad.kd");
+    let mut k = sample_kd();
+    k.nodes[0] = KdNode::interior(0, 0.5, 7);
+    let msg = KdFile::from_bytes(&k.to_bytes(p).unwrap(), p)
+        .unwrap_err()
+        .to_string();
+    assert!(msg.contains("node 0 points at child 7"), "{msg}");
+}
+
+#[test]
+fn rays_and_hits_round_trip_and_reject_short_files() {
+    let p = Path::new("r.rays");
+    let rays = vec![RayRecord {
+        origin: Vec3::new(1.0, -2.0, 3.5),
+        tmin: 0.0,
+        dir: Vec3::new(0.0, -0.0, 1.0),
+        tmax: f32::INFINITY,
+    }];
+    let bytes = rays::encode_rays(&rays);
+    assert_eq!(bytes.len(), 16 + 32);
+    let back = rays::decode_rays(&bytes, p).unwrap();
+    assert_eq!(back, rays);
+    assert!(back[0].dir.y.is_sign_negative());
+    let msg = rays::decode_rays(&bytes[..40], p).unwrap_err().to_string();
+    assert!(msg.contains("truncated"), "{msg}");
+    let hits = vec![
+        Hit::MISS,
+        Hit {
+            t: 2.0,
+            prim: 7,
+            u: 0.25,
+            v: 0.5,
+        },
+    ];
+    assert_eq!(
+        rays::decode_hits(&rays::encode_hits(&hits), p).unwrap(),
+        hits
+    );
+}
+
+#[test]
+fn geometry_hash_depends_on_positions_only() {
+    let a = sample_soup();
+    let mut b = a.clone();
+    b.lights.clear();
+    b.materials[0].color = Vec3::X;
+    b.seal();
+    assert_eq!(a.geometry_hash, b.geometry_hash);
+    b.triangles[0][0].x += 1e-6;
+    b.seal();
+    assert_ne!(a.geometry_hash, b.geometry_hash);
+}
