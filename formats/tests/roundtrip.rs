@@ -183,3 +183,34 @@ fn geometry_hash_depends_on_positions_only() {
     b.seal();
     assert_ne!(a.geometry_hash, b.geometry_hash);
 }
+
+/// SOUP.md promises a byte layout other programs can read: check its first fields by hand.
+#[test]
+fn payload_layout_matches_soup_md() {
+    let p = Path::new("s.soup");
+    let s = sample_soup();
+    let b = s.to_bytes(p).unwrap();
+    let payload = &b[52..];
+    let u64_at = |o: usize| u64::from_le_bytes(payload[o..o + 8].try_into().unwrap());
+    let f32_at = |o: usize| f32::from_le_bytes(payload[o..o + 4].try_into().unwrap());
+    // triangles: u64 count, then 9 f32 per triangle, no inner lengths.
+    assert_eq!(u64_at(0), 2);
+    assert_eq!(f32_at(8 + 36 + 24), 1.0); // second triangle, second vertex (X), x
+    // normals follow directly.
+    assert_eq!(u64_at(8 + 72), 2);
+    // The last 32 bytes are the geometry hash.
+    assert_eq!(&payload[payload.len() - 32..], &s.geometry_hash);
+    // Option<f32> is one tag byte then the value; enums are a u32 index.
+    let m = Material { reflectivity: Some(0.5), ..Material::unity_default() };
+    let mut one = Soup::empty();
+    one.materials = vec![m];
+    one.lights = s.lights.clone();
+    let b = one.to_bytes(p).unwrap();
+    let payload = &b[52..];
+    let find = |needle: &[u8]| payload.windows(needle.len()).position(|w| w == needle).unwrap();
+    let refl = find(&[1, 0, 0, 0, 0x3f]); // tag 1, then 0.5f32 = 00 00 00 3f
+    assert_eq!(f32::from_le_bytes(payload[refl + 1..refl + 5].try_into().unwrap()), 0.5);
+    let spot = find(b"Point Light") + "Point Light".len();
+    assert_eq!(u32::from_le_bytes(payload[spot..spot + 4].try_into().unwrap()), 1, "Spot is variant 1");
+    assert_eq!(f32::from_le_bytes(payload[spot + 4..spot + 8].try_into().unwrap()), 30.0);
+}
