@@ -1,1 +1,95 @@
-//! placeholder
+//! `unity2soup`'s library: reads a text-serialized Unity scene with its project (`.meta`
+//! GUIDs, `.prefab`, `.mat`, OBJ models) and produces the world-space triangle soup of
+//! DESIGN §3–§4.
+//!
+//! Stages: [`docs`] splits files into documents, [`yaml`] parses the bodies it needs,
+//! [`graph`] builds the object graph with prefab instances expanded, [`emit`] walks it
+//! into a [`formats::Soup`].
+
+pub mod docs;
+pub mod emit;
+pub mod graph;
+pub mod material;
+pub mod mesh;
+pub mod meta;
+pub mod obj;
+pub mod objexport;
+pub mod primitives;
+pub mod project;
+pub mod yaml;
+
+use formats::Soup;
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, thiserror::Error)]
+pub enum ConvertError {
+    #[error("{0}: no folder holding Assets/ above the scene; pass --assets PROJECT_DIR")]
+    NoProject(PathBuf),
+    #[error(transparent)]
+    Load(#[from] graph::LoadError),
+    #[error(transparent)]
+    Emit(#[from] emit::EmitError),
+    #[error("--strict: {count} warning(s); the first: {first}")]
+    Strict { count: usize, first: String },
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct Options {
+    /// Project root (the folder holding `Assets/`) or the `Assets` folder; default: walk
+    /// up from the scene.
+    pub project: Option<PathBuf>,
+    /// Turn warnings into an error.
+    pub strict: bool,
+}
+
+/// Convert a scene into a sealed soup.
+pub fn convert(scene: &Path, opts: &Options) -> Result<Soup, ConvertError> {
+    let root = match &opts.project {
+        Some(p) => p.clone(),
+        None => {
+            let dir = scene.parent().unwrap_or(Path::new("."));
+            project::find_root(dir).ok_or_else(|| ConvertError::NoProject(scene.to_path_buf()))?
+        }
+    };
+    let project = project::Project::open(&root);
+    // Refuse binary scenes before doing any work.
+    let bytes = std::fs::read(scene).map_err(|source| graph::LoadError::Io {
+        path: scene.to_path_buf(),
+        source,
+    })?;
+    if !docs::is_text_yaml(&bytes) {
+        return Err(graph::LoadError::Binary(scene.to_path_buf()).into());
+    }
+    project.preload_models(&String::from_utf8_lossy(&bytes));
+    let mut g = graph::Graph::new(&project);
+    g.warnings.extend(project.guids.warnings.iter().cloned());
+    g.load_scene(scene)?;
+    let scene_rel = project.rel(scene);
+    let mut soup = emit::emit(&g, &scene_rel)?;
+    // Model-level warnings (missing .mtl …), once per model used.
+    let mut model_warnings: Vec<String> = Vec::new();
+    for f in soup
+        .objects
+        .iter()
+        .map(|o| o.source.split('#').next().unwrap_or(""))
+    {
+        let p = project.root.join(f);
+        if project::ext(&p) == "obj" {
+            if let Ok(a) = project.model(&p).as_ref() {
+                for w in &a.obj.warnings {
+                    if !model_warnings.contains(w) {
+                        model_warnings.push(w.clone());
+                    }
+                }
+            }
+        }
+    }
+    soup.warnings.extend(model_warnings);
+    if opts.strict && !soup.warnings.is_empty() {
+        return Err(ConvertError::Strict {
+            count: soup.warnings.len(),
+            first: soup.warnings[0].clone(),
+        });
+    }
+    Ok(soup)
+}

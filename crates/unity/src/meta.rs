@@ -1,0 +1,211 @@
+//! `.meta` files: the project's GUID → asset index, and the ModelImporter settings that
+//! decide which fileID names which object inside a model (DESIGN §4).
+
+use crate::yaml::{self, Node};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use xxhash_rust::xxh64::xxh64;
+
+/// GUID → asset path, from every `*.meta` under `Assets/`.
+#[derive(Default, Debug)]
+pub struct GuidIndex {
+    pub map: HashMap<String, PathBuf>,
+    pub warnings: Vec<String>,
+}
+
+impl GuidIndex {
+    pub fn build(assets: &Path) -> GuidIndex {
+        let mut idx = GuidIndex::default();
+        let mut stack = vec![assets.to_path_buf()];
+        while let Some(dir) = stack.pop() {
+            let Ok(rd) = std::fs::read_dir(&dir) else {
+                continue;
+            };
+            let mut entries: Vec<_> = rd.filter_map(Result::ok).map(|e| e.path()).collect();
+            entries.sort();
+            for p in entries {
+                if p.is_dir() {
+                    stack.push(p);
+                } else if p.extension().is_some_and(|e| e == "meta") {
+                    if let Some(guid) = read_guid(&p) {
+                        let asset = p.with_extension("");
+                        if let Some(prev) = idx.map.get(&guid) {
+                            idx.warnings.push(format!(
+                                "duplicate GUID {guid} in {} and {}; using the first",
+                                prev.display(),
+                                asset.display()
+                            ));
+                        } else {
+                            idx.map.insert(guid, asset);
+                        }
+                    }
+                }
+            }
+        }
+        idx
+    }
+
+    pub fn get(&self, guid: &str) -> Option<&PathBuf> {
+        self.map.get(guid)
+    }
+}
+
+/// The `guid:` line of a `.meta` file (read as a string, never as a number).
+fn read_guid(meta: &Path) -> Option<String> {
+    let text = std::fs::read_to_string(meta).ok()?;
+    text.lines()
+        .find_map(|l| l.strip_prefix("guid:"))
+        .map(|g| g.trim().to_string())
+        .filter(|g| !g.is_empty())
+}
+
+pub fn class_name(class: u32) -> &'static str {
+    match class {
+        1 => "GameObject",
+        4 => "Transform",
+        21 => "Material",
+        23 => "MeshRenderer",
+        33 => "MeshFilter",
+        43 => "Mesh",
+        _ => "Object",
+    }
+}
+
+/// What a model's `.meta` says about fileIDs and import scale.
+#[derive(Clone, Debug, Default)]
+pub struct ModelMeta {
+    /// `fileIDToRecycleName` (legacy): fileID → name.
+    pub recycle: Vec<(i64, String)>,
+    /// `internalIDToNameTable`: (class, fileID, name).
+    pub internal: Vec<(u32, i64, String)>,
+    /// `fileIdsGeneration: 2` (path-string hashes).
+    pub generation2: bool,
+    /// `globalScale` (ModelImporter scale factor).
+    pub global_scale: f32,
+}
+
+impl ModelMeta {
+    pub fn read(model: &Path) -> ModelMeta {
+        let mut meta_path = model.as_os_str().to_owned();
+        meta_path.push(".meta");
+        let text = std::fs::read_to_string(PathBuf::from(meta_path)).unwrap_or_default();
+        Self::parse(&text)
+    }
+
+    pub fn parse(text: &str) -> ModelMeta {
+        let root = yaml::parse(text);
+        let imp = root
+            .get("ModelImporter")
+            .cloned()
+            .unwrap_or(Node::Map(vec![]));
+        let mut m = ModelMeta {
+            global_scale: 1.0,
+            ..Default::default()
+        };
+        for (k, v) in imp
+            .get("fileIDToRecycleName")
+            .map(Node::as_map)
+            .unwrap_or(&[])
+        {
+            if let (Ok(id), Some(name)) = (k.trim().parse::<i64>(), v.as_str()) {
+                m.recycle.push((id, name.to_string()));
+            }
+        }
+        for e in imp
+            .get("internalIDToNameTable")
+            .map(Node::as_seq)
+            .unwrap_or(&[])
+        {
+            let name = e.str_at("second").unwrap_or("").to_string();
+            if let Some((k, v)) = e.get("first").and_then(|f| f.as_map().first()) {
+                if let (Ok(class), Some(id)) = (k.trim().parse::<u32>(), v.as_i64()) {
+                    m.internal.push((class, id, name));
+                }
+            }
+        }
+        if let Some(meshes) = imp.get("meshes") {
+            if let Some(s) = meshes.f32_at("globalScale") {
+                if s.is_finite() && s > 0.0 {
+                    m.global_scale = s;
+                }
+            }
+        }
+        m.generation2 = imp
+            .path(&["meshes", "fileIdsGeneration"])
+            .or_else(|| imp.get("fileIdsGeneration"))
+            .and_then(Node::as_i64)
+            == Some(2);
+        m
+    }
+
+    /// Every fileID this meta may use for the object of `class` that Unity names
+    /// `name` in its legacy table and in the 2019.1–2019.2 hash, and `path` in the
+    /// `fileIdsGeneration: 2` hash. All schemes are registered at once: they cannot
+    /// collide in practice, and old projects keep legacy ids after an upgrade.
+    pub fn ids(&self, class: u32, name: &str, path: &str) -> Vec<i64> {
+        let mut out = Vec::new();
+        for (id, n) in &self.recycle {
+            if n == name && (*id / 100000) as u32 == class {
+                out.push(*id);
+            }
+        }
+        for (c, id, n) in &self.internal {
+            if *c == class && n == name {
+                out.push(*id);
+            }
+        }
+        let cls = class_name(class);
+        out.push(hash_id(&format!("Type:{cls}->{name}0")));
+        out.push(hash_id(&format!("Type:{cls}->{path}0")));
+        out
+    }
+}
+
+/// Unity's hashed fileID: xxHash64 (seed 0) of the identifier string, as i64.
+pub fn hash_id(s: &str) -> i64 {
+    xxh64(s.as_bytes(), 0) as i64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hashed_ids_match_the_corpus() {
+        // fuqunaga/ComputeShaderBVHMeshHit bunny.obj (fileIdsGeneration: 2), and
+        // Ayinzhang/Rigidbody-Fracture's PrefabInstance targets of its bunny.obj.
+        assert_eq!(hash_id("Type:Mesh->default0"), -2432090755550338912);
+        assert_eq!(
+            hash_id("Type:GameObject->//RootNode/root0"),
+            919132149155446097
+        );
+        assert_eq!(
+            hash_id("Type:Transform->//RootNode/root/Transform0"),
+            -8679921383154817045
+        );
+        assert_eq!(
+            hash_id("Type:MeshFilter->//RootNode/root/default/MeshFilter0"),
+            -6400281290468069383
+        );
+        // superdump (2019.2, name hashes): root GameObject, root and child Transforms.
+        assert_eq!(hash_id("Type:GameObject->//RootNode0"), -927199367670048503);
+        assert_eq!(hash_id("Type:Transform->//RootNode0"), -4216859302048453862);
+        assert_eq!(hash_id("Type:Transform->default0"), -5975033157549033438);
+    }
+
+    #[test]
+    fn legacy_table_and_settings() {
+        let text = "fileFormatVersion: 2\nguid: 19cde6fd65027fb4c9c6814597f47199\nModelImporter:\n  serializedVersion: 23\n  fileIDToRecycleName:\n    100000: //RootNode\n    100002: Bunny\n    400000: //RootNode\n    400002: Bunny\n    4300000: default\n    4300002: Bunny\n  meshes:\n    globalScale: 0.007\n";
+        let m = ModelMeta::parse(text);
+        assert_eq!(m.global_scale, 0.007);
+        assert!(!m.generation2);
+        assert_eq!(m.ids(43, "Bunny", "Bunny")[0], 4300002);
+        assert_eq!(
+            m.ids(4, "//RootNode", "//RootNode/root/Transform")[0],
+            400000
+        );
+        let g2 = ModelMeta::parse("ModelImporter:\n  internalIDToNameTable:\n  - first:\n      43: 777\n    second: Foo\n  meshes:\n    fileIdsGeneration: 2\n");
+        assert!(g2.generation2);
+        assert_eq!(g2.ids(43, "Foo", "Foo")[0], 777);
+    }
+}

@@ -1,0 +1,323 @@
+//! Wavefront OBJ as Unity imports it: one mesh per `g`/`o` group name (`default` when
+//! none; groups with the same name merge, groups without faces make no mesh), each
+//! `usemtl` block a sub-mesh in order of first use, polygons triangulated, normals
+//! computed when the file has none, X negated and winding reversed (Unity space).
+//!
+//! A hand-written reader rather than `tobj`: Unity's grouping (merge by name, faceless
+//! groups dropped, sub-meshes per material inside a group) is what the scene's fileIDs
+//! and material slots refer to, and it is simpler to follow exactly here.
+
+use crate::mesh::{smooth_normals, triangulate, Mesh};
+use glam::Vec3;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, thiserror::Error)]
+pub enum ObjError {
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{0}: is a Git LFS pointer, not the model (run `git lfs pull` in the project)")]
+    LfsPointer(PathBuf),
+    #[error("{path}:{line}: {detail}")]
+    Parse {
+        path: PathBuf,
+        line: usize,
+        detail: String,
+    },
+}
+
+#[derive(Clone, Debug)]
+pub struct ObjGroup {
+    pub name: String,
+    /// Unity space.
+    pub mesh: Mesh,
+    /// The `usemtl` name of each sub-mesh (`""` when none was given).
+    pub materials: Vec<String>,
+}
+
+#[derive(Clone, Debug)]
+pub struct ObjModel {
+    pub path: PathBuf,
+    pub groups: Vec<ObjGroup>,
+    /// `Kd` of each material in the `.mtl` files found.
+    pub mtl_colors: HashMap<String, Vec3>,
+    pub warnings: Vec<String>,
+}
+
+impl ObjModel {
+    pub fn triangle_count(&self) -> usize {
+        self.groups.iter().map(|g| g.mesh.triangle_count()).sum()
+    }
+}
+
+/// A face corner: position index and the file's normal index, if any.
+type Corner = (u32, Option<u32>);
+
+struct GroupAcc {
+    name: String,
+    /// Per material (in order of first use): polygons as (position, normal) index lists.
+    subs: Vec<(String, Vec<Vec<Corner>>)>,
+}
+
+fn resolve(idx: i64, len: usize) -> Option<u32> {
+    let i = if idx < 0 { len as i64 + idx } else { idx - 1 };
+    (i >= 0 && (i as usize) < len).then_some(i as u32)
+}
+
+pub fn load(path: &Path) -> Result<ObjModel, ObjError> {
+    let bytes = std::fs::read(path).map_err(|source| ObjError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    if bytes.starts_with(b"version https://git-lfs.github.com/spec") {
+        return Err(ObjError::LfsPointer(path.to_path_buf()));
+    }
+    let text = String::from_utf8_lossy(&bytes);
+    parse(&text, path)
+}
+
+pub fn parse(text: &str, path: &Path) -> Result<ObjModel, ObjError> {
+    let mut pos: Vec<Vec3> = Vec::new();
+    let mut nrm: Vec<Vec3> = Vec::new();
+    let mut groups: Vec<GroupAcc> = Vec::new();
+    let mut group_of: HashMap<String, usize> = HashMap::new();
+    let mut current_group = "default".to_string();
+    let mut current_mtl = String::new();
+    let mut mtllibs: Vec<String> = Vec::new();
+    let bad = |line: usize, detail: String| ObjError::Parse {
+        path: path.to_path_buf(),
+        line,
+        detail,
+    };
+    let mut lines = text.lines().enumerate().peekable();
+    while let Some((ln, raw)) = lines.next() {
+        let mut line = raw.trim().to_string();
+        // Backslash continues a line.
+        while line.ends_with('\\') {
+            line.pop();
+            match lines.next() {
+                Some((_, more)) => line.push_str(more.trim()),
+                None => break,
+            }
+        }
+        let line = line.split('#').next().unwrap_or("").trim();
+        let mut it = line.split_whitespace();
+        let Some(tag) = it.next() else { continue };
+        let lno = ln + 1;
+        let floats = |it: std::str::SplitWhitespace| -> Result<Vec3, ObjError> {
+            let v: Vec<f32> = it
+                .take(3)
+                .map(|s| s.parse::<f32>())
+                .collect::<Result<_, _>>()
+                .map_err(|e| bad(lno, format!("bad number in `{line}`: {e}")))?;
+            if v.len() < 3 {
+                return Err(bad(lno, format!("expected 3 numbers in `{line}`")));
+            }
+            let v = Vec3::new(v[0], v[1], v[2]);
+            if !v.is_finite() {
+                return Err(bad(lno, format!("non-finite number in `{line}`")));
+            }
+            Ok(v)
+        };
+        match tag {
+            "v" => pos.push(floats(it)?),
+            "vn" => nrm.push(floats(it)?),
+            "g" | "o" => {
+                let name = it.collect::<Vec<_>>().join(" ");
+                current_group = if name.is_empty() {
+                    "default".into()
+                } else {
+                    name
+                };
+            }
+            "usemtl" => current_mtl = it.collect::<Vec<_>>().join(" "),
+            "mtllib" => mtllibs.push(it.collect::<Vec<_>>().join(" ")),
+            "f" => {
+                let mut poly = Vec::new();
+                for c in it {
+                    let mut parts = c.split('/');
+                    let vi: i64 = parts
+                        .next()
+                        .and_then(|s| s.parse().ok())
+                        .ok_or_else(|| bad(lno, format!("bad face corner `{c}`")))?;
+                    let v = resolve(vi, pos.len())
+                        .ok_or_else(|| bad(lno, format!("vertex index {vi} out of range")))?;
+                    let _vt = parts.next();
+                    let n = match parts.next().filter(|s| !s.is_empty()) {
+                        Some(s) => {
+                            let ni: i64 = s
+                                .parse()
+                                .map_err(|_| bad(lno, format!("bad normal index in `{c}`")))?;
+                            Some(resolve(ni, nrm.len()).ok_or_else(|| {
+                                bad(lno, format!("normal index {ni} out of range"))
+                            })?)
+                        }
+                        None => None,
+                    };
+                    poly.push((v, n));
+                }
+                if poly.len() < 3 {
+                    continue;
+                }
+                let gi = *group_of.entry(current_group.clone()).or_insert_with(|| {
+                    groups.push(GroupAcc {
+                        name: current_group.clone(),
+                        subs: Vec::new(),
+                    });
+                    groups.len() - 1
+                });
+                let g = &mut groups[gi];
+                let si = match g.subs.iter().position(|(m, _)| *m == current_mtl) {
+                    Some(i) => i,
+                    None => {
+                        g.subs.push((current_mtl.clone(), Vec::new()));
+                        g.subs.len() - 1
+                    }
+                };
+                g.subs[si].1.push(poly);
+            }
+            _ => {}
+        }
+    }
+
+    let mut warnings = Vec::new();
+    let mut mtl_colors = HashMap::new();
+    let dir = path.parent().unwrap_or(Path::new("."));
+    for lib in &mtllibs {
+        let p = dir.join(lib);
+        match std::fs::read_to_string(&p) {
+            Ok(t) => parse_mtl(&t, &mut mtl_colors),
+            Err(_) => warnings.push(format!(
+                "{}: material library {lib} not found; its materials use Unity's default",
+                path.display()
+            )),
+        }
+    }
+
+    let groups = groups
+        .into_iter()
+        .map(|g| build_group(g, &pos, &nrm))
+        .collect();
+    Ok(ObjModel {
+        path: path.to_path_buf(),
+        groups,
+        mtl_colors,
+        warnings,
+    })
+}
+
+/// Triangulate a group's polygons and give every corner a normal (the file's, or a
+/// smoothed one split at 60° creases), then convert to Unity space.
+fn build_group(g: GroupAcc, pos: &[Vec3], nrm: &[Vec3]) -> ObjGroup {
+    // Triangles as (position index, file normal index) corners, per sub-mesh.
+    let mut subs_tris: Vec<Vec<[Corner; 3]>> = Vec::new();
+    let mut materials = Vec::new();
+    for (mtl, polys) in g.subs {
+        let mut tris = Vec::new();
+        for poly in polys {
+            let pts: Vec<Vec3> = poly.iter().map(|&(v, _)| pos[v as usize]).collect();
+            for t in triangulate(&pts) {
+                tris.push(t.map(|k| poly[k]));
+            }
+        }
+        materials.push(mtl);
+        subs_tris.push(tris);
+    }
+    // Normals the file lacks are computed over the whole group, so smoothing crosses
+    // sub-mesh borders like Unity's.
+    let all: Vec<[u32; 3]> = subs_tris.iter().flatten().map(|t| t.map(|c| c.0)).collect();
+    let needs = subs_tris.iter().flatten().flatten().any(|c| c.1.is_none());
+    let smooth = if needs {
+        smooth_normals(pos, &all, 60.0)
+    } else {
+        Vec::new()
+    };
+    let mut mesh = Mesh::default();
+    let mut vmap: HashMap<(u32, [u32; 3]), u32> = HashMap::new();
+    let mut k = 0usize;
+    for tris in subs_tris {
+        let mut out = Vec::with_capacity(tris.len());
+        for t in tris {
+            let mut tri = [0u32; 3];
+            for (j, &(v, n)) in t.iter().enumerate() {
+                let normal = match n {
+                    Some(ni) => nrm[ni as usize].normalize_or_zero(),
+                    None => smooth[k][j],
+                };
+                let key = (v, normal.to_array().map(f32::to_bits));
+                tri[j] = *vmap.entry(key).or_insert_with(|| {
+                    mesh.positions.push(pos[v as usize]);
+                    mesh.normals.push(normal);
+                    (mesh.positions.len() - 1) as u32
+                });
+            }
+            out.push(tri);
+            k += 1;
+        }
+        mesh.submeshes.push(out);
+    }
+    ObjGroup {
+        name: g.name,
+        mesh: mesh.import_rh(),
+        materials,
+    }
+}
+
+fn parse_mtl(text: &str, out: &mut HashMap<String, Vec3>) {
+    let mut current: Option<String> = None;
+    for line in text.lines() {
+        let mut it = line.split_whitespace();
+        match it.next() {
+            Some("newmtl") => current = Some(it.collect::<Vec<_>>().join(" ")),
+            Some("Kd") => {
+                let v: Vec<f32> = it.filter_map(|s| s.parse().ok()).collect();
+                if let (Some(name), [r, g, b, ..]) = (&current, v.as_slice()) {
+                    out.insert(name.clone(), Vec3::new(*r, *g, *b));
+                }
+            }
+            _ => {}
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn groups_merge_by_name_and_faceless_groups_vanish() {
+        let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\ng default\ng A\nusemtl red\nf 1 2 3\nusemtl blue\nf 1 3 4\ng B\nf -4 -3 -2 -1\ng A\nusemtl red\nf 1 2 4\n";
+        let m = parse(text, Path::new("t.obj")).unwrap();
+        let names: Vec<_> = m.groups.iter().map(|g| g.name.as_str()).collect();
+        assert_eq!(names, ["A", "B"]);
+        assert_eq!(m.groups[0].materials, ["red", "blue"]);
+        assert_eq!(m.groups[0].mesh.submeshes[0].len(), 2);
+        assert_eq!(m.groups[0].mesh.submeshes[1].len(), 1);
+        assert_eq!(m.groups[1].mesh.triangle_count(), 2);
+        // Unity space: x negated; the computed normals of faces that point +Z in the file
+        // still point +Z (negating X keeps Z).
+        assert!(m.groups[1].mesh.positions.iter().any(|p| p.x == -1.0));
+        assert!(m.groups[1]
+            .mesh
+            .normals
+            .iter()
+            .all(|n| (*n - Vec3::Z).length() < 1e-6));
+        assert!(m.warnings.is_empty());
+    }
+
+    #[test]
+    fn lfs_pointer_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("b.obj");
+        std::fs::write(
+            &p,
+            "version https://git-lfs.github.com/spec/v1\noid sha256:00\nsize 3\n",
+        )
+        .unwrap();
+        assert!(matches!(load(&p), Err(ObjError::LfsPointer(_))));
+    }
+}

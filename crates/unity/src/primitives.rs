@@ -1,0 +1,331 @@
+//! Unity's built-in meshes (`guid: 0000000000000000e000000000000000`), generated at
+//! Unity's dimensions. They are symmetric in X, so they are written here as right-handed
+//! counter-clockwise data and imported like an OBJ ([`Mesh::import_rh`]).
+
+use crate::mesh::Mesh;
+use glam::Vec3;
+use std::f32::consts::{PI, TAU};
+
+pub const BUILTIN_MESH_GUID: &str = "0000000000000000e000000000000000";
+
+/// Name of a built-in mesh by fileID.
+pub fn name(file_id: i64) -> Option<&'static str> {
+    Some(match file_id {
+        10202 => "Cube",
+        10206 => "Cylinder",
+        10207 => "Sphere",
+        10208 => "Capsule",
+        10209 => "Plane",
+        10210 => "Quad",
+        _ => return None,
+    })
+}
+
+/// The built-in mesh with this fileID, in Unity space.
+pub fn mesh(file_id: i64) -> Option<Mesh> {
+    let m = match file_id {
+        10202 => cube(),
+        10206 => cylinder(20),
+        10207 => sphere(24, 16),
+        10208 => capsule(24, 8),
+        10209 => plane(),
+        10210 => quad(),
+        _ => return None,
+    };
+    Some(m.import_rh())
+}
+
+#[derive(Default)]
+struct Builder {
+    p: Vec<Vec3>,
+    n: Vec<Vec3>,
+    t: Vec<[u32; 3]>,
+}
+
+impl Builder {
+    fn v(&mut self, p: Vec3, n: Vec3) -> u32 {
+        self.p.push(p);
+        self.n.push(n);
+        (self.p.len() - 1) as u32
+    }
+    /// Quad a-b-c-d counter-clockwise seen from the front.
+    fn quad(&mut self, a: u32, b: u32, c: u32, d: u32) {
+        self.t.push([a, b, c]);
+        self.t.push([a, c, d]);
+    }
+    fn done(self) -> Mesh {
+        Mesh {
+            positions: self.p,
+            normals: self.n,
+            submeshes: vec![self.t],
+        }
+    }
+}
+
+/// 1×1×1, 24 vertices, 12 triangles.
+fn cube() -> Mesh {
+    let mut b = Builder::default();
+    for axis in 0..3 {
+        for sign in [-1.0f32, 1.0] {
+            let n = Vec3::from_array(std::array::from_fn(|i| if i == axis { sign } else { 0.0 }));
+            // Two tangents with t1 × t2 = n.
+            let t1 = Vec3::from_array(std::array::from_fn(|i| {
+                if i == (axis + 1) % 3 {
+                    1.0
+                } else {
+                    0.0
+                }
+            }));
+            let t2 = n.cross(t1);
+            let c = n * 0.5;
+            let vs: Vec<u32> = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+                .iter()
+                .map(|&(s, t)| b.v(c + t1 * (0.5 * s) + t2 * (0.5 * t), n))
+                .collect();
+            b.quad(vs[0], vs[1], vs[2], vs[3]);
+        }
+    }
+    b.done()
+}
+
+/// 10×10 in XZ at y = 0, facing +Y: 11×11 vertices, 200 triangles.
+fn plane() -> Mesh {
+    let mut b = Builder::default();
+    let idx = |i: u32, j: u32| i * 11 + j;
+    for i in 0..11 {
+        for j in 0..11 {
+            b.v(Vec3::new(-5.0 + j as f32, 0.0, -5.0 + i as f32), Vec3::Y);
+        }
+    }
+    for i in 0..10 {
+        for j in 0..10 {
+            // Counter-clockwise seen from +Y: (x, z) → (x, z+1) → (x+1, z+1) → (x+1, z).
+            b.quad(idx(i, j), idx(i + 1, j), idx(i + 1, j + 1), idx(i, j + 1));
+        }
+    }
+    b.done()
+}
+
+/// 1×1 in XY at z = 0, facing −Z.
+fn quad() -> Mesh {
+    let mut b = Builder::default();
+    let n = Vec3::NEG_Z;
+    let a = b.v(Vec3::new(-0.5, -0.5, 0.0), n);
+    let c = b.v(Vec3::new(-0.5, 0.5, 0.0), n);
+    let d = b.v(Vec3::new(0.5, 0.5, 0.0), n);
+    let e = b.v(Vec3::new(0.5, -0.5, 0.0), n);
+    // Counter-clockwise seen from −Z.
+    b.quad(a, c, d, e);
+    b.done()
+}
+
+/// A UV sphere around the origin; `rings` latitude bands.
+fn sphere_points(b: &mut Builder, seg: u32, rings: u32, r: f32, y_of: impl Fn(f32) -> f32) {
+    // Rows of vertices from the north pole (ring 0) to the south pole (ring `rings`);
+    // the poles are single-triangle fans.
+    let mut rows: Vec<Vec<u32>> = Vec::new();
+    for ri in 0..=rings {
+        let theta = PI * ri as f32 / rings as f32;
+        let (st, ct) = theta.sin_cos();
+        // Exactly on the equator when there is an equator row (the capsule splits there).
+        let ct = if 2 * ri == rings { 0.0 } else { ct };
+        let row = (0..=seg)
+            .map(|si| {
+                let phi = TAU * si as f32 / seg as f32;
+                let n = Vec3::new(st * phi.cos(), ct, -st * phi.sin());
+                let p = Vec3::new(n.x * r, y_of(n.y * r), n.z * r);
+                b.v(p, n)
+            })
+            .collect();
+        rows.push(row);
+    }
+    for ri in 0..rings as usize {
+        for si in 0..seg as usize {
+            let (a, bb) = (rows[ri][si], rows[ri][si + 1]);
+            let (c, d) = (rows[ri + 1][si + 1], rows[ri + 1][si]);
+            // Outward-facing: north row a→b runs counter-clockwise seen from above.
+            if ri == 0 {
+                b.t.push([a, d, c]);
+            } else if ri == rings as usize - 1 {
+                b.t.push([a, d, bb]);
+            } else {
+                b.quad(a, d, c, bb);
+            }
+        }
+    }
+}
+
+/// Diameter 1.
+fn sphere(seg: u32, rings: u32) -> Mesh {
+    let mut b = Builder::default();
+    sphere_points(&mut b, seg, rings, 0.5, |y| y);
+    b.done()
+}
+
+/// Diameter 1, height 2: hemispheres of radius 0.5 centred at y = ±0.5.
+fn capsule(seg: u32, half_rings: u32) -> Mesh {
+    let mut b = Builder::default();
+    // An even number of rings puts a row on the equator; shifting the two halves apart
+    // there stretches that band into the cylindrical side.
+    sphere_points(&mut b, seg, half_rings * 2, 0.5, |y| {
+        if y > 0.0 {
+            y + 0.5
+        } else if y < 0.0 {
+            y - 0.5
+        } else {
+            0.0
+        }
+    });
+    // The equator row sits at y = 0 from the closure above; rebuild it as two rows so
+    // the side spans y ∈ [−0.5, 0.5].
+    let m = b.done();
+    fix_capsule_equator(m, seg)
+}
+
+/// The equator ring of the capsule generator is at y = 0: split the bands touching it so
+/// that the upper band ends at y = +0.5 and the lower starts at y = −0.5, joined by a side
+/// band.
+fn fix_capsule_equator(m: Mesh, seg: u32) -> Mesh {
+    let mut b = Builder::default();
+    let mut remap_up = vec![u32::MAX; m.positions.len()];
+    let mut remap_down = vec![u32::MAX; m.positions.len()];
+    for (i, (&p, &n)) in m.positions.iter().zip(&m.normals).enumerate() {
+        if p.y == 0.0 {
+            remap_up[i] = b.v(Vec3::new(p.x, 0.5, p.z), n);
+            remap_down[i] = b.v(Vec3::new(p.x, -0.5, p.z), n);
+        } else {
+            remap_up[i] = b.v(p, n);
+            remap_down[i] = remap_up[i];
+        }
+    }
+    for t in &m.submeshes[0] {
+        let above = t.iter().any(|&i| m.positions[i as usize].y > 0.0);
+        let r = if above { &remap_up } else { &remap_down };
+        b.t.push(t.map(|i| r[i as usize]));
+    }
+    // Side band between the two equator copies.
+    let eq: Vec<usize> = (0..m.positions.len())
+        .filter(|&i| m.positions[i].y == 0.0)
+        .collect();
+    debug_assert_eq!(eq.len(), seg as usize + 1);
+    for w in eq.windows(2) {
+        let (a, c) = (w[0], w[1]);
+        b.quad(remap_up[a], remap_down[a], remap_down[c], remap_up[c]);
+    }
+    b.done()
+}
+
+/// Diameter 1, height 2 (y ∈ [−1, 1]), `seg` sides, capped.
+fn cylinder(seg: u32) -> Mesh {
+    let mut b = Builder::default();
+    let ring = |b: &mut Builder, y: f32, side: bool| -> Vec<u32> {
+        (0..=seg)
+            .map(|si| {
+                let phi = TAU * si as f32 / seg as f32;
+                let d = Vec3::new(phi.cos(), 0.0, -phi.sin());
+                let n = if side {
+                    d
+                } else {
+                    Vec3::new(0.0, y.signum(), 0.0)
+                };
+                b.v(d * 0.5 + Vec3::Y * y, n)
+            })
+            .collect()
+    };
+    let top = ring(&mut b, 1.0, true);
+    let bot = ring(&mut b, -1.0, true);
+    for i in 0..seg as usize {
+        b.quad(top[i], bot[i], bot[i + 1], top[i + 1]);
+    }
+    for (y, up) in [(1.0f32, true), (-1.0, false)] {
+        let r = ring(&mut b, y, false);
+        let c = b.v(Vec3::Y * y, Vec3::Y * y.signum());
+        for i in 0..seg as usize {
+            // φ increases counter-clockwise seen from +Y (x = cos φ, z = −sin φ).
+            if up {
+                b.t.push([c, r[i], r[i + 1]]);
+            } else {
+                b.t.push([c, r[i + 1], r[i]]);
+            }
+        }
+    }
+    b.done()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bounds(m: &Mesh) -> (Vec3, Vec3) {
+        m.positions.iter().fold(
+            (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+            |(lo, hi), &p| (lo.min(p), hi.max(p)),
+        )
+    }
+
+    /// Unity's front faces wind clockwise as seen on a left-handed screen, which is the
+    /// same as (b−a)×(c−a) (the component formula) pointing out of the front; check each
+    /// triangle's geometric normal against its stored vertex normals.
+    fn assert_outward(m: &Mesh, name: &str) {
+        for t in &m.submeshes[0] {
+            let [a, b, c] = t.map(|i| m.positions[i as usize]);
+            let g = (b - a).cross(c - a);
+            if g.length() < 1e-9 {
+                continue;
+            }
+            let n: Vec3 = t.iter().map(|&i| m.normals[i as usize]).sum();
+            assert!(g.dot(n) > 0.0, "{name}: triangle {t:?} faces the wrong way");
+        }
+    }
+
+    #[test]
+    fn dimensions_counts_and_facing() {
+        let close = |a: Vec3, b: Vec3| (a - b).length() < 1e-5;
+        let cube = mesh(10202).unwrap();
+        assert_eq!(cube.triangle_count(), 12);
+        assert!(
+            close(bounds(&cube).0, Vec3::splat(-0.5)) && close(bounds(&cube).1, Vec3::splat(0.5))
+        );
+        let plane = mesh(10209).unwrap();
+        assert_eq!(plane.triangle_count(), 200);
+        let (lo, hi) = bounds(&plane);
+        assert!(close(lo, Vec3::new(-5.0, 0.0, -5.0)) && close(hi, Vec3::new(5.0, 0.0, 5.0)));
+        assert!(plane.normals.iter().all(|&n| n == Vec3::Y));
+        let quad = mesh(10210).unwrap();
+        assert_eq!(quad.triangle_count(), 2);
+        let (lo, hi) = bounds(&quad);
+        assert!(close(lo, Vec3::new(-0.5, -0.5, 0.0)) && close(hi, Vec3::new(0.5, 0.5, 0.0)));
+        assert!(quad.normals.iter().all(|&n| n == Vec3::NEG_Z));
+        let sphere = mesh(10207).unwrap();
+        let (lo, hi) = bounds(&sphere);
+        assert!(
+            close(lo, Vec3::splat(-0.5)) && close(hi, Vec3::splat(0.5)),
+            "{lo} {hi}"
+        );
+        assert!(sphere
+            .positions
+            .iter()
+            .all(|p| (p.length() - 0.5).abs() < 1e-5));
+        let cyl = mesh(10206).unwrap();
+        let (lo, hi) = bounds(&cyl);
+        assert!(close(lo, Vec3::new(-0.5, -1.0, -0.5)) && close(hi, Vec3::new(0.5, 1.0, 0.5)));
+        let cap = mesh(10208).unwrap();
+        let (lo, hi) = bounds(&cap);
+        assert!(
+            close(lo, Vec3::new(-0.5, -1.0, -0.5)) && close(hi, Vec3::new(0.5, 1.0, 0.5)),
+            "{lo} {hi}"
+        );
+        for (id, m) in [
+            (10202, &cube),
+            (10209, &plane),
+            (10210, &quad),
+            (10207, &sphere),
+            (10206, &cyl),
+            (10208, &cap),
+        ] {
+            assert_outward(m, name(id).unwrap());
+        }
+        assert_eq!(name(10202), Some("Cube"));
+        assert!(mesh(10303).is_none());
+    }
+}

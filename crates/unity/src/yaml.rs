@@ -1,0 +1,480 @@
+//! A parser for the YAML subset Unity writes: block mappings, `- ` sequences (at the
+//! parent key's indentation, as Unity writes them), flow mappings and sequences that may
+//! wrap onto following lines, and plain scalars.
+//!
+//! Unity's files are not valid YAML for a strict parser (` stripped` headers, a `%TAG`
+//! that covers only the first document, repeated `data:` keys in old materials), so each
+//! document body is parsed alone by this small parser. Mappings keep their keys in order
+//! and keep duplicates.
+
+use glam::{Quat, Vec3, Vec4};
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Node {
+    Scalar(String),
+    Map(Vec<(String, Node)>),
+    Seq(Vec<Node>),
+}
+
+static EMPTY_SEQ: &[Node] = &[];
+
+impl Node {
+    /// First value under `key` (mappings only).
+    pub fn get(&self, key: &str) -> Option<&Node> {
+        match self {
+            Node::Map(kv) => kv.iter().find(|(k, _)| k == key).map(|(_, v)| v),
+            _ => None,
+        }
+    }
+
+    /// Every value under `key` (old materials repeat `data:`).
+    pub fn get_all<'a>(&'a self, key: &'a str) -> impl Iterator<Item = &'a Node> + 'a {
+        let kv: &[(String, Node)] = match self {
+            Node::Map(kv) => kv,
+            _ => &[],
+        };
+        kv.iter().filter(move |(k, _)| k == key).map(|(_, v)| v)
+    }
+
+    /// Follow a path of keys.
+    pub fn path(&self, keys: &[&str]) -> Option<&Node> {
+        keys.iter().try_fold(self, |n, k| n.get(k))
+    }
+
+    pub fn as_str(&self) -> Option<&str> {
+        match self {
+            Node::Scalar(s) => Some(s),
+            _ => None,
+        }
+    }
+
+    pub fn as_seq(&self) -> &[Node] {
+        match self {
+            Node::Seq(v) => v,
+            _ => EMPTY_SEQ,
+        }
+    }
+
+    pub fn as_map(&self) -> &[(String, Node)] {
+        match self {
+            Node::Map(kv) => kv,
+            _ => &[],
+        }
+    }
+
+    pub fn as_f32(&self) -> Option<f32> {
+        self.as_str().and_then(parse_f32)
+    }
+
+    pub fn as_i64(&self) -> Option<i64> {
+        let s = self.as_str()?.trim();
+        s.parse::<i64>()
+            .ok()
+            .or_else(|| s.parse::<u64>().ok().map(|u| u as i64))
+            .or_else(|| parse_f32(s).filter(|f| f.fract() == 0.0).map(|f| f as i64))
+    }
+
+    /// `key` as a float, if present and numeric.
+    pub fn f32_at(&self, key: &str) -> Option<f32> {
+        self.get(key).and_then(Node::as_f32)
+    }
+
+    pub fn i64_at(&self, key: &str) -> Option<i64> {
+        self.get(key).and_then(Node::as_i64)
+    }
+
+    pub fn str_at(&self, key: &str) -> Option<&str> {
+        self.get(key).and_then(Node::as_str)
+    }
+
+    /// `{x: …, y: …, z: …}`.
+    pub fn vec3(&self) -> Option<Vec3> {
+        Some(Vec3::new(
+            self.f32_at("x")?,
+            self.f32_at("y")?,
+            self.f32_at("z")?,
+        ))
+    }
+
+    /// `{x: …, y: …, z: …, w: …}` as a quaternion (not normalised here).
+    pub fn quat(&self) -> Option<Quat> {
+        Some(Quat::from_xyzw(
+            self.f32_at("x")?,
+            self.f32_at("y")?,
+            self.f32_at("z")?,
+            self.f32_at("w")?,
+        ))
+    }
+
+    /// `{r: …, g: …, b: …, a: …}` (alpha defaults to 1).
+    pub fn color(&self) -> Option<Vec4> {
+        Some(Vec4::new(
+            self.f32_at("r")?,
+            self.f32_at("g")?,
+            self.f32_at("b")?,
+            self.f32_at("a").unwrap_or(1.0),
+        ))
+    }
+}
+
+/// A float as Unity writes it: `1.5`, `.5`, `-1e-05`, or `0x3fc00000(1.5)` where the hex
+/// bits are authoritative.
+pub fn parse_f32(s: &str) -> Option<f32> {
+    let s = s.trim();
+    if let Some(hex) = s.strip_prefix("0x") {
+        let end = hex.find('(').unwrap_or(hex.len());
+        return u32::from_str_radix(&hex[..end], 16)
+            .ok()
+            .map(f32::from_bits);
+    }
+    match s {
+        "Infinity" | "inf" => Some(f32::INFINITY),
+        "-Infinity" | "-inf" => Some(f32::NEG_INFINITY),
+        "NaN" | "nan" => Some(f32::NAN),
+        _ => s.parse::<f32>().ok(),
+    }
+}
+
+struct Line {
+    indent: usize,
+    text: String,
+}
+
+/// Parse one document body (the lines after a `--- !u!` header).
+pub fn parse(text: &str) -> Node {
+    let lines = logical_lines(text);
+    let mut p = Parser { lines, pos: 0 };
+    if p.lines.is_empty() {
+        return Node::Map(vec![]);
+    }
+    let indent = p.lines[0].indent;
+    p.node(indent)
+}
+
+/// Split into lines, dropping blanks and comments, and join flow collections that wrap
+/// onto following lines (Unity wraps long `{fileID: …, guid: …, type: 3}` values).
+fn logical_lines(text: &str) -> Vec<Line> {
+    let mut out: Vec<Line> = Vec::new();
+    let mut depth: i64 = 0;
+    for raw in text.lines() {
+        let raw = raw.trim_end_matches('\r');
+        let trimmed = raw.trim_start_matches(' ');
+        if depth > 0 {
+            if let Some(last) = out.last_mut() {
+                last.text.push(' ');
+                last.text.push_str(trimmed.trim());
+            }
+            depth += bracket_balance(trimmed);
+            continue;
+        }
+        if trimmed.is_empty() || trimmed.starts_with('#') || trimmed.starts_with('%') {
+            continue;
+        }
+        let indent = raw.len() - trimmed.len();
+        // A line deeper than the previous one that is neither a key nor a list item
+        // continues a multi-line plain scalar: fold it in.
+        if let Some(last) = out.last_mut() {
+            if indent > last.indent && !looks_structural(trimmed) && !last.text.ends_with(':') {
+                last.text.push(' ');
+                last.text.push_str(trimmed.trim());
+                continue;
+            }
+        }
+        depth = bracket_balance(trimmed).max(0);
+        out.push(Line {
+            indent,
+            text: trimmed.to_string(),
+        });
+    }
+    out
+}
+
+fn looks_structural(t: &str) -> bool {
+    t.starts_with("- ") || t == "-" || split_key(t).is_some()
+}
+
+/// Net count of open flow brackets outside quotes.
+fn bracket_balance(s: &str) -> i64 {
+    let mut d = 0i64;
+    let mut quote: Option<char> = None;
+    for c in s.chars() {
+        match (quote, c) {
+            (Some(q), c) if c == q => quote = None,
+            (Some(_), _) => {}
+            (None, '\'' | '"') => quote = Some(c),
+            (None, '{' | '[') => d += 1,
+            (None, '}' | ']') => d -= 1,
+            _ => {}
+        }
+    }
+    d
+}
+
+/// `key: value` or `key:` → (key, value). Keys may contain spaces (`field of view`).
+fn split_key(t: &str) -> Option<(&str, &str)> {
+    if t.starts_with('{') || t.starts_with('[') || t.starts_with('"') || t.starts_with('\'') {
+        return None;
+    }
+    if let Some(i) = t.find(": ") {
+        return Some((&t[..i], t[i + 2..].trim()));
+    }
+    t.strip_suffix(':').map(|k| (k, ""))
+}
+
+struct Parser {
+    lines: Vec<Line>,
+    pos: usize,
+}
+
+impl Parser {
+    fn is_item(&self, i: usize) -> bool {
+        let t = &self.lines[i].text;
+        t == "-" || t.starts_with("- ")
+    }
+
+    fn node(&mut self, indent: usize) -> Node {
+        if self.pos < self.lines.len() && self.is_item(self.pos) {
+            self.seq(indent)
+        } else {
+            self.map(indent)
+        }
+    }
+
+    fn map(&mut self, indent: usize) -> Node {
+        let mut kv = Vec::new();
+        while self.pos < self.lines.len() {
+            let line = &self.lines[self.pos];
+            if line.indent < indent || (line.indent == indent && self.is_item(self.pos)) {
+                break;
+            }
+            if line.indent > indent {
+                // Stray deeper line: not ours to interpret.
+                self.pos += 1;
+                continue;
+            }
+            let Some((k, v)) = split_key(&line.text) else {
+                self.pos += 1;
+                continue;
+            };
+            let (key, value) = (k.to_string(), v.to_string());
+            self.pos += 1;
+            let node = if !value.is_empty() {
+                inline(&value)
+            } else if self.pos < self.lines.len()
+                && (self.lines[self.pos].indent > indent
+                    || (self.lines[self.pos].indent == indent && self.is_item(self.pos)))
+            {
+                let ind = self.lines[self.pos].indent;
+                self.node(ind)
+            } else {
+                Node::Scalar(String::new())
+            };
+            kv.push((key, node));
+        }
+        Node::Map(kv)
+    }
+
+    fn seq(&mut self, indent: usize) -> Node {
+        let mut items = Vec::new();
+        while self.pos < self.lines.len()
+            && self.lines[self.pos].indent == indent
+            && self.is_item(self.pos)
+        {
+            let text = self.lines[self.pos].text.clone();
+            let rest = text[1..].trim_start();
+            if rest.is_empty() {
+                self.pos += 1;
+                if self.pos < self.lines.len() && self.lines[self.pos].indent > indent {
+                    let ind = self.lines[self.pos].indent;
+                    items.push(self.node(ind));
+                } else {
+                    items.push(Node::Scalar(String::new()));
+                }
+            } else if split_key(rest).is_some() || rest.starts_with("- ") {
+                // `- key: value` starts a mapping whose further keys sit under `key`.
+                let inner = indent + (text.len() - rest.len());
+                self.lines[self.pos] = Line {
+                    indent: inner,
+                    text: rest.to_string(),
+                };
+                items.push(self.node(inner));
+            } else {
+                items.push(inline(rest));
+                self.pos += 1;
+            }
+        }
+        Node::Seq(items)
+    }
+}
+
+/// A value written on the key's line: flow mapping, flow sequence or scalar.
+fn inline(s: &str) -> Node {
+    let mut f = Flow {
+        s: s.as_bytes(),
+        i: 0,
+    };
+    f.value(true)
+}
+
+struct Flow<'a> {
+    s: &'a [u8],
+    i: usize,
+}
+
+impl Flow<'_> {
+    fn ws(&mut self) {
+        while self.i < self.s.len() && (self.s[self.i] == b' ' || self.s[self.i] == b'\t') {
+            self.i += 1;
+        }
+    }
+
+    fn value(&mut self, top: bool) -> Node {
+        self.ws();
+        match self.s.get(self.i) {
+            Some(b'{') => {
+                self.i += 1;
+                let mut kv = Vec::new();
+                loop {
+                    self.ws();
+                    match self.s.get(self.i) {
+                        None => break,
+                        Some(b'}') => {
+                            self.i += 1;
+                            break;
+                        }
+                        Some(b',') => {
+                            self.i += 1;
+                            continue;
+                        }
+                        _ => {}
+                    }
+                    let start = self.i;
+                    while self.i < self.s.len() && !matches!(self.s[self.i], b':' | b',' | b'}') {
+                        self.i += 1;
+                    }
+                    let key = String::from_utf8_lossy(&self.s[start..self.i])
+                        .trim()
+                        .to_string();
+                    if self.s.get(self.i) == Some(&b':') {
+                        self.i += 1;
+                        let v = self.value(false);
+                        kv.push((key, v));
+                    } else {
+                        kv.push((key, Node::Scalar(String::new())));
+                    }
+                }
+                Node::Map(kv)
+            }
+            Some(b'[') => {
+                self.i += 1;
+                let mut items = Vec::new();
+                loop {
+                    self.ws();
+                    match self.s.get(self.i) {
+                        None => break,
+                        Some(b']') => {
+                            self.i += 1;
+                            break;
+                        }
+                        Some(b',') => {
+                            self.i += 1;
+                            continue;
+                        }
+                        _ => items.push(self.value(false)),
+                    }
+                }
+                Node::Seq(items)
+            }
+            Some(&q) if q == b'"' || q == b'\'' => {
+                self.i += 1;
+                let start = self.i;
+                while self.i < self.s.len() && self.s[self.i] != q {
+                    self.i += 1;
+                }
+                let v = String::from_utf8_lossy(&self.s[start..self.i]).to_string();
+                self.i = (self.i + 1).min(self.s.len());
+                Node::Scalar(v)
+            }
+            _ => {
+                let start = self.i;
+                if top {
+                    self.i = self.s.len();
+                } else {
+                    while self.i < self.s.len() && !matches!(self.s[self.i], b',' | b'}' | b']') {
+                        self.i += 1;
+                    }
+                }
+                Node::Scalar(
+                    String::from_utf8_lossy(&self.s[start..self.i])
+                        .trim()
+                        .to_string(),
+                )
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unity_subset() {
+        let body = "Transform:\n  m_GameObject: {fileID: 12}\n  m_LocalRotation: {x: 0, y: 0.7071068, z: 0,\n    w: 0.7071068}\n  m_LocalPosition: {x: .5, y: 0x3fc00000(1.5), z: -2}\n  m_Children:\n  - {fileID: 5}\n  - {fileID: -9223372036854775807}\n  m_Component:\n  - component: {fileID: 7}\n  - 4: {fileID: 8}\n  field of view: 60\n  m_Name: My Thing: 2\n  empty:\n  guid: 0000000000000000e000000000000000\n";
+        let n = parse(body);
+        let t = n.get("Transform").unwrap();
+        assert_eq!(
+            t.path(&["m_GameObject", "fileID"]).unwrap().as_i64(),
+            Some(12)
+        );
+        let q = t.get("m_LocalRotation").unwrap().quat().unwrap();
+        assert!((q.w - std::f32::consts::FRAC_1_SQRT_2).abs() < 1e-7);
+        let p = t.get("m_LocalPosition").unwrap().vec3().unwrap();
+        assert_eq!(p, Vec3::new(0.5, 1.5, -2.0));
+        let ch = t.get("m_Children").unwrap().as_seq();
+        assert_eq!(ch.len(), 2);
+        assert_eq!(ch[1].i64_at("fileID"), Some(-9223372036854775807));
+        let comps = t.get("m_Component").unwrap().as_seq();
+        assert_eq!(
+            comps[0].path(&["component", "fileID"]).unwrap().as_i64(),
+            Some(7)
+        );
+        assert_eq!(comps[1].path(&["4", "fileID"]).unwrap().as_i64(), Some(8));
+        assert_eq!(t.f32_at("field of view"), Some(60.0));
+        assert_eq!(t.str_at("m_Name"), Some("My Thing: 2"));
+        assert_eq!(t.str_at("empty"), Some(""));
+        assert_eq!(t.str_at("guid"), Some("0000000000000000e000000000000000"));
+    }
+
+    #[test]
+    fn nested_sequences_of_mappings_and_repeated_keys() {
+        let body = "Material:\n  m_SavedProperties:\n    m_Floats:\n      data:\n        first:\n          name: _Metallic\n        second: 0.25\n      data:\n        first:\n          name: _Glossiness\n        second: .75\n    m_Colors:\n    - _Color: {r: 1, g: 0.5, b: 0, a: 1}\n    - _EmissionColor: {r: 0, g: 0, b: 0, a: 1}\n  m_Mods:\n    - target: {fileID: 400000, guid: abc, type: 3}\n      propertyPath: m_LocalPosition.x\n      value: 3\n";
+        let n = parse(body);
+        let m = n.get("Material").unwrap();
+        let floats = m.path(&["m_SavedProperties", "m_Floats"]).unwrap();
+        let datas: Vec<_> = floats.get_all("data").collect();
+        assert_eq!(datas.len(), 2);
+        assert_eq!(
+            datas[1].path(&["first", "name"]).unwrap().as_str(),
+            Some("_Glossiness")
+        );
+        assert_eq!(datas[1].f32_at("second"), Some(0.75));
+        let colors = m.path(&["m_SavedProperties", "m_Colors"]).unwrap().as_seq();
+        assert_eq!(colors[0].get("_Color").unwrap().color().unwrap().y, 0.5);
+        let mods = m.get("m_Mods").unwrap().as_seq();
+        assert_eq!(mods[0].str_at("propertyPath"), Some("m_LocalPosition.x"));
+        assert_eq!(mods[0].f32_at("value"), Some(3.0));
+        assert_eq!(
+            mods[0].path(&["target", "guid"]).unwrap().as_str(),
+            Some("abc")
+        );
+    }
+
+    #[test]
+    fn hex_floats_use_the_bits() {
+        assert_eq!(parse_f32("0x3fc00000(1.5)"), Some(1.5));
+        assert_eq!(parse_f32("0x3f800000(9)"), Some(1.0));
+        assert_eq!(parse_f32(".5"), Some(0.5));
+        assert_eq!(parse_f32("-.25"), Some(-0.25));
+    }
+}
