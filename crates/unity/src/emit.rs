@@ -293,10 +293,11 @@ impl Emitter<'_, '_> {
             let mat = match mat_refs.get(si) {
                 Some(r) => self.material(r, &g.objs[mr], &what),
                 None => {
+                    // Unity draws nothing for a sub-mesh without a material slot.
                     self.soup.warnings.push(format!(
-                        "{what}: sub-mesh {si} has no material slot; Unity's default used"
+                        "{what}: sub-mesh {si} has no material slot, so Unity draws nothing for it; skipped"
                     ));
-                    self.default_material()
+                    continue;
                 }
             };
             for t in tris {
@@ -568,6 +569,8 @@ impl Emitter<'_, '_> {
                         m.color = linear_rgb(kd.extend(1.0));
                         self.add_material(key, || m)
                     }
+                    // No `usemtl`: Unity's importer gives the mesh its default material.
+                    None if name == model_material_name("") => self.default_material(),
                     None => {
                         let why = format!("{rel}: material '{name}' has no Kd in a .mtl");
                         warn_default(self, why)
@@ -627,16 +630,13 @@ impl Emitter<'_, '_> {
                 .filter(|&r| r > 0.0)
                 .unwrap_or(0.1)
         };
-        // HDRP stores physical units (lux, lumen); the built-in model wants ~1.
-        if b.get("m_LightUnit").is_some() || intensity > 1000.0 {
-            let mapped = if ty == 1 {
-                intensity / 100_000.0
-            } else {
-                intensity / 10_000.0
-            };
+        // HDRP stores physical units (lux for the sun, lumen for lamps); the built-in
+        // model of DESIGN §6 wants about 1 for a typical light.
+        if self.g.project.hdrp {
+            let div = if ty == 1 { 100_000.0 } else { 1_000.0 };
+            let mapped = intensity / div;
             self.soup.warnings.push(format!(
-                "{what}: intensity {intensity} looks like HDRP physical units; mapped to {mapped} (÷{})",
-                if ty == 1 { "100000 lux" } else { "10000 lumen" }
+                "{what}: HDRP project: intensity {intensity} (physical units) mapped to {mapped} (÷{div})"
             ));
             intensity = mapped;
         }

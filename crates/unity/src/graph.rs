@@ -239,7 +239,9 @@ impl<'p> Graph<'p> {
             .filter(|d| d.class == docs::PREFAB_INSTANCE && !d.stripped)
         {
             let body = d.parse();
-            if body.i64_at("m_IsPrefabParent") == Some(1) {
+            if body.i64_at("m_IsPrefabParent") == Some(1)
+                || body.i64_at("m_IsPrefabAsset") == Some(1)
+            {
                 continue; // a legacy prefab asset's own root, not an instance
             }
             let (smap, roots) = self.instantiate(d, &body, &rel);
@@ -345,7 +347,14 @@ impl<'p> Graph<'p> {
         rel: &str,
     ) -> (HashMap<i64, usize>, Vec<usize>) {
         let (_, guid) = fref(body.get("m_SourcePrefab").or(body.get("m_ParentPrefab")));
-        let name = instance_name(body);
+        let source_stem = guid
+            .as_deref()
+            .and_then(|g| self.project.resolve(g))
+            .and_then(|p| p.file_stem())
+            .map(|s| s.to_string_lossy().into_owned());
+        let name = instance_name(body)
+            .or(source_stem)
+            .unwrap_or_else(|| "?".into());
         let what = format!("{rel}: prefab instance '{name}' (fileID {})", d.file_id);
         let Some(guid) = guid else {
             self.warnings
@@ -515,13 +524,12 @@ fn is_ref_path(prop: &str) -> bool {
 }
 
 /// The instance's name: its `m_Name` override, else its source's name.
-fn instance_name(body: &Node) -> String {
+fn instance_name(body: &Node) -> Option<String> {
     body.path(&["m_Modification", "m_Modifications"])
         .map(Node::as_seq)
         .unwrap_or(&[])
         .iter()
         .find(|m| m.str_at("propertyPath") == Some("m_Name"))
         .and_then(|m| m.str_at("value"))
-        .unwrap_or("?")
-        .to_string()
+        .map(str::to_string)
 }

@@ -77,8 +77,9 @@ pub fn convert(scene: &Path, opts: &Options) -> Result<Soup, ConvertError> {
         if project::ext(&p) == "obj" {
             if let Ok(a) = project.model(&p).as_ref() {
                 for w in &a.obj.warnings {
-                    if !model_warnings.contains(w) {
-                        model_warnings.push(w.clone());
+                    let w = format!("{f}: {w}");
+                    if !model_warnings.contains(&w) {
+                        model_warnings.push(w);
                     }
                 }
             }

@@ -126,7 +126,10 @@ pub fn parse(text: &str, path: &Path) -> Result<ObjModel, ObjError> {
         match tag {
             "v" => pos.push(floats(it)?),
             "vn" => nrm.push(floats(it)?),
-            "g" | "o" => {
+            // Unity's OBJ importer names meshes by `g` only: `o` is ignored (corpus:
+            // COMP396 suzanne.obj has only `o Suzanne_Suzanne.001`, and its .meta calls
+            // the mesh `default`).
+            "g" => {
                 let name = it.collect::<Vec<_>>().join(" ");
                 current_group = if name.is_empty() {
                     "default".into()
@@ -192,8 +195,7 @@ pub fn parse(text: &str, path: &Path) -> Result<ObjModel, ObjError> {
         match std::fs::read_to_string(&p) {
             Ok(t) => parse_mtl(&t, &mut mtl_colors),
             Err(_) => warnings.push(format!(
-                "{}: material library {lib} not found; its materials use Unity's default",
-                path.display()
+                "material library {lib} not found; its materials use Unity's default"
             )),
         }
     }

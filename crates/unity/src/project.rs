@@ -20,6 +20,9 @@ pub struct Project {
     pub root: PathBuf,
     pub assets: PathBuf,
     pub guids: GuidIndex,
+    /// `Packages/manifest.json` names the High Definition Render Pipeline, whose lights
+    /// are in physical units.
+    pub hdrp: bool,
     models: Mutex<HashMap<PathBuf, ModelResult>>,
 }
 
@@ -46,10 +49,13 @@ impl Project {
             )
         };
         let guids = GuidIndex::build(&assets);
+        let hdrp = std::fs::read_to_string(root.join("Packages").join("manifest.json"))
+            .is_ok_and(|m| m.contains("com.unity.render-pipelines.high-definition"));
         Project {
             root,
             assets,
             guids,
+            hdrp,
             models: Mutex::new(HashMap::new()),
         }
     }
@@ -84,7 +90,7 @@ impl Project {
         {
             return m;
         }
-        let loaded = Arc::new(load_model(path));
+        let loaded = Arc::new(self.load_model(path));
         if let Ok(mut m) = self.models.lock() {
             m.insert(path.to_path_buf(), loaded.clone());
         }
@@ -119,7 +125,7 @@ impl Project {
         let loaded: Vec<(PathBuf, ModelResult)> = objs
             .into_par_iter()
             .map(|p| {
-                let m = Arc::new(load_model(&p));
+                let m = Arc::new(self.load_model(&p));
                 (p, m)
             })
             .collect();
@@ -129,12 +135,18 @@ impl Project {
     }
 }
 
-fn load_model(path: &Path) -> Result<ModelAsset, String> {
-    let obj = obj::load(path).map_err(|e| e.to_string())?;
-    Ok(ModelAsset {
-        obj,
-        meta: ModelMeta::read(path),
-    })
+impl Project {
+    fn load_model(&self, path: &Path) -> Result<ModelAsset, String> {
+        let obj = obj::load(path).map_err(|e| {
+            // Name the file relative to the project, as every other message does.
+            e.to_string()
+                .replace(&path.display().to_string(), &self.rel(path))
+        })?;
+        Ok(ModelAsset {
+            obj,
+            meta: ModelMeta::read(path),
+        })
+    }
 }
 
 /// Lower-case extension.

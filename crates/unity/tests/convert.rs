@@ -1,0 +1,534 @@
+//! unity2soup on tiny hand-written projects: coordinates, handedness, hierarchy,
+//! primitives, fileID schemes, prefab instances, visibility, lights and camera.
+
+mod support;
+
+use formats::{LightKind, Shadows};
+use glam::Vec3;
+use std::f32::consts::FRAC_1_SQRT_2;
+use support::*;
+
+const OBJ_GUID: &str = "a1b2c3d4e5f60718293a4b5c6d7e8f90";
+
+/// A triangle and a quad (two triangles) in a right-handed OBJ, normals along +Z.
+const OBJ: &str = "v 1 2 3\nv 4 2 3\nv 1 5 3\nv 10 0 -1\nv 11 0 -1\nv 11 1 -1\nv 10 1 -1\nvn 0 0 1\ng default\nf 1//1 2//1 3//1\nf 4//1 5//1 6//1 7//1\n";
+
+fn legacy_meta(guid: &str, names: &[&str]) -> String {
+    let mut s = format!("fileFormatVersion: 2\nguid: {guid}\nModelImporter:\n  serializedVersion: 23\n  fileIDToRecycleName:\n    100000: //RootNode\n    400000: //RootNode\n");
+    for (i, n) in names.iter().enumerate() {
+        s += &format!(
+            "    {}: {n}\n    {}: {n}\n    {}: {n}\n    {}: {n}\n    {}: {n}\n",
+            100002 + 2 * i,
+            400002 + 2 * i,
+            2300000 + 2 * i,
+            3300000 + 2 * i,
+            4300000 + 2 * i
+        );
+    }
+    s + "  meshes:\n    globalScale: 1\n"
+}
+
+#[test]
+fn obj_at_identity_keeps_its_file_coordinates_and_winding() {
+    let mut sc = Scene::default();
+    let (go, _) = sc.object("Model", &Tf::at(0.0, 0.0, 0.0), 0, true);
+    sc.mesh(
+        go,
+        4300000,
+        OBJ_GUID,
+        &[(10303, "0000000000000000f000000000000000")],
+        true,
+    );
+    let (_d, root) = project(&[
+        ("Assets/m.obj", OBJ),
+        ("Assets/m.obj.meta", &legacy_meta(OBJ_GUID, &["default"])),
+        ("Assets/s.unity", &sc.text),
+    ]);
+    let soup = convert(&root.join("Assets/s.unity"));
+    let v = |x, y, z| Vec3::new(x, y, z);
+    assert_eq!(
+        soup.triangles,
+        vec![
+            [v(1., 2., 3.), v(4., 2., 3.), v(1., 5., 3.)],
+            [v(10., 0., -1.), v(11., 0., -1.), v(11., 1., -1.)],
+            [v(10., 0., -1.), v(11., 1., -1.), v(10., 1., -1.)],
+        ],
+        "exactly the file's positions, in file order and winding"
+    );
+    assert!(soup.normals.iter().flatten().all(|n| *n == Vec3::Z));
+    assert_eq!(soup.objects.len(), 1);
+    assert_eq!(soup.objects[0].name, "Model");
+    assert_eq!(soup.objects[0].source, "Assets/m.obj#default");
+    assert!(
+        soup.warnings.iter().all(|w| !w.contains("m.obj")),
+        "{:?}",
+        soup.warnings
+    );
+}
+
+#[test]
+fn object_at_unity_plus_x_is_right_of_the_camera() {
+    let mut sc = Scene::default();
+    sc.camera(&Tf::at(0.0, 0.0, 0.0));
+    sc.primitive("Right", &Tf::at(3.0, 0.0, 10.0), 0, CUBE);
+    let (_d, root) = project(&[("Assets/s.unity", &sc.text)]);
+    let soup = convert(&root.join("Assets/s.unity"));
+    let cam = &soup.camera;
+    assert_eq!(cam.forward, Vec3::Z);
+    assert_eq!(cam.up, Vec3::Y);
+    let centre =
+        soup.triangles.iter().flatten().copied().sum::<Vec3>() / (soup.triangles.len() * 3) as f32;
+    assert!(
+        close(centre, Vec3::new(-3.0, 0.0, 10.0), 1e-4),
+        "soup x is negated: {centre}"
+    );
+    assert!(
+        (centre - cam.position).dot(cam.right()) > 2.9,
+        "right of the image"
+    );
+    // Solid background, sRGB 0.5 → linear.
+    assert!((soup.environment.background.x - 0.21404114).abs() < 1e-6);
+}
+
+#[test]
+fn primitives_have_unity_dimensions() {
+    let cases = [
+        (10202, "Cube", 12, Vec3::splat(-0.5), Vec3::splat(0.5)),
+        (
+            10206,
+            "Cylinder",
+            0,
+            Vec3::new(-0.5, -1.0, -0.5),
+            Vec3::new(0.5, 1.0, 0.5),
+        ),
+        (10207, "Sphere", 0, Vec3::splat(-0.5), Vec3::splat(0.5)),
+        (
+            10208,
+            "Capsule",
+            0,
+            Vec3::new(-0.5, -1.0, -0.5),
+            Vec3::new(0.5, 1.0, 0.5),
+        ),
+        (
+            10209,
+            "Plane",
+            200,
+            Vec3::new(-5.0, 0.0, -5.0),
+            Vec3::new(5.0, 0.0, 5.0),
+        ),
+        (
+            10210,
+            "Quad",
+            2,
+            Vec3::new(-0.5, -0.5, 0.0),
+            Vec3::new(0.5, 0.5, 0.0),
+        ),
+    ];
+    for (id, name, tris, lo, hi) in cases {
+        let mut sc = Scene::default();
+        sc.primitive(name, &Tf::at(0.0, 0.0, 0.0), 0, id);
+        let (_d, root) = project(&[("Assets/s.unity", &sc.text)]);
+        let soup = convert(&root.join("Assets/s.unity"));
+        if tris > 0 {
+            assert_eq!(soup.triangles.len(), tris, "{name}");
+        }
+        let (blo, bhi) = bounds(soup.triangles.iter().flatten().copied());
+        assert!(
+            close(blo, lo, 1e-5) && close(bhi, hi, 1e-5),
+            "{name}: {blo} {bhi}"
+        );
+        assert_eq!(soup.objects[0].source, format!("builtin:{name}"));
+        // Every triangle's winding agrees with its shading normals (front = CCW).
+        for (t, n) in soup.triangles.iter().zip(&soup.normals) {
+            let g = (t[1] - t[0]).cross(t[2] - t[0]);
+            assert!(
+                g.dot(n[0] + n[1] + n[2]) > 0.0,
+                "{name}: winding against normals"
+            );
+        }
+    }
+    // Plane faces +Y, Quad faces −Z (z is unchanged by the x flip).
+    let facing = |id: i64| {
+        let mut sc = Scene::default();
+        sc.primitive("P", &Tf::at(0.0, 0.0, 0.0), 0, id);
+        let (_d, root) = project(&[("Assets/s.unity", &sc.text)]);
+        let soup = convert(&root.join("Assets/s.unity"));
+        let t = soup.triangles[0];
+        (t[1] - t[0]).cross(t[2] - t[0]).normalize()
+    };
+    assert!(close(facing(PLANE), Vec3::Y, 1e-6));
+    assert!(close(facing(QUAD), Vec3::NEG_Z, 1e-6));
+}
+
+#[test]
+fn negative_scale_mirrors_and_keeps_faces_outward() {
+    // A Quad mirrored in Z (scale z = −1 does not move a z = 0 quad, but mirrors its
+    // facing): it must now face +Z, with winding and normals agreeing.
+    let mut sc = Scene::default();
+    sc.primitive(
+        "Mirrored",
+        &Tf::at(0.0, 0.0, 0.0).scale(1.0, 1.0, -1.0),
+        0,
+        QUAD,
+    );
+    sc.primitive(
+        "MirroredCube",
+        &Tf::at(5.0, 0.0, 0.0).scale(-1.0, 2.0, 1.0),
+        0,
+        CUBE,
+    );
+    let (_d, root) = project(&[("Assets/s.unity", &sc.text)]);
+    let soup = convert(&root.join("Assets/s.unity"));
+    for (i, (t, n)) in soup.triangles.iter().zip(&soup.normals).enumerate() {
+        let g = (t[1] - t[0]).cross(t[2] - t[0]).normalize();
+        assert!(
+            g.dot(n[0]) > 0.99,
+            "triangle {i}: winding {g} vs normal {}",
+            n[0]
+        );
+        if soup.tri_object[i] == 0 {
+            assert!(close(g, Vec3::Z, 1e-6), "mirrored quad faces +Z, got {g}");
+        } else {
+            // Outward: from the cube's centre (−5, 0, 0) towards the face.
+            let c = (t[0] + t[1] + t[2]) / 3.0 - Vec3::new(-5.0, 0.0, 0.0);
+            assert!(g.dot(c) > 0.0, "cube face {i} points inward");
+        }
+    }
+}
+
+#[test]
+fn parented_rotated_scaled_hierarchy() {
+    // Parent: position (1, 2, 3), rotation 90° about +Y (q = (0, sin 45°, 0, cos 45°)),
+    // scale 2. Child Cube: local position (1, 0, 0), scale (1, 0.5, 1).
+    // World (Unity) = T·R·S·child: S makes the offset (2, 0, 0); R (90° about Y) turns
+    // +X into −Z, so (0, 0, −2); T adds (1, 2, 3): centre (1, 2, 1). Size: the cube's
+    // 1×0.5×1 scaled by 2 → 2×1×2, turned about Y it stays 2×1×2.
+    // Soup: x negated → centre (−1, 2, 1), bounds [−2, 1.5, 0] … [0, 2.5, 2].
+    let mut sc = Scene::default();
+    let (_, parent) = sc.object(
+        "Parent",
+        &Tf::at(1.0, 2.0, 3.0)
+            .rot([0.0, FRAC_1_SQRT_2, 0.0, FRAC_1_SQRT_2])
+            .scale(2.0, 2.0, 2.0),
+        0,
+        true,
+    );
+    sc.primitive(
+        "Child",
+        &Tf::at(1.0, 0.0, 0.0).scale(1.0, 0.5, 1.0),
+        parent,
+        CUBE,
+    );
+    // Non-uniform parent scale with a rotated child shears: parent scale (1, 3, 1), child
+    // rotated 45° about Z. The child's local +X edge direction (1,1)/√2 becomes (1,3)/√2.
+    let (_, p2) = sc.object(
+        "Stretch",
+        &Tf::at(0.0, 0.0, 20.0).scale(1.0, 3.0, 1.0),
+        0,
+        true,
+    );
+    let s = (std::f32::consts::PI / 8.0).sin();
+    let c = (std::f32::consts::PI / 8.0).cos();
+    sc.primitive(
+        "Sheared",
+        &Tf::at(0.0, 0.0, 0.0).rot([0.0, 0.0, s, c]),
+        p2,
+        CUBE,
+    );
+    let (_d, root) = project(&[("Assets/s.unity", &sc.text)]);
+    let soup = convert(&root.join("Assets/s.unity"));
+    assert_eq!(soup.objects[0].name, "Parent/Child");
+    let pts = |o: u32| {
+        soup.triangles
+            .iter()
+            .zip(&soup.tri_object)
+            .filter(move |(_, &ob)| ob == o)
+            .flat_map(|(t, _)| t.iter().copied())
+    };
+    let (lo, hi) = bounds(pts(0));
+    assert!(
+        close(lo, Vec3::new(-2.0, 1.5, 0.0), 1e-5) && close(hi, Vec3::new(0.0, 2.5, 2.0), 1e-5),
+        "{lo} {hi}"
+    );
+    // Sheared cube: corner (0.5, 0.5) rotated 45° → (0, 0.7071), scaled y×3 → (0, 2.1213).
+    let (lo, hi) = bounds(pts(1));
+    assert!(
+        (hi.y - 3.0 * FRAC_1_SQRT_2).abs() < 1e-5 && (lo.y + 3.0 * FRAC_1_SQRT_2).abs() < 1e-5,
+        "{lo} {hi}"
+    );
+    assert!((hi.x - FRAC_1_SQRT_2).abs() < 1e-5, "{hi}");
+}
+
+#[test]
+fn inactive_parents_and_disabled_renderers_draw_nothing() {
+    let mut sc = Scene::default();
+    let (_, hidden) = sc.object("Hidden", &Tf::at(0.0, 0.0, 0.0), 0, false);
+    sc.primitive("UnderHidden", &Tf::at(0.0, 0.0, 0.0), hidden, CUBE);
+    let (go, _) = sc.object("Disabled", &Tf::at(0.0, 0.0, 0.0), 0, true);
+    sc.mesh(go, CUBE, BUILTIN, &[], false);
+    sc.primitive("Shown", &Tf::at(0.0, 0.0, 0.0), 0, SPHERE);
+    let (_d, root) = project(&[("Assets/s.unity", &sc.text)]);
+    let soup = convert(&root.join("Assets/s.unity"));
+    assert_eq!(soup.objects.len(), 1);
+    assert_eq!(soup.objects[0].name, "Shown");
+}
+
+#[test]
+fn lights_convert_position_direction_colour_and_shadows() {
+    let mut sc = Scene::default();
+    // Spot at (1, 2, 3) turned 90° about +Y: Unity's +Z becomes +X; soup −X.
+    sc.light(
+        &Tf::at(1.0, 2.0, 3.0).rot([0.0, FRAC_1_SQRT_2, 0.0, FRAC_1_SQRT_2]),
+        0,
+        [1.0, 0.5, 0.0],
+        2,
+    );
+    sc.light(&Tf::at(0.0, 5.0, 0.0), 2, [1.0, 1.0, 1.0], 1);
+    sc.light(&Tf::at(0.0, 0.0, 0.0), 1, [1.0, 1.0, 1.0], 0);
+    sc.light(&Tf::at(0.0, 0.0, 0.0), 3, [1.0, 1.0, 1.0], 0);
+    let (_d, root) = project(&[("Assets/s.unity", &sc.text)]);
+    let soup = convert(&root.join("Assets/s.unity"));
+    assert_eq!(soup.lights.len(), 3, "the area light is skipped");
+    let spot = &soup.lights[0];
+    assert_eq!(
+        spot.kind,
+        LightKind::Spot {
+            angle: 40.0,
+            inner_angle: 40.0
+        }
+    );
+    assert!(close(spot.position, Vec3::new(-1.0, 2.0, 3.0), 1e-6));
+    assert!(
+        close(spot.direction, Vec3::new(-1.0, 0.0, 0.0), 1e-6),
+        "{}",
+        spot.direction
+    );
+    assert!(close(spot.color, Vec3::new(1.0, 0.21404114, 0.0), 1e-6));
+    assert_eq!(
+        (spot.intensity, spot.range, spot.shadows, spot.shadow_radius),
+        (1.5, 12.0, Shadows::Soft, 0.1)
+    );
+    assert_eq!(
+        (soup.lights[1].kind, soup.lights[1].shadows),
+        (LightKind::Point, Shadows::Hard)
+    );
+    assert_eq!(
+        (soup.lights[2].kind, soup.lights[2].shadow_radius),
+        (LightKind::Directional, 1.0)
+    );
+    assert!(soup.warnings.iter().any(|w| w.contains("area light")));
+}
+
+const TWO_GROUPS: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 5 0 0\nv 6 0 0\nv 5 1 0\nmtllib two.mtl\ng A\nusemtl red\nf 1 2 3\ng B\nusemtl green\nf 4 5 6\n";
+const TWO_MTL: &str = "newmtl red\nKd 1 0 0\nnewmtl green\nKd 0 1 0\n";
+
+#[test]
+fn legacy_table_resolves_sub_meshes_by_name() {
+    let mut sc = Scene::default();
+    let (go, _) = sc.object("B", &Tf::at(0.0, 0.0, 0.0), 0, true);
+    // 4300002 is `B` in the table (4300000 is `A`).
+    sc.mesh(
+        go,
+        4300002,
+        OBJ_GUID,
+        &[(2100000, "ffffffffffffffffffffffffffffffff")],
+        true,
+    );
+    let (_d, root) = project(&[
+        ("Assets/two.obj", TWO_GROUPS),
+        ("Assets/two.mtl", TWO_MTL),
+        ("Assets/two.obj.meta", &legacy_meta(OBJ_GUID, &["A", "B"])),
+        ("Assets/s.unity", &sc.text),
+    ]);
+    let soup = convert(&root.join("Assets/s.unity"));
+    assert_eq!(soup.triangles.len(), 1);
+    assert_eq!(soup.triangles[0][0], Vec3::new(5.0, 0.0, 0.0));
+    assert_eq!(soup.objects[0].source, "Assets/two.obj#B");
+    // The material GUID is unknown: Unity's default, with a warning that names it.
+    assert_eq!(soup.materials[0].name, "Default-Material");
+    assert!(soup
+        .warnings
+        .iter()
+        .any(|w| w.contains("ffffffffffffffffffffffffffffffff")));
+}
+
+fn gen2_meta(guid: &str) -> String {
+    format!("fileFormatVersion: 2\nguid: {guid}\nModelImporter:\n  serializedVersion: 22200\n  internalIDToNameTable: []\n  meshes:\n    globalScale: 1\n    fileIdsGeneration: 2\n")
+}
+
+#[test]
+fn file_ids_generation_2_resolves_hashed_ids() {
+    let mut sc = Scene::default();
+    let (go, _) = sc.object("B", &Tf::at(0.0, 0.0, 0.0), 0, true);
+    let default_mat = (10303, "0000000000000000f000000000000000");
+    sc.mesh(
+        go,
+        unity::meta::hash_id("Type:Mesh->B0"),
+        OBJ_GUID,
+        &[default_mat],
+        true,
+    );
+    // A renderer without material slots draws nothing.
+    let (go2, _) = sc.object("NoSlots", &Tf::at(0.0, 0.0, 0.0), 0, true);
+    sc.mesh(
+        go2,
+        unity::meta::hash_id("Type:Mesh->A0"),
+        OBJ_GUID,
+        &[],
+        true,
+    );
+    let (_d, root) = project(&[
+        ("Assets/two.obj", TWO_GROUPS),
+        ("Assets/two.obj.meta", &gen2_meta(OBJ_GUID)),
+        ("Assets/s.unity", &sc.text),
+    ]);
+    let soup = convert(&root.join("Assets/s.unity"));
+    assert_eq!(soup.objects.len(), 1);
+    assert_eq!(soup.objects[0].source, "Assets/two.obj#B");
+    assert_eq!(soup.triangles.len(), 1);
+    assert_eq!(soup.triangles[0][0], Vec3::new(5.0, 0.0, 0.0));
+    assert!(soup
+        .warnings
+        .iter()
+        .any(|w| w.contains("'NoSlots'") && w.contains("no material slot")));
+}
+
+#[test]
+fn prefab_instance_of_an_obj_model_applies_modifications() {
+    // A 2018.3+ PrefabInstance of two.obj (fileIdsGeneration 2): the root Transform is
+    // moved to (10, 0, 0) and group B's renderer is switched off, group A's material
+    // overridden by a .mat; a scene Cube is parented under the instance's stripped root.
+    let h = |s: &str| unity::meta::hash_id(s);
+    let root_tf = h("Type:Transform->//RootNode/root/Transform0");
+    let b_mr = h("Type:MeshRenderer->//RootNode/root/B/MeshRenderer0");
+    let a_mr = h("Type:MeshRenderer->//RootNode/root/A/MeshRenderer0");
+    let g = OBJ_GUID;
+    let mat_guid = "0123456789abcdef0123456789abcdef";
+    let mut sc = Scene::default();
+    sc.raw(&format!(
+        "--- !u!1001 &500\nPrefabInstance:\n  m_ObjectHideFlags: 0\n  serializedVersion: 2\n  m_Modification:\n    m_TransformParent: {{fileID: 0}}\n    m_Modifications:\n    - target: {{fileID: {root_tf}, guid: {g}, type: 3}}\n      propertyPath: m_LocalPosition.x\n      value: 10\n      objectReference: {{fileID: 0}}\n    - target: {{fileID: {b_mr}, guid: {g}, type: 3}}\n      propertyPath: m_Enabled\n      value: 0\n      objectReference: {{fileID: 0}}\n    - target: {{fileID: {a_mr}, guid: {g}, type: 3}}\n      propertyPath: m_Materials.Array.data[0]\n      value: \n      objectReference: {{fileID: 2100000, guid: {mat_guid},\n        type: 2}}\n    m_RemovedComponents: []\n  m_SourcePrefab: {{fileID: 100100000, guid: {g}, type: 3}}\n--- !u!4 &501 stripped\nTransform:\n  m_CorrespondingSourceObject: {{fileID: {root_tf}, guid: {g}, type: 3}}\n  m_PrefabInstance: {{fileID: 500}}\n  m_PrefabAsset: {{fileID: 0}}\n"
+    ));
+    sc.primitive("Child", &Tf::at(0.0, 3.0, 0.0), 501, CUBE);
+    let mat = "%YAML 1.1\n%TAG !u! tag:unity3d.com,2011:\n--- !u!21 &2100000\nMaterial:\n  serializedVersion: 6\n  m_Name: Blue\n  m_Shader: {fileID: 46, guid: 0000000000000000f000000000000000, type: 0}\n  m_ShaderKeywords: \n  m_SavedProperties:\n    serializedVersion: 3\n    m_Floats:\n    - _Metallic: 0\n    - _Glossiness: 0.9\n    m_Colors:\n    - _Color: {r: 0, g: 0, b: 1, a: 1}\n";
+    let (_d, root) = project(&[
+        ("Assets/two.obj", TWO_GROUPS),
+        ("Assets/two.mtl", TWO_MTL),
+        ("Assets/two.obj.meta", &gen2_meta(g)),
+        ("Assets/Blue.mat", mat),
+        (
+            "Assets/Blue.mat.meta",
+            &format!("fileFormatVersion: 2\nguid: {mat_guid}\n"),
+        ),
+        ("Assets/s.unity", &sc.text),
+    ]);
+    let soup = convert(&root.join("Assets/s.unity"));
+    let names: Vec<_> = soup.objects.iter().map(|o| o.name.as_str()).collect();
+    assert_eq!(names, ["two/A", "two/Child"]);
+    // Group A's triangle (0,0,0),(1,0,0),(0,1,0) moved by Unity +10 in x → soup −10.
+    let t = soup.triangles[0];
+    assert!(
+        close(t[0], Vec3::new(-10.0, 0.0, 0.0), 1e-6)
+            && close(t[1], Vec3::new(-9.0, 0.0, 0.0), 1e-6),
+        "{t:?}"
+    );
+    assert_eq!(soup.materials[soup.tri_material[0] as usize].name, "Blue");
+    assert_eq!(soup.materials[soup.tri_material[0] as usize].color, Vec3::Z);
+    // The Cube under the stripped root: Unity (10, 3, 0) → soup (−10, 3, 0).
+    let cube: Vec3 = soup.triangles[1..].iter().flatten().copied().sum::<Vec3>() / (12.0 * 3.0);
+    assert!(close(cube, Vec3::new(-10.0, 3.0, 0.0), 1e-5), "{cube}");
+}
+
+#[test]
+fn model_materials_take_the_mtl_colour() {
+    // A legacy MeshFilter on group A; its renderer uses the model's internal material.
+    let mut sc = Scene::default();
+    let (go, _) = sc.object("A", &Tf::at(0.0, 0.0, 0.0), 0, true);
+    let mat_id = unity::meta::hash_id("Type:Material->red0");
+    sc.mesh(go, 4300000, OBJ_GUID, &[(mat_id, OBJ_GUID)], true);
+    let (_d, root) = project(&[
+        ("Assets/two.obj", TWO_GROUPS),
+        ("Assets/two.mtl", TWO_MTL),
+        ("Assets/two.obj.meta", &legacy_meta(OBJ_GUID, &["A", "B"])),
+        ("Assets/s.unity", &sc.text),
+    ]);
+    let soup = convert(&root.join("Assets/s.unity"));
+    assert_eq!(soup.materials.len(), 1);
+    assert_eq!(soup.materials[0].color, Vec3::X);
+    assert_eq!(soup.materials[0].source, "Assets/two.obj#red");
+}
+
+#[test]
+fn unresolved_mesh_falls_back_to_the_object_name() {
+    let mut sc = Scene::default();
+    let (go, _) = sc.object("m", &Tf::at(0.0, 0.0, 0.0), 0, true);
+    sc.mesh(
+        go,
+        4300000,
+        "99999999999999999999999999999999",
+        &[(10303, "0000000000000000f000000000000000")],
+        true,
+    );
+    let (_d, root) = project(&[("Assets/Models/m.obj", OBJ), ("Assets/s.unity", &sc.text)]);
+    let soup = convert(&root.join("Assets/s.unity"));
+    assert_eq!(soup.triangles.len(), 3);
+    assert!(
+        soup.warnings.iter().any(|w| w.contains("seed's fallback")),
+        "{:?}",
+        soup.warnings
+    );
+}
+
+#[test]
+fn binary_scene_is_refused() {
+    let (_d, root) = project(&[("Assets/s.unity", "\0\0\u{2e}K\0\0\u{36}\u{c}\0\0\0\u{f}")]);
+    let err = unity::convert(&root.join("Assets/s.unity"), &unity::Options::default()).unwrap_err();
+    let msg = err.to_string();
+    assert!(
+        msg.contains("binary") && msg.contains("Force Text"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn non_finite_transform_is_an_error_naming_the_object() {
+    let mut sc = Scene::default();
+    sc.primitive("Broken", &Tf::at(f32::NAN, 0.0, 0.0), 0, CUBE);
+    let (_d, root) = project(&[("Assets/s.unity", &sc.text)]);
+    let err = unity::convert(&root.join("Assets/s.unity"), &unity::Options::default()).unwrap_err();
+    assert!(err.to_string().contains("'Broken'"), "{err}");
+}
+
+#[test]
+fn degenerate_triangles_are_dropped_and_counted() {
+    let obj = "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\nf 1 1 4\n";
+    let mut sc = Scene::default();
+    let (go, _) = sc.object("D", &Tf::at(0.0, 0.0, 0.0), 0, true);
+    sc.mesh(
+        go,
+        4300000,
+        OBJ_GUID,
+        &[(10303, "0000000000000000f000000000000000")],
+        true,
+    );
+    let (_d, root) = project(&[
+        ("Assets/d.obj", obj),
+        ("Assets/d.obj.meta", &legacy_meta(OBJ_GUID, &["default"])),
+        ("Assets/s.unity", &sc.text),
+    ]);
+    let soup = convert(&root.join("Assets/s.unity"));
+    assert_eq!(soup.triangles.len(), 1);
+    assert_eq!(soup.dropped_degenerate, 2);
+}
+
+#[test]
+fn strict_turns_warnings_into_an_error() {
+    let mut sc = Scene::default();
+    sc.primitive("C", &Tf::at(0.0, 0.0, 0.0), 0, CUBE);
+    let (_d, root) = project(&[("Assets/s.unity", &sc.text)]);
+    let opts = unity::Options {
+        project: None,
+        strict: true,
+    };
+    let err = unity::convert(&root.join("Assets/s.unity"), &opts).unwrap_err();
+    assert!(err.to_string().contains("no enabled camera"), "{err}");
+}
