@@ -3,6 +3,7 @@
 //! winding reversed; DESIGN §3).
 
 use crate::docs;
+use crate::embedded;
 use crate::graph::{
     fref, is_transform, model_material_hash, model_material_name, ref_ctx, Graph, Obj,
 };
@@ -47,7 +48,8 @@ struct Emitter<'g, 'p> {
     materials: HashMap<String, u32>,
 }
 
-pub fn emit(g: &Graph, scene_rel: &str) -> Result<Soup, EmitError> {
+/// The soup, and how many enabled cameras on active objects the scene has.
+pub fn emit(g: &Graph, scene_rel: &str) -> Result<(Soup, usize), EmitError> {
     let mut e = Emitter {
         g,
         soup: Soup::empty(),
@@ -104,7 +106,7 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Soup, EmitError> {
     e.camera(&cameras, scene_rel)?;
     e.environment();
     e.soup.seal();
-    Ok(e.soup)
+    Ok((e.soup, cameras.len()))
 }
 
 fn enabled(o: &Obj) -> bool {
@@ -353,15 +355,25 @@ impl Emitter<'_, '_> {
         );
         let Some(guid) = guid else {
             let ctx = ref_ctx(r, holder);
-            let file = self
-                .g
-                .files
-                .get(ctx)
-                .map(|f| self.g.project.rel(&f.path))
-                .unwrap_or_default();
-            return Err(format!(
-                "mesh is embedded in {file} (Mesh fileID {id}); embedded meshes are not decoded"
-            ));
+            let Some(file) = self.g.files.get(ctx) else {
+                return Err(format!("local mesh fileID {id} has no file"));
+            };
+            let rel = self.g.project.rel(&file.path);
+            let source = format!("{rel}#Mesh{id}");
+            if let Some(Some(m)) = self.meshes.get(&key) {
+                return Ok((m.clone(), source));
+            }
+            return match file.doc(id) {
+                Some((docs::MESH, body)) => {
+                    let m = Arc::new(
+                        embedded::decode(&body)
+                            .map_err(|e| format!("embedded Mesh fileID {id} in {rel}: {e}"))?,
+                    );
+                    self.meshes.insert(key, Some(m.clone()));
+                    Ok((m, source))
+                }
+                _ => Err(format!("mesh fileID {id} is not a Mesh in {rel}")),
+            };
         };
         if guid == BUILTIN_MESH_GUID {
             let name =

@@ -7,6 +7,7 @@
 //! into a [`formats::Soup`].
 
 pub mod docs;
+pub mod embedded;
 pub mod emit;
 pub mod graph;
 pub mod material;
@@ -42,8 +43,20 @@ pub struct Options {
     pub strict: bool,
 }
 
+/// A converted scene with the counts the soup does not hold.
+pub struct Report {
+    pub soup: Soup,
+    /// Enabled cameras on active objects (the soup keeps one).
+    pub cameras: usize,
+}
+
 /// Convert a scene into a sealed soup.
 pub fn convert(scene: &Path, opts: &Options) -> Result<Soup, ConvertError> {
+    convert_report(scene, opts).map(|r| r.soup)
+}
+
+/// [`convert`], also returning counts for diagnostics and tests.
+pub fn convert_report(scene: &Path, opts: &Options) -> Result<Report, ConvertError> {
     let root = match &opts.project {
         Some(p) => p.clone(),
         None => {
@@ -65,7 +78,7 @@ pub fn convert(scene: &Path, opts: &Options) -> Result<Soup, ConvertError> {
     g.warnings.extend(project.guids.warnings.iter().cloned());
     g.load_scene(scene)?;
     let scene_rel = project.rel(scene);
-    let mut soup = emit::emit(&g, &scene_rel)?;
+    let (mut soup, cameras) = emit::emit(&g, &scene_rel)?;
     // Model-level warnings (missing .mtl …), once per model used.
     let mut model_warnings: Vec<String> = Vec::new();
     for f in soup
@@ -92,5 +105,5 @@ pub fn convert(scene: &Path, opts: &Options) -> Result<Soup, ConvertError> {
             first: soup.warnings[0].clone(),
         });
     }
-    Ok(soup)
+    Ok(Report { soup, cameras })
 }

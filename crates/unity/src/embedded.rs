@@ -1,0 +1,189 @@
+//! Meshes stored inside a scene (class 43 documents): `m_VertexData` (channels over
+//! hex-encoded streams) and `m_IndexBuffer` (hex, 16- or 32-bit little-endian indices).
+//! The data is already in Unity space with Unity's winding.
+
+use crate::mesh::{smooth_normals, Mesh};
+use crate::yaml::Node;
+use glam::Vec3;
+
+fn hex(s: &str) -> Result<Vec<u8>, String> {
+    let s = s.trim();
+    if !s.len().is_multiple_of(2) {
+        return Err("odd-length hex data".into());
+    }
+    (0..s.len())
+        .step_by(2)
+        .map(|i| u8::from_str_radix(&s[i..i + 2], 16).map_err(|_| "bad hex data".to_string()))
+        .collect()
+}
+
+/// Bytes per component of a vertex format code (the same codes cover Unity 2017's
+/// float/half/byte and 2019+'s VertexFormat enum).
+fn format_size(f: i64) -> Option<usize> {
+    [4, 2, 1, 1, 2, 2, 1, 1, 2, 2, 4, 4]
+        .get(usize::try_from(f).ok()?)
+        .copied()
+}
+
+struct Channel {
+    stream: usize,
+    offset: usize,
+    format: i64,
+    dim: usize,
+}
+
+pub fn decode(body: &Node) -> Result<Mesh, String> {
+    if body.i64_at("m_MeshCompression").unwrap_or(0) != 0 {
+        return Err("the mesh is compressed (m_MeshCompression), which is not decoded".into());
+    }
+    let vd = body.get("m_VertexData").ok_or("no m_VertexData")?;
+    let count = vd.i64_at("m_VertexCount").unwrap_or(0).max(0) as usize;
+    let data = hex(vd.str_at("_typelessdata").unwrap_or(""))?;
+    let channels: Vec<Channel> = vd
+        .get("m_Channels")
+        .map(Node::as_seq)
+        .unwrap_or(&[])
+        .iter()
+        .map(|c| Channel {
+            stream: c.i64_at("stream").unwrap_or(0).max(0) as usize,
+            offset: c.i64_at("offset").unwrap_or(0).max(0) as usize,
+            format: c.i64_at("format").unwrap_or(0),
+            dim: (c.i64_at("dimension").unwrap_or(0) & 0xF) as usize,
+        })
+        .collect();
+    if channels.first().is_none_or(|c| c.dim < 3) {
+        return Err("no position channel".into());
+    }
+    // Streams follow each other, each `stride × count` bytes, aligned to 16.
+    let n_streams = channels
+        .iter()
+        .filter(|c| c.dim > 0)
+        .map(|c| c.stream + 1)
+        .max()
+        .unwrap_or(1);
+    let mut stride = vec![0usize; n_streams];
+    for c in channels.iter().filter(|c| c.dim > 0) {
+        let size = format_size(c.format).ok_or(format!("unknown vertex format {}", c.format))?;
+        stride[c.stream] = stride[c.stream].max(c.offset + size * c.dim);
+    }
+    let mut start = vec![0usize; n_streams];
+    let mut at = 0usize;
+    for s in 0..n_streams {
+        start[s] = at;
+        at = (at + stride[s] * count).div_ceil(16) * 16;
+    }
+    let read_vec3 = |c: &Channel, i: usize| -> Result<Vec3, String> {
+        if c.format != 0 {
+            return Err(format!(
+                "vertex format {} for positions/normals is not decoded",
+                c.format
+            ));
+        }
+        let base = start[c.stream] + stride[c.stream] * i + c.offset;
+        let f = |k: usize| -> Result<f32, String> {
+            let b = data
+                .get(base + 4 * k..base + 4 * k + 4)
+                .ok_or("vertex data is shorter than its channels say")?;
+            Ok(f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        };
+        Ok(Vec3::new(f(0)?, f(1)?, f(2)?))
+    };
+    let positions: Vec<Vec3> = (0..count)
+        .map(|i| read_vec3(&channels[0], i))
+        .collect::<Result<_, _>>()?;
+    let file_normals: Option<Vec<Vec3>> = match channels.get(1).filter(|c| c.dim >= 3) {
+        Some(c) => Some(
+            (0..count)
+                .map(|i| read_vec3(c, i))
+                .collect::<Result<_, _>>()?,
+        ),
+        None => None,
+    };
+
+    let ib = hex(body.str_at("m_IndexBuffer").unwrap_or(""))?;
+    let wide = body.i64_at("m_IndexFormat") == Some(1);
+    let index = |k: usize| -> Option<u32> {
+        if wide {
+            ib.get(4 * k..4 * k + 4)
+                .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        } else {
+            ib.get(2 * k..2 * k + 2)
+                .map(|b| u16::from_le_bytes([b[0], b[1]]) as u32)
+        }
+    };
+    let isize_ = if wide { 4 } else { 2 };
+    let mut submeshes = Vec::new();
+    for sm in body.get("m_SubMeshes").map(Node::as_seq).unwrap_or(&[]) {
+        if sm.i64_at("topology").unwrap_or(0) != 0 {
+            submeshes.push(vec![]); // lines/points draw no surface
+            continue;
+        }
+        let first = sm.i64_at("firstByte").unwrap_or(0).max(0) as usize / isize_;
+        let n = sm.i64_at("indexCount").unwrap_or(0).max(0) as usize;
+        let base = sm.i64_at("baseVertex").unwrap_or(0);
+        let mut tris = Vec::with_capacity(n / 3);
+        for t in 0..n / 3 {
+            let mut tri = [0u32; 3];
+            for (j, v) in tri.iter_mut().enumerate() {
+                let i = index(first + 3 * t + j)
+                    .ok_or("index buffer is shorter than its sub-meshes say")?
+                    as i64
+                    + base;
+                if i < 0 || i as usize >= count {
+                    return Err(format!("index {i} out of range of {count} vertices"));
+                }
+                *v = i as u32;
+            }
+            tris.push(tri);
+        }
+        submeshes.push(tris);
+    }
+    let normals = match file_normals {
+        Some(n) => n.into_iter().map(|v| v.normalize_or_zero()).collect(),
+        None => {
+            // Per-vertex average of the smoothed corner normals.
+            let all: Vec<[u32; 3]> = submeshes.iter().flatten().copied().collect();
+            let corner = smooth_normals(&positions, &all, 180.0);
+            let mut acc = vec![Vec3::ZERO; count];
+            for (t, ns) in all.iter().zip(corner) {
+                for k in 0..3 {
+                    acc[t[k] as usize] += ns[k];
+                }
+            }
+            acc.into_iter().map(|v| v.normalize_or_zero()).collect()
+        }
+    };
+    Ok(Mesh {
+        positions,
+        normals,
+        submeshes,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::yaml::parse;
+
+    #[test]
+    fn decodes_positions_normals_and_indices() {
+        // Three vertices, position + normal (stride 24), one triangle 0-1-2.
+        let mut data = String::new();
+        for (p, n) in [
+            ([0.0f32, 0.0, 0.0], [0.0f32, 0.0, -1.0]),
+            ([0.0, 1.0, 0.0], [0.0, 0.0, -1.0]),
+            ([1.0, 0.0, 0.0], [0.0, 0.0, -1.0]),
+        ] {
+            for v in p.iter().chain(&n) {
+                for b in v.to_le_bytes() {
+                    data += &format!("{b:02x}");
+                }
+            }
+        }
+        let text = format!("Mesh:\n  m_SubMeshes:\n  - serializedVersion: 2\n    firstByte: 0\n    indexCount: 3\n    topology: 0\n    baseVertex: 0\n  m_IndexFormat: 0\n  m_IndexBuffer: 000001000200\n  m_VertexData:\n    m_VertexCount: 3\n    m_Channels:\n    - stream: 0\n      offset: 0\n      format: 0\n      dimension: 3\n    - stream: 0\n      offset: 12\n      format: 0\n      dimension: 3\n    m_DataSize: 72\n    _typelessdata: {data}\n");
+        let m = decode(parse(&text).get("Mesh").unwrap()).unwrap();
+        assert_eq!(m.positions[1], Vec3::Y);
+        assert_eq!(m.normals[2], Vec3::NEG_Z);
+        assert_eq!(m.submeshes, vec![vec![[0, 1, 2]]]);
+    }
+}

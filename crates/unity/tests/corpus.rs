@@ -1,0 +1,379 @@
+//! unity2soup on the real projects of `../shared/corpus/unity/` (see its MANIFEST.md) and
+//! on the bundled baseline scene.
+//!
+//! Expected numbers were derived by hand, not by running the converter:
+//! * OBJ triangle counts: Σ (corners − 2) over the `f` lines of each file (quads give 2,
+//!   n-gons n − 2), e.g. `awk '/^f /{t+=NF-3} END{print t}' bunny.obj`.
+//! * Built-in primitive counts are this converter's tessellation (Cube 12, Plane 200,
+//!   Quad 2, Sphere 720, Cylinder 80, Capsule 768), see `primitives.rs`.
+//! * Objects: MeshFilter + MeshRenderer pairs whose GameObject and all ancestors are
+//!   active (`m_IsActive`), whose renderer is enabled and has a material slot, and whose
+//!   mesh resolves (built-in, or an OBJ in the project); a multi-group OBJ model gives one
+//!   object per `g` group that has faces.
+//! * Lights: enabled Light components of type 0–2 on active objects. Cameras: enabled
+//!   Camera components on active objects.
+
+use glam::Vec3;
+use std::path::{Path, PathBuf};
+
+const CUBE: usize = 12;
+const PLANE: usize = 200;
+const QUAD: usize = 2;
+const SPHERE: usize = 720;
+const CAPSULE: usize = 768;
+
+fn corpus() -> Option<PathBuf> {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/corpus/unity");
+    if p.is_dir() {
+        Some(p)
+    } else {
+        eprintln!(
+            "SKIPPED: corpus tests, because {} does not exist (the corpus lives beside the repo in ../shared)",
+            p.display()
+        );
+        None
+    }
+}
+
+fn report(path: &Path) -> unity::Report {
+    unity::convert_report(path, &unity::Options::default())
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+struct Expect {
+    scene: &'static str,
+    objects: usize,
+    triangles: usize,
+    lights: usize,
+    cameras: usize,
+    /// Substrings that must appear in some warning.
+    warns: &'static [&'static str],
+}
+
+#[rustfmt::skip]
+fn expectations() -> Vec<Expect> {
+    vec![
+        // 5 Cubes, 1 Plane and bunny.obj (11141 tris + 1394 quads + 1 pentagon = 13932);
+        // no Light at all; bunny.mtl is missing.
+        Expect { scene: "ADRC4__Voxel/Assets/Scenes/GraphTests.unity", objects: 7,
+                 triangles: 5 * CUBE + PLANE + 13932, lights: 0, cameras: 1,
+                 warns: &["bunny.mtl not found"] },
+        // Scene-owned (listed from the YAML): 33 Cubes, 19 Spheres and 58 Planes are
+        // active with enabled renderers; one Plane has no material slot (draws nothing),
+        // one Plane and 4 key.obj objects are under inactive parents. Active OBJ
+        // MeshFilters: key.obj (472) and InteriorDoor.obj groups 4300000/4300002 (30 for
+        // both). OBJ prefab instances: table.obj ×2 (68 each, group polySurface27 only),
+        // InteriorDoor.obj (2 groups, 30), TV.obj (264), blocc.obj (794, 9 n-gons),
+        // Toilet.obj (294). remote.FBX meshes and FBX prefab sources are missing.
+        // Cameras: "Main Camera" is on; the second scene camera has m_Enabled 0 and the
+        // FPSController instance is deactivated by an m_IsActive modification.
+        // Objects: 33 + 19 + 57 + 1 + 2 + 2 + 2 + 1 + 1 + 1 = 119.
+        Expect { scene: "Astraela__Escape-The-Room/Assets/Scenes/Game.unity", objects: 119,
+                 triangles: 33 * CUBE + 19 * SPHERE + 57 * PLANE + 472 + 30 + 2 * 68 + 30 + 264 + 794 + 294,
+                 lights: 1, cameras: 1,
+                 warns: &["'Remote'", "no material slot", "is not in the project"] },
+        // 5 Cubes + 1 Sphere.
+        Expect { scene: "Ayinzhang__Rigidbody-Fracture/Assets/Scenes/RigidbodyFracture.unity", objects: 6,
+                 triangles: 5 * CUBE + SPHERE, lights: 1, cameras: 1, warns: &[] },
+        // A Plane, and the bunny instance whose m_Mesh is overridden to the embedded
+        // Mesh 1770867978 (10000 triangles).
+        Expect { scene: "Ayinzhang__Rigidbody-Fracture/Assets/Scenes/RigidbodySimulation.unity", objects: 2,
+                 triangles: PLANE + 10000, lights: 1, cameras: 1, warns: &[] },
+        // 8 Cubes, 3 Spheres, 1 Quad; 1 directional + 2 point lights; the second camera
+        // renders into a RenderTexture.
+        Expect { scene: "IceMiaoMiao__Unity-Shader-Study-Projects/Assets/Scenes/Scene_10_2.unity", objects: 12,
+                 triangles: 8 * CUBE + 3 * SPHERE + QUAD, lights: 3, cameras: 2, warns: &[] },
+        // PrefabInstance of suzanne.obj (15488 triangles, one group), mtllib missing.
+        Expect { scene: "IceMiaoMiao__Unity-Shader-Study-Projects/Assets/Scenes/Scene_14_1.unity", objects: 1,
+                 triangles: 15488, lights: 1, cameras: 1, warns: &["suzanne.mtl not found"] },
+        // One Capsule; 1 directional + 4 point lights.
+        Expect { scene: "IceMiaoMiao__Unity-Shader-Study-Projects/Assets/Scenes/Scene_9_2_2.unity", objects: 1,
+                 triangles: CAPSULE, lights: 5, cameras: 1, warns: &[] },
+        // Only the built-in Plane resolves: every other mesh is in an FBX/.mb file that
+        // is not in the corpus.
+        Expect { scene: "Pjaerr__GDSJam-Reflection/Assets/Scenes/Tutorial.unity", objects: 1,
+                 triangles: PLANE, lights: 1, cameras: 1,
+                 warns: &["SkinnedMeshRenderer", "prefab instance 'side (1)'"] },
+        // multcoloredcube2.obj: 6 groups of 2 triangles.
+        Expect { scene: "VidarUre__MeshToSvgConverter/Assets/Scenes/cubescene.unity", objects: 6,
+                 triangles: 12, lights: 1, cameras: 1, warns: &[] },
+        Expect { scene: "VidarUre__MeshToSvgConverter/Assets/Scenes/gridscene.unity", objects: 1,
+                 triangles: 162, lights: 1, cameras: 1, warns: &[] },
+        // terrainmodel.obj: 16 groups, 8959 triangles.
+        Expect { scene: "VidarUre__MeshToSvgConverter/Assets/Scenes/terrainscene.unity", objects: 16,
+                 triangles: 8959, lights: 1, cameras: 1, warns: &[] },
+        Expect { scene: "VidarUre__MeshToSvgConverter/Assets/Scenes/torusscene.unity", objects: 1,
+                 triangles: 288, lights: 1, cameras: 1, warns: &[] },
+        // 2018.2 transitional Prefab of bunny.obj (one group `Bunny`, 4968 triangles).
+        Expect { scene: "adcimon__mesh-deformer/Assets/Scenes/Scene.unity", objects: 1,
+                 triangles: 4968, lights: 1, cameras: 1, warns: &[] },
+        // MeshFilter → bunny.obj by the hashed id of `Type:Mesh->default0`.
+        Expect { scene: "fuqunaga__ComputeShaderBVHMeshHit/Assets/Scenes/SampleScene.unity", objects: 1,
+                 triangles: 4968, lights: 1, cameras: 1, warns: &[] },
+        // The three item prefab instances are deactivated by modification, bg/floor/grid
+        // are inactive; what remains is wall.obj's 2 groups (6 + 6).
+        Expect { scene: "jonike__CubeRoom/Assets/Scenes/Capture.unity", objects: 2,
+                 triangles: 12, lights: 1, cameras: 2, warns: &[] },
+        // 3 MeshFilters on embedded meshes, 2 of whose renderers are disabled; the
+        // enabled one (MaterialMesh) uses Mesh 892444932: indexCount 72 → 24 triangles.
+        Expect { scene: "jonike__CubeRoom/Assets/Scenes/WindowTest.unity", objects: 1,
+                 triangles: 24, lights: 1, cameras: 1, warns: &[] },
+        // One Plane; the UI canvas is ignored; HDRP light units are mapped.
+        Expect { scene: "kcherr1__UnityStressTest/Assets/Main.unity", objects: 1,
+                 triangles: PLANE, lights: 1, cameras: 1, warns: &["HDRP"] },
+        // The model is a Git LFS pointer: reported, nothing converted.
+        Expect { scene: "superdump__unity-compute-shader-ray-tracer/Assets/Scenes/SampleScene.unity", objects: 0,
+                 triangles: 0, lights: 1, cameras: 1, warns: &["Git LFS pointer"] },
+        // suzanne.obj (32 tris + 468 quads = 968), Cube, Plane, Sphere.
+        Expect { scene: "wbalaniucCentennialCollege__COMP396_F2018_Graphics/Assets/Scenes/Graphics.unity", objects: 4,
+                 triangles: 968 + CUBE + PLANE + SPHERE, lights: 1, cameras: 1, warns: &[] },
+    ]
+}
+
+#[test]
+fn every_text_scene_converts_to_the_hand_derived_counts() {
+    let Some(root) = corpus() else { return };
+    let mut failures = Vec::new();
+    for e in expectations() {
+        let r = report(&root.join(e.scene));
+        let got = (
+            r.soup.objects.len(),
+            r.soup.triangles.len(),
+            r.soup.lights.len(),
+            r.cameras,
+        );
+        let want = (e.objects, e.triangles, e.lights, e.cameras);
+        if got != want {
+            failures.push(format!(
+                "{}: (objects, triangles, lights, cameras) = {got:?}, expected {want:?}",
+                e.scene
+            ));
+        }
+        for w in e.warns {
+            if !r.soup.warnings.iter().any(|x| x.contains(w)) {
+                failures.push(format!(
+                    "{}: no warning mentions {w:?}: {:#?}",
+                    e.scene, r.soup.warnings
+                ));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn binary_scene_is_refused_with_a_fix() {
+    let Some(root) = corpus() else { return };
+    let p = root.join("candycat1992__Unity_Shaders_Book/Assets/Scenes/Chapter14/Scene_14_1.unity");
+    let err = unity::convert(
+        &p,
+        &unity::Options {
+            project: Some(root.join("candycat1992__Unity_Shaders_Book")),
+            strict: false,
+        },
+    )
+    .expect_err("binary scene must be refused");
+    let msg = err.to_string();
+    assert!(
+        msg.contains("binary") && msg.contains("Force Text"),
+        "{msg}"
+    );
+}
+
+fn object_bounds(soup: &formats::Soup, name: &str) -> (Vec3, Vec3) {
+    let idx = soup
+        .objects
+        .iter()
+        .position(|o| o.name == name)
+        .unwrap_or_else(|| {
+            panic!(
+                "no object {name}: {:?}",
+                soup.objects.iter().map(|o| &o.name).collect::<Vec<_>>()
+            )
+        });
+    soup.triangles
+        .iter()
+        .zip(&soup.tri_object)
+        .filter(|(_, &o)| o as usize == idx)
+        .flat_map(|(t, _)| t.iter().copied())
+        .fold(
+            (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+            |(lo, hi), p| (lo.min(p), hi.max(p)),
+        )
+}
+
+fn assert_box(got: (Vec3, Vec3), lo: Vec3, hi: Vec3, eps: f32, what: &str) {
+    assert!(
+        (got.0 - lo).abs().max_element() < eps && (got.1 - hi).abs().max_element() < eps,
+        "{what}: got {:?}, expected {lo} … {hi}",
+        got
+    );
+}
+
+/// sRGB → linear, written out here so the test does not lean on the library's.
+fn eotf(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+#[test]
+#[allow(clippy::excessive_precision)] // values as computed by hand
+fn mesh_to_svg_prefab_instance_of_multi_group_obj() {
+    let Some(root) = corpus() else { return };
+    // cubescene: PrefabInstance of multcoloredcube2.obj; root Transform 400012 moved to
+    // (30.91, 390.74, −446.33), rotated q = (0.16436426, −0.68089753, −0.16095737,
+    // −0.69530976). Group Cube_Cube.000 uses 4 vertices of the file; each was taken
+    // (x, y, z) → Unity (−x, y, z) → q·v·q⁻¹ + T → soup (−x, y, z), by hand in a
+    // 15-line Python script: box (−32.40334, 390.444_8, −444.35446) …
+    // (−29.7201, 393.1286, −444.29826).
+    let soup =
+        report(&root.join("VidarUre__MeshToSvgConverter/Assets/Scenes/cubescene.unity")).soup;
+    let b = object_bounds(&soup, "multcoloredcube2/Cube_Cube.000");
+    assert_box(
+        b,
+        Vec3::new(-32.40334, 390.444_8, -444.35446),
+        Vec3::new(-29.7201, 393.1286, -444.29826),
+        1e-3,
+        "Cube_Cube.000",
+    );
+
+    // terrainscene: renderer 2300000 (group Earth_Plane.108, 2048 faces) has its material
+    // overridden by the scene-embedded Material 525343101 (_Color sRGB (0.64, 0.295121,
+    // 0.048366), _Glossiness 0, _Metallic 0).
+    let soup =
+        report(&root.join("VidarUre__MeshToSvgConverter/Assets/Scenes/terrainscene.unity")).soup;
+    let idx = soup
+        .objects
+        .iter()
+        .position(|o| o.name == "terrainmodel/Earth_Plane.108")
+        .expect("Earth_Plane.108");
+    let t = soup
+        .tri_object
+        .iter()
+        .position(|&o| o as usize == idx)
+        .unwrap();
+    let m = &soup.materials[soup.tri_material[t] as usize];
+    assert!(m.name.starts_with("EarthTextureMaterial"), "{}", m.name);
+    let want = Vec3::new(eotf(0.64), eotf(0.295121), eotf(0.048366));
+    assert!(
+        (m.color - want).abs().max_element() < 1e-6,
+        "{} vs {want}",
+        m.color
+    );
+    assert_eq!((m.metallic, m.smoothness), (0.0, 0.0));
+    assert_eq!(
+        soup.tri_object
+            .iter()
+            .filter(|&&o| o as usize == idx)
+            .count(),
+        2048
+    );
+}
+
+#[test]
+fn compute_shader_bvh_parented_scaled_obj() {
+    let Some(root) = corpus() else { return };
+    // Meshs (identity) / bunny: position (1, −1.72, 0), rotation (0, 1, 0, 0) = 180°
+    // about Y, scale 50, MeshFilter → bunny.obj by hashed fileID. A file vertex (x, y, z)
+    // imports as (−x, y, z), turns to (x, y, −z), scales and moves to
+    // (1 + 50x, −1.72 + 50y, −50z) and lands in the soup at (−1 − 50x, −1.72 + 50y, −50z).
+    // File bounds: x [−0.09438042, 0.0607788], y [0.0333099, 0.18699602],
+    // z [−0.06167917, 0.05871464] → soup x [−4.03894, 3.719021], y [−0.054505, 7.629801],
+    // z [−2.935732, 3.0839585].
+    let soup =
+        report(&root.join("fuqunaga__ComputeShaderBVHMeshHit/Assets/Scenes/SampleScene.unity"))
+            .soup;
+    let b = object_bounds(&soup, "Meshs/bunny");
+    assert_box(
+        b,
+        Vec3::new(-4.03894, -0.054505, -2.935732),
+        Vec3::new(3.719021, 7.629801, 3.0839585),
+        1e-4,
+        "bunny",
+    );
+}
+
+#[test]
+fn cube_room_capture_legacy_prefab_scene() {
+    let Some(root) = corpus() else { return };
+    // wall (identity) / mesh (scale x 0.66) / inner → wall.obj 4300000 = group Mesh1, one
+    // quad at z = 0 with x ∈ [−3, 3], y ∈ [0, 6]: x scales to ±1.98 (symmetric, so the
+    // two x negations do not show). outter → 4300002 = Mesh2, five quads over all
+    // 8 vertices: z ∈ [−0.2, 0].
+    let soup = report(&root.join("jonike__CubeRoom/Assets/Scenes/Capture.unity")).soup;
+    assert_box(
+        object_bounds(&soup, "wall/mesh/inner"),
+        Vec3::new(-1.98, 0.0, 0.0),
+        Vec3::new(1.98, 6.0, 0.0),
+        1e-5,
+        "inner",
+    );
+    assert_box(
+        object_bounds(&soup, "wall/mesh/outter"),
+        Vec3::new(-1.98, 0.0, -0.2),
+        Vec3::new(1.98, 6.0, 0.0),
+        1e-5,
+        "outter",
+    );
+    // The camera is orthographic.
+    assert!(matches!(
+        soup.camera.projection,
+        formats::Projection::Orthographic { .. }
+    ));
+}
+
+#[test]
+fn rigidbody_fracture_unity6_bounds() {
+    let Some(root) = corpus() else { return };
+    // Unity 6 scene (SceneRoots). "Cube (4)": position (−1.5, −0.6, 1.5), unit scale →
+    // Unity box [−2, −1.1, 1] … [−1, −0.1, 2] → soup x negated: [1, −1.1, 1] … [2, −0.1, 2].
+    // "Sphere": (0, 3, 1.5), scale 0.3 → radius 0.15. "Cube": origin, scale (3, 0.1, 3).
+    let soup =
+        report(&root.join("Ayinzhang__Rigidbody-Fracture/Assets/Scenes/RigidbodyFracture.unity"))
+            .soup;
+    assert_box(
+        object_bounds(&soup, "Cube (4)"),
+        Vec3::new(1.0, -1.1, 1.0),
+        Vec3::new(2.0, -0.1, 2.0),
+        1e-5,
+        "Cube (4)",
+    );
+    assert_box(
+        object_bounds(&soup, "Sphere"),
+        Vec3::new(-0.15, 2.85, 1.35),
+        Vec3::new(0.15, 3.15, 1.65),
+        1e-5,
+        "Sphere",
+    );
+    assert_box(
+        object_bounds(&soup, "Cube"),
+        Vec3::new(-1.5, -0.05, -1.5),
+        Vec3::new(1.5, 0.05, 1.5),
+        1e-5,
+        "Cube",
+    );
+    // Camera at (0, 1, −10) with identity rotation: soup forward +Z, right = −X.
+    assert_eq!(soup.camera.position, Vec3::new(0.0, 1.0, -10.0));
+    assert_eq!(soup.camera.right(), Vec3::NEG_X);
+}
+
+#[test]
+fn baseline_scene_has_41833_triangles() {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes/baseline/Assets/Scenes/Baseline.unity");
+    if !p.exists() {
+        eprintln!(
+            "SKIPPED: baseline test, because {} does not exist yet",
+            p.display()
+        );
+        return;
+    }
+    let r = report(&p);
+    assert_eq!(r.soup.triangles.len(), 41_833);
+    assert_eq!(r.soup.objects.len(), 9);
+    assert_eq!(r.soup.lights.len(), 2);
+    assert!(r.soup.warnings.is_empty(), "{:?}", r.soup.warnings);
+}
