@@ -1,1 +1,65 @@
-//! placeholder
+//! `kd2exr`'s library: renders a unitrace soup through its compiled k-d tree into an
+//! OpenEXR image, Whitted style (DESIGN §6).
+//!
+//! The steps, each in its own module:
+//! * [`plan`]: decide from the soup which effects can change the image (and why);
+//! * [`camera`]: pixel → ray (perspective or orthographic, y = 0 at the top row);
+//! * [`lights`]: Unity's range falloff and spot cones;
+//! * [`integrator`]: emission, ambient, direct light with hard/soft shadows, mirrors;
+//! * [`offset`]: secondary rays spawned past the hit point's rounding error;
+//! * [`sampling`]: per-pixel seeded RNG, stratified pixel and shadow samples;
+//! * [`render`]: tiles in parallel (rayon work stealing), ray counters;
+//! * [`exrio`], [`preview`]: EXR with AOVs, crop windows and merging; PNG preview;
+//! * [`memory`]: refuse a render that cannot fit before it starts.
+
+pub mod aov;
+pub mod camera;
+pub mod counters;
+pub mod environment;
+pub mod error;
+pub mod exrio;
+pub mod frame;
+pub mod integrator;
+pub mod lights;
+pub mod memory;
+pub mod offset;
+pub mod options;
+pub mod plan;
+pub mod preview;
+pub mod render;
+pub mod sampling;
+
+pub use aov::{Aov, AovSet};
+pub use camera::CameraModel;
+pub use counters::RayCounts;
+pub use error::RenderError;
+pub use exrio::ExrImage;
+pub use frame::Frame;
+pub use options::{RenderOptions, Window};
+pub use plan::Plan;
+pub use render::{render, render_scene, Rendered};
+
+/// The header attributes unitrace stores in every EXR it renders (`unitrace.*` text
+/// attributes, shown by `exrheader`).
+pub fn header_attributes(
+    plan: &Plan,
+    opts: &RenderOptions,
+    seconds: f64,
+    geometry_hash: &formats::Digest,
+) -> std::collections::BTreeMap<String, String> {
+    let p = exrio::ATTR_PREFIX;
+    let mut a = std::collections::BTreeMap::new();
+    a.insert(format!("{p}plan"), exrio::ascii_json(&plan.to_json()));
+    a.insert(format!("{p}spp"), opts.spp.to_string());
+    a.insert(format!("{p}depth"), opts.depth.to_string());
+    a.insert(format!("{p}seed"), opts.seed.to_string());
+    a.insert(format!("{p}softSamples"), opts.soft_samples.to_string());
+    a.insert(format!("{p}cutoff"), opts.cutoff.to_string());
+    a.insert(format!("{p}renderSeconds"), format!("{seconds:.6}"));
+    a.insert(format!("{p}geometryHash"), formats::hex(geometry_hash));
+    a.insert(format!("{p}version"), env!("CARGO_PKG_VERSION").to_string());
+    if let Some(c) = opts.crop {
+        a.insert(format!("{p}crop"), c.to_string());
+    }
+    a
+}

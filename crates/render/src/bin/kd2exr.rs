@@ -1,0 +1,237 @@
+//! kd2exr: render a soup through its k-d tree into an OpenEXR image.
+//!
+//! ```text
+//! kd2exr scene.soup scene.kd -o image.exr [--preview image.png] [--width 1024] [--height 768]
+//!        [--depth 2] [--spp 1] [--seed 0] [--threads N] [--json] [--half]
+//!        [--aov depth,normal,albedo,object] [--exposure 0] [--crop x0,y0,x1,y1]
+//!        [--soft-samples 16] [--cutoff 0.004]
+//! kd2exr merge a.exr b.exr … -o full.exr
+//! ```
+
+use anyhow::{Context, Result};
+use clap::{Args, Parser, Subcommand};
+use formats::{KdFile, Soup};
+use render::{memory, preview, AovSet, ExrImage, Plan, RenderOptions, Window};
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(Parser)]
+#[command(
+    name = "kd2exr",
+    version,
+    about = "Ray-trace a unitrace soup through its k-d tree into an OpenEXR image",
+    args_conflicts_with_subcommands = true,
+    subcommand_negates_reqs = true
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+    #[command(flatten)]
+    render: RenderArgs,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Join EXR crops (kd2exr --crop …) of one render into the full image.
+    Merge {
+        /// The crops, in any order; together they must cover the image.
+        #[arg(required = true)]
+        inputs: Vec<PathBuf>,
+        #[arg(short, long)]
+        output: PathBuf,
+    },
+}
+
+#[derive(Args)]
+struct RenderArgs {
+    /// The scene (unity2soup output).
+    #[arg(required = true)]
+    soup: Option<PathBuf>,
+    /// Its compiled k-d tree (soup2kd output).
+    #[arg(required = true)]
+    kd: Option<PathBuf>,
+    /// The EXR to write.
+    #[arg(short, long, required = true)]
+    output: Option<PathBuf>,
+    /// Also write an 8-bit sRGB PNG preview.
+    #[arg(long)]
+    preview: Option<PathBuf>,
+    #[arg(long, default_value_t = 1024)]
+    width: u32,
+    #[arg(long, default_value_t = 768)]
+    height: u32,
+    /// Maximum mirror bounces.
+    #[arg(long, default_value_t = 2)]
+    depth: u32,
+    /// Samples per pixel (stratified, box filter).
+    #[arg(long, default_value_t = 1)]
+    spp: u32,
+    /// Seed of the per-pixel random numbers.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Worker threads (default: one per core).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    json: bool,
+    /// Store RGBA (and albedo) as 16-bit floats.
+    #[arg(long)]
+    half: bool,
+    /// Extra channels: any of depth,normal,albedo,object.
+    #[arg(long, value_name = "LIST")]
+    aov: Option<String>,
+    /// Preview exposure in stops (the PNG is scaled by 2^exposure).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    exposure: f32,
+    /// Render only the window x0,y0,x1,y1 (x1, y1 exclusive) of the full image.
+    #[arg(long, value_name = "x0,y0,x1,y1", value_parser = Window::parse)]
+    crop: Option<Window>,
+    /// Shadow rays per soft-shadow light per shading point.
+    #[arg(long, default_value_t = 16)]
+    soft_samples: u32,
+    /// Stop reflection rays when the path weight falls below this.
+    #[arg(long, default_value_t = 0.004)]
+    cutoff: f32,
+}
+
+fn main() {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Some(Command::Merge { inputs, output }) => merge(&inputs, &output),
+        None => run(cli.render),
+    };
+    if let Err(e) = result {
+        eprintln!("kd2exr: error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+fn merge(inputs: &[PathBuf], output: &std::path::Path) -> Result<()> {
+    let start = Instant::now();
+    let parts = inputs
+        .iter()
+        .map(|p| ExrImage::read(p))
+        .collect::<Result<Vec<_>, _>>()?;
+    let full = render::exrio::merge(&parts)?;
+    full.write(output)?;
+    eprintln!(
+        "kd2exr: merged {} crops into {} ({}×{}) in {:.2} s",
+        parts.len(),
+        output.display(),
+        full.width,
+        full.height,
+        start.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+fn run(a: RenderArgs) -> Result<()> {
+    let (Some(soup_path), Some(kd_path), Some(out_path)) = (a.soup, a.kd, a.output) else {
+        anyhow::bail!("a render needs SOUP KD -o OUTPUT");
+    };
+    let opts = RenderOptions {
+        width: a.width,
+        height: a.height,
+        depth: a.depth,
+        spp: a.spp,
+        seed: a.seed,
+        soft_samples: a.soft_samples,
+        cutoff: a.cutoff,
+        crop: a.crop,
+        aovs: match &a.aov {
+            Some(list) => AovSet::parse(list)?,
+            None => AovSet::default(),
+        },
+        threads: a.threads,
+        ..RenderOptions::default()
+    };
+    if !a.exposure.is_finite() {
+        anyhow::bail!(
+            "invalid option: --exposure {} is not a finite number",
+            a.exposure
+        );
+    }
+    // Everything that can be refused is refused before loading or tracing anything.
+    opts.validate()?;
+    memory::check(&opts, memory::available_bytes())?;
+
+    let t_load = Instant::now();
+    let soup = Soup::read(&soup_path)?;
+    let kd = KdFile::read(&kd_path)?;
+    let accel = kdtree::Accel::new(&soup, &kd)
+        .with_context(|| format!("{} and {}", soup_path.display(), kd_path.display()))?;
+    let load_seconds = t_load.elapsed().as_secs_f64();
+
+    let plan = Plan::derive(&soup, &opts);
+    if !a.json {
+        eprintln!("{}", plan.describe());
+    }
+
+    let window = opts.window();
+    let bar = std::io::stderr().is_terminal().then(|| {
+        let total = render::render::tiles(window, opts.tile).len() as u64;
+        let bar = indicatif::ProgressBar::new(total);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{bar:40} {pos}/{len} tiles, {elapsed} elapsed, ETA {eta}",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        bar
+    });
+    let tick = |done: u64, _total: u64| {
+        if let Some(b) = &bar {
+            b.set_position(done);
+        }
+    };
+    let out = render::render(&soup, &accel, &plan, &opts, Some(&tick))?;
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+
+    let attrs = render::header_attributes(&plan, &opts, out.seconds, &soup.geometry_hash);
+    ExrImage::from_frame(&out.frame, a.half, attrs).write(&out_path)?;
+    if let Some(png) = &a.preview {
+        preview::write_png(png, &out.frame, a.exposure)?;
+    }
+
+    let c = out.counts;
+    let mrays = c.total() as f64 / out.seconds.max(1e-9) / 1e6;
+    eprintln!(
+        "kd2exr: rendered {}×{} (window {}) at {} spp, depth {} in {:.3} s ({:.2} Mrays/s; loading took {:.3} s)",
+        opts.width, opts.height, window, opts.spp, opts.depth, out.seconds, mrays, load_seconds
+    );
+    eprintln!(
+        "kd2exr: rays: camera {}, shadow {}, soft_shadow {}, reflection {} (total {})",
+        c.camera,
+        c.shadow,
+        c.soft_shadow,
+        c.reflection,
+        c.total()
+    );
+    if c.sanitized > 0 {
+        eprintln!(
+            "kd2exr: warning: {} samples were NaN or infinite and were set to 0 (check the scene's materials and lights)",
+            c.sanitized
+        );
+    }
+    eprintln!("kd2exr: wrote {}", out_path.display());
+    if a.json {
+        let json = serde_json::json!({
+            "width": opts.width,
+            "height": opts.height,
+            "window": [window.x0, window.y0, window.x1, window.y1],
+            "spp": opts.spp,
+            "depth": opts.depth,
+            "seconds": out.seconds,
+            "rays": c,
+            "sanitized": c.sanitized,
+            "plan": plan.to_json(),
+            "output": out_path,
+        });
+        println!("{json}");
+    }
+    Ok(())
+}

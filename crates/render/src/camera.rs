@@ -1,0 +1,140 @@
+//! Camera rays: perspective (vertical field of view) or orthographic (half height).
+
+use crate::RenderError;
+use formats::{Camera, Projection};
+use glam::Vec3;
+use kdtree::Ray;
+
+/// A soup camera prepared for an image of `width`×`height` pixels.
+#[derive(Clone, Debug)]
+pub struct CameraModel {
+    position: Vec3,
+    forward: Vec3,
+    right: Vec3,
+    up: Vec3,
+    /// Half extent of the view at unit distance (perspective) or in metres (orthographic).
+    half_w: f32,
+    half_h: f32,
+    ortho: bool,
+    near: f32,
+    width: f32,
+    height: f32,
+}
+
+impl CameraModel {
+    pub fn new(cam: &Camera, width: u32, height: u32) -> Result<Self, RenderError> {
+        let bad = |detail: String| RenderError::Camera {
+            name: cam.name.clone(),
+            detail,
+        };
+        let forward = cam.forward.normalize_or_zero();
+        // Image right is forward × up (DESIGN §3); re-derive up so the frame is orthonormal.
+        let right = cam.right();
+        if forward == Vec3::ZERO || right == Vec3::ZERO || !cam.position.is_finite() {
+            return Err(bad(format!(
+                "position {}, forward {} and up {} do not define a view",
+                cam.position, cam.forward, cam.up
+            )));
+        }
+        let up = right.cross(forward);
+        let aspect = width as f32 / height as f32;
+        let (half_h, ortho) = match cam.projection {
+            Projection::Perspective { fov_y } => {
+                if !(fov_y > 0.0 && fov_y < 180.0) {
+                    return Err(bad(format!(
+                        "vertical field of view {fov_y}° is not in (0, 180)"
+                    )));
+                }
+                ((fov_y.to_radians() * 0.5).tan(), false)
+            }
+            Projection::Orthographic { half_height } => {
+                if !(half_height > 0.0 && half_height.is_finite()) {
+                    return Err(bad(format!(
+                        "orthographic size {half_height} is not positive"
+                    )));
+                }
+                (half_height, true)
+            }
+        };
+        Ok(CameraModel {
+            position: cam.position,
+            forward,
+            right,
+            up,
+            half_w: half_h * aspect,
+            half_h,
+            ortho,
+            near: if cam.near.is_finite() {
+                cam.near.max(0.0)
+            } else {
+                0.0
+            },
+            width: width as f32,
+            height: height as f32,
+        })
+    }
+
+    /// The ray through image position (`px`, `py`) in pixels of the full image, with
+    /// (0, 0) the top-left corner of the top-left pixel and y growing downwards. Geometry
+    /// nearer than the camera's near clip plane is not seen, as in Unity.
+    pub fn ray(&self, px: f32, py: f32) -> Ray {
+        let sx = (2.0 * px / self.width - 1.0) * self.half_w;
+        let sy = (1.0 - 2.0 * py / self.height) * self.half_h;
+        if self.ortho {
+            Ray {
+                origin: self.position + self.right * sx + self.up * sy,
+                dir: self.forward,
+                tmin: self.near,
+                tmax: f32::INFINITY,
+            }
+        } else {
+            let dir = (self.forward + self.right * sx + self.up * sy).normalize();
+            Ray {
+                origin: self.position,
+                dir,
+                // The near plane is at `near` along forward: further along an oblique ray.
+                tmin: self.near / dir.dot(self.forward),
+                tmax: f32::INFINITY,
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn centre_ray_looks_forward_and_right_is_right() {
+        let cam = Camera::default();
+        let m = CameraModel::new(&cam, 200, 100).unwrap();
+        let r = m.ray(100.0, 50.0);
+        assert!((r.dir - cam.forward).length() < 1e-6);
+        let right = m.ray(200.0, 50.0);
+        assert!(right.dir.dot(cam.right()) > 0.0);
+        let top = m.ray(100.0, 0.0);
+        assert!(top.dir.y > 0.0);
+        // The top edge is at fov/2 above the axis.
+        let a = top.dir.dot(cam.forward).acos().to_degrees();
+        assert!((a - 30.0).abs() < 1e-3, "{a}");
+    }
+
+    #[test]
+    fn orthographic_rays_are_parallel_and_span_the_half_height() {
+        let cam = Camera {
+            projection: Projection::Orthographic { half_height: 2.0 },
+            ..Camera::default()
+        };
+        let m = CameraModel::new(&cam, 100, 100).unwrap();
+        let top = m.ray(50.0, 0.0);
+        assert_eq!(top.dir, cam.forward);
+        assert!((top.origin - (cam.position + Vec3::Y * 2.0)).length() < 1e-5);
+    }
+
+    #[test]
+    fn a_degenerate_camera_is_refused() {
+        let mut cam = Camera::default();
+        cam.up = cam.forward;
+        assert!(CameraModel::new(&cam, 10, 10).is_err());
+    }
+}

@@ -1,0 +1,377 @@
+//! OpenEXR output: RGBA (f32, or f16 with `--half`) plus AOV channels in one single-part
+//! scan-line file, the data window set to the rendered crop and the display window to the
+//! full image; reading back; and merging crops into the full image.
+
+use crate::{Frame, RenderError, Window};
+use exr::prelude::*;
+use std::collections::BTreeMap;
+use std::io::Cursor;
+use std::path::Path;
+
+/// Prefix of unitrace's own header attributes.
+pub const ATTR_PREFIX: &str = "unitrace.";
+
+/// Channels stored as f16 with `--half` (colour and albedo). Depth, normals and object
+/// ids stay f32: halves would lose depth precision and object ids above 2048.
+fn halvable(name: &str) -> bool {
+    matches!(name, "R" | "G" | "B" | "A") || name.starts_with("albedo.")
+}
+
+/// JSON with every non-ASCII character escaped (`\uXXXX`), because EXR text attributes
+/// are bytes: light and object names may hold any Unicode.
+pub fn ascii_json(v: &serde_json::Value) -> String {
+    let s = v.to_string();
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        if c.is_ascii() {
+            out.push(c);
+        } else {
+            let mut buf = [0u16; 2];
+            for unit in c.encode_utf16(&mut buf) {
+                out.push_str(&format!("\\u{unit:04x}"));
+            }
+        }
+    }
+    out
+}
+
+/// An EXR image as unitrace reads and writes it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExrImage {
+    pub width: u32,
+    pub height: u32,
+    pub window: Window,
+    /// Sorted by name (the EXR order).
+    pub channels: Vec<(String, FlatSamples)>,
+    /// Text attributes (unitrace's and any other text attribute in the header).
+    pub attributes: BTreeMap<String, String>,
+}
+
+impl ExrImage {
+    pub fn from_frame(frame: &Frame, half: bool, attributes: BTreeMap<String, String>) -> Self {
+        let mut channels: Vec<(String, FlatSamples)> = frame
+            .channels()
+            .into_iter()
+            .map(|(name, plane)| {
+                let samples = if half && halvable(name) {
+                    FlatSamples::F16(plane.into_iter().map(f16::from_f32).collect())
+                } else {
+                    FlatSamples::F32(plane)
+                };
+                (name.to_string(), samples)
+            })
+            .collect();
+        channels.sort_by(|a, b| a.0.cmp(&b.0));
+        ExrImage {
+            width: frame.width,
+            height: frame.height,
+            window: frame.window,
+            channels,
+            attributes,
+        }
+    }
+
+    pub fn channel(&self, name: &str) -> Option<&FlatSamples> {
+        self.channels.iter().find(|c| c.0 == name).map(|c| &c.1)
+    }
+
+    pub fn channel_names(&self) -> Vec<&str> {
+        self.channels.iter().map(|c| c.0.as_str()).collect()
+    }
+
+    /// Value of channel `name` at full-image pixel (x, y), as f32.
+    pub fn value(&self, name: &str, x: u32, y: u32) -> Option<f32> {
+        let w = self.window;
+        if x < w.x0 || x >= w.x1 || y < w.y0 || y >= w.y1 {
+            return None;
+        }
+        let i = (y - w.y0) as usize * w.width() as usize + (x - w.x0) as usize;
+        Some(self.channel(name)?.value_by_flat_index(i).to_f32())
+    }
+
+    /// Encode as an EXR file in memory.
+    pub fn encode(&self) -> std::result::Result<Vec<u8>, String> {
+        let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = self
+            .channels
+            .iter()
+            .map(|(name, s)| {
+                let text =
+                    Text::new_or_none(name).ok_or(format!("channel name {name:?} is not ASCII"))?;
+                Ok(AnyChannel::new(text, s.clone()))
+            })
+            .collect::<std::result::Result<_, String>>()?;
+        let size = (self.window.width() as usize, self.window.height() as usize);
+        let mut attrs = LayerAttributes {
+            layer_position: Vec2(self.window.x0 as i32, self.window.y0 as i32),
+            software_name: Some(Text::from(concat!(
+                "unitrace kd2exr ",
+                env!("CARGO_PKG_VERSION")
+            ))),
+            ..LayerAttributes::default()
+        };
+        for (k, v) in &self.attributes {
+            let (Some(k), Some(v)) = (Text::new_or_none(k), Text::new_or_none(v)) else {
+                return Err(format!("attribute {k:?} is not Latin-1 text"));
+            };
+            attrs.other.insert(k, AttributeValue::Text(v));
+        }
+        let layer = Layer::new(
+            size,
+            attrs,
+            Encoding::SMALL_LOSSLESS,
+            AnyChannels::sort(list),
+        );
+        let display = IntegerBounds::new((0, 0), (self.width as usize, self.height as usize));
+        let image = Image::new(ImageAttributes::new(display), layer);
+        let mut out = Cursor::new(Vec::new());
+        image
+            .write()
+            .to_buffered(&mut out)
+            .map_err(|e| e.to_string())?;
+        Ok(out.into_inner())
+    }
+
+    /// Write atomically (temp file in the same folder + rename).
+    pub fn write(&self, path: &Path) -> std::result::Result<(), RenderError> {
+        let bytes = self.encode().map_err(|detail| RenderError::ExrWrite {
+            path: path.to_path_buf(),
+            detail,
+        })?;
+        formats::write_atomic(path, &bytes)?;
+        Ok(())
+    }
+
+    pub fn read(path: &Path) -> std::result::Result<Self, RenderError> {
+        let err = |detail: String| RenderError::ExrRead {
+            path: path.to_path_buf(),
+            detail,
+        };
+        let bytes = std::fs::read(path).map_err(|e| err(e.to_string()))?;
+        let image = read()
+            .no_deep_data()
+            .largest_resolution_level()
+            .all_channels()
+            .first_valid_layer()
+            .all_attributes()
+            .from_buffered(Cursor::new(bytes))
+            .map_err(|e| err(e.to_string()))?;
+        let display = image.attributes.display_window;
+        if display.position != Vec2(0, 0) {
+            return Err(err(format!(
+                "display window starts at {:?}; unitrace images start at (0, 0)",
+                display.position
+            )));
+        }
+        let layer = image.layer_data;
+        let pos = layer.attributes.layer_position;
+        if pos.0 < 0 || pos.1 < 0 {
+            return Err(err(format!(
+                "data window starts at {pos:?}, outside the image"
+            )));
+        }
+        let window = Window {
+            x0: pos.0 as u32,
+            y0: pos.1 as u32,
+            x1: pos.0 as u32 + layer.size.0 as u32,
+            y1: pos.1 as u32 + layer.size.1 as u32,
+        };
+        let mut attributes = BTreeMap::new();
+        let others = image
+            .attributes
+            .other
+            .iter()
+            .chain(layer.attributes.other.iter());
+        for (k, v) in others {
+            if let AttributeValue::Text(t) = v {
+                attributes.insert(k.to_string(), t.to_string());
+            }
+        }
+        let channels = layer
+            .channel_data
+            .list
+            .into_iter()
+            .map(|c| (c.name.to_string(), c.sample_data))
+            .collect();
+        Ok(ExrImage {
+            width: display.size.0 as u32,
+            height: display.size.1 as u32,
+            window,
+            channels,
+            attributes,
+        })
+    }
+}
+
+/// Attributes that must agree between the crops of one image.
+const SAME_RENDER: [&str; 6] = [
+    "spp",
+    "depth",
+    "seed",
+    "geometryHash",
+    "softSamples",
+    "cutoff",
+];
+
+/// Assemble crops of one render into the full image. Every pixel must be covered; where
+/// crops overlap they must agree bit for bit. The result's pixels are bit-identical to a
+/// one-shot render; its `renderSeconds` is the sum of the parts'.
+pub fn merge(parts: &[ExrImage]) -> std::result::Result<ExrImage, RenderError> {
+    let bad = |s: String| RenderError::Merge(s);
+    let first = parts.first().ok_or_else(|| bad("no input images".into()))?;
+    let names = first.channel_names();
+    for (i, p) in parts.iter().enumerate() {
+        if (p.width, p.height) != (first.width, first.height) {
+            return Err(bad(format!(
+                "input {} is a crop of a {}×{} image, input 1 of {}×{}",
+                i + 1,
+                p.width,
+                p.height,
+                first.width,
+                first.height
+            )));
+        }
+        if p.channel_names() != names {
+            return Err(bad(format!(
+                "input {} has channels {:?}, input 1 has {:?}",
+                i + 1,
+                p.channel_names(),
+                names
+            )));
+        }
+        for key in SAME_RENDER {
+            let k = format!("{ATTR_PREFIX}{key}");
+            if p.attributes.get(&k) != first.attributes.get(&k) {
+                return Err(bad(format!(
+                    "input {} was rendered with {key} {:?}, input 1 with {:?}",
+                    i + 1,
+                    p.attributes.get(&k),
+                    first.attributes.get(&k)
+                )));
+            }
+        }
+    }
+    let (w, h) = (first.width as usize, first.height as usize);
+    let mut covered = vec![false; w * h];
+    let mut channels: Vec<(String, FlatSamples)> = first
+        .channels
+        .iter()
+        .map(|(n, s)| {
+            let full = match s {
+                FlatSamples::F16(_) => FlatSamples::F16(vec![f16::ZERO; w * h]),
+                FlatSamples::F32(_) => FlatSamples::F32(vec![0.0; w * h]),
+                FlatSamples::U32(_) => FlatSamples::U32(vec![0; w * h]),
+            };
+            (n.clone(), full)
+        })
+        .collect();
+    for (pi, p) in parts.iter().enumerate() {
+        let pw = p.window.width() as usize;
+        for (ci, (name, src)) in p.channels.iter().enumerate() {
+            let dst = &mut channels[ci].1;
+            for row in 0..p.window.height() as usize {
+                let y = p.window.y0 as usize + row;
+                let from = row * pw;
+                let to = y * w + p.window.x0 as usize;
+                let ok = match (src, &mut *dst) {
+                    (FlatSamples::F16(s), FlatSamples::F16(d)) => copy_row(
+                        &s[from..from + pw],
+                        &mut d[to..to + pw],
+                        &covered[to..to + pw],
+                        |a, b| a.to_bits() == b.to_bits(),
+                    ),
+                    (FlatSamples::F32(s), FlatSamples::F32(d)) => copy_row(
+                        &s[from..from + pw],
+                        &mut d[to..to + pw],
+                        &covered[to..to + pw],
+                        |a, b| a.to_bits() == b.to_bits(),
+                    ),
+                    (FlatSamples::U32(s), FlatSamples::U32(d)) => copy_row(
+                        &s[from..from + pw],
+                        &mut d[to..to + pw],
+                        &covered[to..to + pw],
+                        |a, b| a == b,
+                    ),
+                    _ => {
+                        return Err(bad(format!(
+                            "channel {name} of input {} has another sample type than in input 1",
+                            pi + 1
+                        )))
+                    }
+                };
+                if let Err(x) = ok {
+                    return Err(bad(format!(
+                        "inputs overlap at pixel ({}, {y}) with different {name} values: \
+                         they are not crops of one render",
+                        p.window.x0 as usize + x
+                    )));
+                }
+            }
+        }
+        for row in 0..p.window.height() as usize {
+            let to = (p.window.y0 as usize + row) * w + p.window.x0 as usize;
+            covered[to..to + pw].iter_mut().for_each(|c| *c = true);
+        }
+    }
+    if let Some(i) = covered.iter().position(|c| !c) {
+        let missing = covered.iter().filter(|c| !**c).count();
+        return Err(bad(format!(
+            "{missing} pixels are in no input, the first at ({}, {})",
+            i % w,
+            i / w
+        )));
+    }
+    let mut attributes = first.attributes.clone();
+    let seconds: f64 = parts
+        .iter()
+        .filter_map(|p| {
+            p.attributes
+                .get(&format!("{ATTR_PREFIX}renderSeconds"))?
+                .parse::<f64>()
+                .ok()
+        })
+        .sum();
+    attributes.insert(
+        format!("{ATTR_PREFIX}renderSeconds"),
+        format!("{seconds:.6}"),
+    );
+    attributes.insert(format!("{ATTR_PREFIX}mergedFrom"), parts.len().to_string());
+    attributes.remove(&format!("{ATTR_PREFIX}crop"));
+    Ok(ExrImage {
+        width: first.width,
+        height: first.height,
+        window: Window::full(first.width, first.height),
+        channels,
+        attributes,
+    })
+}
+
+/// Copy `src` into `dst`; where `covered` already, the values must be equal. Err(x) is
+/// the first disagreeing position.
+fn copy_row<T: Copy>(
+    src: &[T],
+    dst: &mut [T],
+    covered: &[bool],
+    same: impl Fn(T, T) -> bool,
+) -> std::result::Result<(), usize> {
+    for (x, ((s, d), c)) in src.iter().zip(dst.iter_mut()).zip(covered).enumerate() {
+        if *c && !same(*s, *d) {
+            return Err(x);
+        }
+        *d = *s;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ascii_json_escapes_unicode() {
+        let v = serde_json::json!({"name": "Lampe à 🌞"});
+        let s = ascii_json(&v);
+        assert!(s.is_ascii());
+        let back: serde_json::Value = serde_json::from_str(&s).unwrap();
+        assert_eq!(back, v);
+    }
+}

@@ -1,0 +1,149 @@
+//! What a render is asked to do: image size, window, sampling and effect limits.
+
+use crate::{AovSet, RenderError};
+
+/// A half-open pixel rectangle [x0, x1) × [y0, y1) of the full image, y = 0 at the top.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Window {
+    pub x0: u32,
+    pub y0: u32,
+    pub x1: u32,
+    pub y1: u32,
+}
+
+impl Window {
+    pub fn full(width: u32, height: u32) -> Self {
+        Window {
+            x0: 0,
+            y0: 0,
+            x1: width,
+            y1: height,
+        }
+    }
+    pub fn width(&self) -> u32 {
+        self.x1 - self.x0
+    }
+    pub fn height(&self) -> u32 {
+        self.y1 - self.y0
+    }
+    pub fn pixels(&self) -> u64 {
+        self.width() as u64 * self.height() as u64
+    }
+
+    /// Parse `x0,y0,x1,y1` (x1, y1 exclusive).
+    pub fn parse(s: &str) -> Result<Self, String> {
+        let v: Vec<u32> = s
+            .split(',')
+            .map(|p| p.trim().parse::<u32>())
+            .collect::<Result<_, _>>()
+            .map_err(|e| format!("crop {s:?}: {e}; expected x0,y0,x1,y1"))?;
+        match v[..] {
+            [x0, y0, x1, y1] => Ok(Window { x0, y0, x1, y1 }),
+            _ => Err(format!(
+                "crop {s:?} has {} numbers; expected x0,y0,x1,y1",
+                v.len()
+            )),
+        }
+    }
+}
+
+impl std::fmt::Display for Window {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{},{},{},{}", self.x0, self.y0, self.x1, self.y1)
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct RenderOptions {
+    pub width: u32,
+    pub height: u32,
+    /// Maximum number of mirror bounces along a path (0: no reflection rays).
+    pub depth: u32,
+    /// Samples per pixel.
+    pub spp: u32,
+    pub seed: u64,
+    /// Shadow rays per soft-shadow light per shading point.
+    pub soft_samples: u32,
+    /// Reflection rays are traced only while the path weight (the product of the
+    /// reflectances met so far, largest channel) is at least this.
+    pub cutoff: f32,
+    /// Render only this window of the full image (None: the whole image).
+    pub crop: Option<Window>,
+    pub aovs: AovSet,
+    /// Worker threads (None: rayon's default, one per core).
+    pub threads: Option<usize>,
+    /// Tile edge in pixels.
+    pub tile: u32,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions {
+            width: 1024,
+            height: 768,
+            depth: 2,
+            spp: 1,
+            seed: 0,
+            soft_samples: 16,
+            cutoff: 0.004,
+            crop: None,
+            aovs: AovSet::default(),
+            threads: None,
+            tile: 32,
+        }
+    }
+}
+
+/// Largest image edge: EXR windows are i32 and a pixel index must fit comfortably.
+pub const MAX_EDGE: u32 = 1 << 20;
+
+impl RenderOptions {
+    /// Refuse options that cannot make an image, naming the option.
+    pub fn validate(&self) -> Result<(), RenderError> {
+        let bad = |s: String| Err(RenderError::Option(s));
+        if self.width == 0 || self.height == 0 {
+            return bad(format!(
+                "--width {} --height {}: the image needs at least one pixel",
+                self.width, self.height
+            ));
+        }
+        if self.width > MAX_EDGE || self.height > MAX_EDGE {
+            return bad(format!(
+                "--width {} --height {}: edges above {MAX_EDGE} pixels are not supported",
+                self.width, self.height
+            ));
+        }
+        if self.spp == 0 {
+            return bad("--spp 0: at least one sample per pixel is needed".into());
+        }
+        if self.soft_samples == 0 {
+            return bad("--soft-samples 0: at least one shadow sample is needed".into());
+        }
+        if !(self.cutoff.is_finite() && self.cutoff >= 0.0) {
+            return bad(format!(
+                "--cutoff {}: must be a finite number ≥ 0",
+                self.cutoff
+            ));
+        }
+        if self.threads == Some(0) {
+            return bad("--threads 0: at least one thread is needed".into());
+        }
+        if self.tile == 0 {
+            return bad("tile size 0".into());
+        }
+        if let Some(c) = self.crop {
+            if c.x0 >= c.x1 || c.y0 >= c.y1 || c.x1 > self.width || c.y1 > self.height {
+                return bad(format!(
+                    "--crop {c}: must be a non-empty window inside the {}×{} image \
+                     (x0 < x1 ≤ width, y0 < y1 ≤ height; x1 and y1 are exclusive)",
+                    self.width, self.height
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    pub fn window(&self) -> Window {
+        self.crop.unwrap_or(Window::full(self.width, self.height))
+    }
+}

@@ -1,0 +1,340 @@
+//! The effects plan: before tracing, decide from the soup which effects can change the
+//! image, and why. The integrator consults it, so a ray that cannot change the image is
+//! never traced; it is printed, stored in the EXR header and returned in `--json`.
+
+use crate::RenderOptions;
+use formats::{AmbientMode, ClearFlags, LightKind, Shadows, Soup};
+use glam::Vec3;
+use serde::Serialize;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ShadowMode {
+    None,
+    Hard,
+    Soft,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct LightPlan {
+    pub name: String,
+    pub kind: &'static str,
+    /// Whether the light is evaluated at all.
+    pub enabled: bool,
+    pub shadows: ShadowMode,
+    /// Shadow rays per shading point (0, 1, or --soft-samples).
+    pub shadow_rays: u32,
+    pub reason: String,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Effect {
+    pub enabled: bool,
+    pub reason: String,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct ReflectionPlan {
+    pub enabled: bool,
+    /// Maximum bounces (0 when disabled).
+    pub depth: u32,
+    pub cutoff: f32,
+    pub reflective_materials: usize,
+    pub reason: String,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct AntiAliasing {
+    pub enabled: bool,
+    pub spp: u32,
+    pub pattern: &'static str,
+    pub reason: String,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Plan {
+    /// Direct lighting: on when some light is on and some material has a diffuse albedo.
+    pub direct: Effect,
+    pub lights: Vec<LightPlan>,
+    pub reflections: ReflectionPlan,
+    pub ambient: Effect,
+    pub emission: Effect,
+    pub anti_aliasing: AntiAliasing,
+    pub background: String,
+}
+
+fn vec(v: Vec3) -> String {
+    format!("({:.3}, {:.3}, {:.3})", v.x, v.y, v.z)
+}
+
+impl Plan {
+    pub fn derive(soup: &Soup, opts: &RenderOptions) -> Plan {
+        // Only materials that some triangle uses can change the image.
+        let mut used = vec![false; soup.materials.len()];
+        for &m in &soup.tri_material {
+            if let Some(u) = used.get_mut(m as usize) {
+                *u = true;
+            }
+        }
+        let mats: Vec<_> = soup
+            .materials
+            .iter()
+            .zip(&used)
+            .filter(|(_, &u)| u)
+            .map(|(m, _)| m)
+            .collect();
+        let diffuse = mats.iter().any(|m| m.albedo().max_element() > 0.0);
+
+        let lights: Vec<LightPlan> = soup
+            .lights
+            .iter()
+            .map(|l| light_plan(l, diffuse, opts))
+            .collect();
+        let lit = lights.iter().filter(|l| l.enabled).count();
+        let direct = Effect {
+            enabled: lit > 0,
+            reason: if soup.lights.is_empty() {
+                "the scene has no lights".into()
+            } else if !diffuse {
+                "no material has a diffuse albedo".into()
+            } else if lit == 0 {
+                "no light delivers any light".into()
+            } else {
+                format!("{lit} of {} lights contribute", soup.lights.len())
+            },
+        };
+
+        let reflective = mats
+            .iter()
+            .filter(|m| m.reflectance().max_element() >= opts.cutoff.max(f32::MIN_POSITIVE))
+            .count();
+        let reflections = if opts.depth == 0 {
+            ReflectionPlan {
+                enabled: false,
+                depth: 0,
+                cutoff: opts.cutoff,
+                reflective_materials: reflective,
+                reason: "--depth 0".into(),
+            }
+        } else if reflective == 0 {
+            ReflectionPlan {
+                enabled: false,
+                depth: 0,
+                cutoff: opts.cutoff,
+                reflective_materials: 0,
+                reason: format!("no material has a reflectance ≥ {}", opts.cutoff),
+            }
+        } else {
+            ReflectionPlan {
+                enabled: true,
+                depth: opts.depth,
+                cutoff: opts.cutoff,
+                reflective_materials: reflective,
+                reason: format!(
+                    "{reflective} reflective materials; rays stop at depth {} or when the \
+                     path weight falls below {}",
+                    opts.depth, opts.cutoff
+                ),
+            }
+        };
+
+        let amb = &soup.environment.ambient;
+        let ambient_on = match amb.mode {
+            AmbientMode::Flat => amb.sky.max_element() > 0.0,
+            AmbientMode::Trilight | AmbientMode::Skybox => {
+                amb.sky.max(amb.equator).max(amb.ground).max_element() > 0.0
+            }
+        };
+        let ambient = Effect {
+            enabled: ambient_on && diffuse,
+            reason: if !ambient_on {
+                "the ambient light is black".into()
+            } else if !diffuse {
+                "no material has a diffuse albedo".into()
+            } else {
+                match amb.mode {
+                    AmbientMode::Flat => format!("flat ambient {}", vec(amb.sky)),
+                    _ => format!(
+                        "{:?} ambient: sky {}, equator {}, ground {}",
+                        amb.mode,
+                        vec(amb.sky),
+                        vec(amb.equator),
+                        vec(amb.ground)
+                    ),
+                }
+            },
+        };
+
+        let emissive = mats
+            .iter()
+            .filter(|m| m.emission.max_element() > 0.0)
+            .count();
+        let emission = Effect {
+            enabled: emissive > 0,
+            reason: if emissive > 0 {
+                format!("{emissive} emissive materials")
+            } else {
+                "no material emits".into()
+            },
+        };
+
+        let anti_aliasing = AntiAliasing {
+            enabled: opts.spp > 1,
+            spp: opts.spp,
+            pattern: if opts.spp <= 1 {
+                "pixel centre"
+            } else if is_square(opts.spp) {
+                "jittered grid, box filter"
+            } else {
+                "Latin hypercube, box filter"
+            },
+            reason: if opts.spp > 1 {
+                format!("--spp {}", opts.spp)
+            } else {
+                "--spp 1".into()
+            },
+        };
+
+        let background = match soup.environment.clear {
+            ClearFlags::SolidColor => format!("solid colour {}", vec(soup.environment.background)),
+            ClearFlags::Skybox => "sky gradient".into(),
+        };
+
+        Plan {
+            direct,
+            lights,
+            reflections,
+            ambient,
+            emission,
+            anti_aliasing,
+            background,
+        }
+    }
+
+    /// Human-readable, one effect per line.
+    pub fn describe(&self) -> String {
+        let on = |b: bool| if b { "on " } else { "off" };
+        let mut s = String::from("effects plan:\n");
+        s += &format!(
+            "  direct light   {}  {}\n",
+            on(self.direct.enabled),
+            self.direct.reason
+        );
+        for l in &self.lights {
+            s += &format!(
+                "    light {:?} ({}): {}, shadows {:?} ({} rays/point): {}\n",
+                l.name,
+                l.kind,
+                if l.enabled { "on" } else { "off" },
+                l.shadows,
+                l.shadow_rays,
+                l.reason
+            );
+        }
+        s += &format!(
+            "  reflections    {}  {}\n",
+            on(self.reflections.enabled),
+            self.reflections.reason
+        );
+        s += &format!(
+            "  ambient        {}  {}\n",
+            on(self.ambient.enabled),
+            self.ambient.reason
+        );
+        s += &format!(
+            "  emission       {}  {}\n",
+            on(self.emission.enabled),
+            self.emission.reason
+        );
+        s += &format!(
+            "  anti-aliasing  {}  {} ({})\n",
+            on(self.anti_aliasing.enabled),
+            self.anti_aliasing.reason,
+            self.anti_aliasing.pattern
+        );
+        s += &format!("  background     {}", self.background);
+        s
+    }
+
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::to_value(self).unwrap_or(serde_json::Value::Null)
+    }
+}
+
+fn is_square(n: u32) -> bool {
+    let k = (n as f64).sqrt().round() as u32;
+    k * k == n
+}
+
+fn light_plan(l: &formats::Light, diffuse: bool, opts: &RenderOptions) -> LightPlan {
+    let kind = match l.kind {
+        LightKind::Point => "point",
+        LightKind::Spot { .. } => "spot",
+        LightKind::Directional => "directional",
+    };
+    let power = l.color * l.intensity;
+    let off = |reason: String| LightPlan {
+        name: l.name.clone(),
+        kind,
+        enabled: false,
+        shadows: ShadowMode::None,
+        shadow_rays: 0,
+        reason,
+    };
+    if !power.is_finite() {
+        return off("its colour or intensity is not a finite number".into());
+    }
+    if power.max_element() <= 0.0 {
+        return off("black or zero intensity".into());
+    }
+    match l.kind {
+        LightKind::Point | LightKind::Spot { .. } if l.range.is_nan() || l.range <= 0.0 => {
+            return off(format!("range {} lights nothing", l.range))
+        }
+        LightKind::Spot { angle, .. } if angle.is_nan() || angle <= 0.0 => {
+            return off(format!("spot angle {angle}° lights nothing"))
+        }
+        _ => {}
+    }
+    if !diffuse {
+        return off("no material has a diffuse albedo to light".into());
+    }
+    let (shadows, shadow_rays, reason) = match l.shadows {
+        Shadows::None => (ShadowMode::None, 0, "m_Shadows is none".to_string()),
+        Shadows::Hard => (ShadowMode::Hard, 1, "hard shadows".to_string()),
+        Shadows::Soft if l.shadow_radius.is_nan() || l.shadow_radius <= 0.0 => (
+            ShadowMode::Hard,
+            1,
+            format!(
+                "soft shadows with a shadow radius of {}: a point emitter, traced as hard",
+                l.shadow_radius
+            ),
+        ),
+        Shadows::Soft if opts.soft_samples == 1 => (
+            ShadowMode::Hard,
+            1,
+            "soft shadows with --soft-samples 1: traced as hard".to_string(),
+        ),
+        Shadows::Soft => (
+            ShadowMode::Soft,
+            opts.soft_samples,
+            format!(
+                "soft shadows: {} samples over a {}",
+                opts.soft_samples,
+                if matches!(l.kind, LightKind::Directional) {
+                    format!("{}° cone", l.shadow_radius)
+                } else {
+                    format!("disc of radius {} m", l.shadow_radius)
+                }
+            ),
+        ),
+    };
+    LightPlan {
+        name: l.name.clone(),
+        kind,
+        enabled: true,
+        shadows,
+        shadow_rays,
+        reason,
+    }
+}

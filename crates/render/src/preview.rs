@@ -1,0 +1,71 @@
+//! The PNG preview: exposure, sRGB encoding, 8 bits.
+
+use crate::{Frame, RenderError};
+use std::path::Path;
+
+/// The sRGB opto-electronic transfer function (IEC 61966-2-1) on a linear value in [0, 1].
+pub fn srgb_oetf(c: f32) -> f32 {
+    if c <= 0.003_130_8 {
+        12.92 * c
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// One linear channel to an 8-bit sRGB value: scale by 2^exposure, clamp to [0, 1],
+/// encode, round.
+pub fn to_8bit(linear: f32, exposure: f32) -> u8 {
+    let v = linear * exposure.exp2();
+    let v = if v.is_finite() {
+        v.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (srgb_oetf(v) * 255.0 + 0.5) as u8
+}
+
+/// Encode the frame's window as an 8-bit sRGB PNG.
+pub fn encode_png(frame: &Frame, exposure: f32) -> Result<Vec<u8>, String> {
+    let (w, h) = (frame.window.width(), frame.window.height());
+    let mut rgb = Vec::with_capacity(frame.color.len() * 3);
+    for c in &frame.color {
+        rgb.extend(c.to_array().map(|v| to_8bit(v, exposure)));
+    }
+    let mut out = Vec::new();
+    {
+        let mut enc = png::Encoder::new(&mut out, w, h);
+        enc.set_color(png::ColorType::Rgb);
+        enc.set_depth(png::BitDepth::Eight);
+        enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+        let mut writer = enc.write_header().map_err(|e| e.to_string())?;
+        writer.write_image_data(&rgb).map_err(|e| e.to_string())?;
+    }
+    Ok(out)
+}
+
+/// Write the preview atomically (temp file + rename).
+pub fn write_png(path: &Path, frame: &Frame, exposure: f32) -> Result<(), RenderError> {
+    let bytes = encode_png(frame, exposure).map_err(|detail| RenderError::PngWrite {
+        path: path.to_path_buf(),
+        detail,
+    })?;
+    formats::write_atomic(path, &bytes)?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn srgb_encoding_of_known_values() {
+        assert_eq!(to_8bit(0.0, 0.0), 0);
+        assert_eq!(to_8bit(1.0, 0.0), 255);
+        assert_eq!(to_8bit(0.5, 1.0), 255);
+        // Linear 0.2142 is just above sRGB 0.5 (127.5 rounds to 128); 0.05 is sRGB 0.2474 (63).
+        assert_eq!(to_8bit(0.2142, 0.0), 128);
+        assert_eq!(to_8bit(0.05, 0.0), 63);
+        assert_eq!(to_8bit(f32::NAN, 0.0), 0);
+        assert_eq!(to_8bit(5.0, 0.0), 255);
+    }
+}

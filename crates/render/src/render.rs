@@ -1,0 +1,182 @@
+//! Parallel rendering over tiles with rayon's work stealing.
+
+use crate::counters::{RayCounts, SharedCounts};
+use crate::integrator::{Integrator, Primary};
+use crate::sampling::{pixel_samples, Rng};
+use crate::{CameraModel, Frame, Plan, RenderError, RenderOptions, Window};
+use formats::{KdFile, Soup};
+use glam::Vec3;
+use kdtree::Accel;
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// A finished render.
+#[derive(Debug)]
+pub struct Rendered {
+    pub frame: Frame,
+    pub counts: RayCounts,
+    /// Wall-clock time of the tracing itself (not loading or writing).
+    pub seconds: f64,
+}
+
+/// Tiles of at most `edge`×`edge` pixels covering the window, row by row.
+pub fn tiles(window: Window, edge: u32) -> Vec<Window> {
+    let mut out = Vec::new();
+    let mut y = window.y0;
+    while y < window.y1 {
+        let y1 = (y + edge).min(window.y1);
+        let mut x = window.x0;
+        while x < window.x1 {
+            let x1 = (x + edge).min(window.x1);
+            out.push(Window {
+                x0: x,
+                y0: y,
+                x1,
+                y1,
+            });
+            x = x1;
+        }
+        y = y1;
+    }
+    out
+}
+
+/// Validate, derive the plan, build the accelerator and render: the all-in-one entry
+/// point used by tests. `kd2exr` does the same steps one at a time to report on each.
+pub fn render_scene(
+    soup: &Soup,
+    kd: &KdFile,
+    opts: &RenderOptions,
+) -> Result<(Rendered, Plan), RenderError> {
+    opts.validate()?;
+    let accel = Accel::new(soup, kd)?;
+    let plan = Plan::derive(soup, opts);
+    let out = render(soup, &accel, &plan, opts, None)?;
+    Ok((out, plan))
+}
+
+/// Render `opts.window()` of the image. `progress` is called after each tile with
+/// (tiles done, tiles in all).
+pub fn render(
+    soup: &Soup,
+    accel: &Accel,
+    plan: &Plan,
+    opts: &RenderOptions,
+    progress: Option<&(dyn Fn(u64, u64) + Sync)>,
+) -> Result<Rendered, RenderError> {
+    opts.validate()?;
+    let camera = CameraModel::new(&soup.camera, opts.width, opts.height)?;
+    let integrator = Integrator::new(soup, accel, plan, opts.soft_samples);
+    let window = opts.window();
+    let run = || render_tiles(&camera, &integrator, opts, window, progress);
+    let start = Instant::now();
+    let (frame, counts) = match opts.threads {
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .map_err(|e| RenderError::Threads {
+                threads: n,
+                detail: e.to_string(),
+            })?
+            .install(run),
+        None => run(),
+    };
+    Ok(Rendered {
+        frame,
+        counts,
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+fn render_tiles(
+    camera: &CameraModel,
+    integrator: &Integrator,
+    opts: &RenderOptions,
+    window: Window,
+    progress: Option<&(dyn Fn(u64, u64) + Sync)>,
+) -> (Frame, RayCounts) {
+    let list = tiles(window, opts.tile);
+    let total = list.len() as u64;
+    let shared = SharedCounts::default();
+    let done = std::sync::atomic::AtomicU64::new(0);
+    let results: Vec<(Window, Vec<(Vec3, Primary)>)> = list
+        .into_par_iter()
+        .map(|tile| {
+            let mut counts = RayCounts::default();
+            let mut pixels = Vec::with_capacity(tile.pixels() as usize);
+            for y in tile.y0..tile.y1 {
+                for x in tile.x0..tile.x1 {
+                    pixels.push(render_pixel(camera, integrator, opts, x, y, &mut counts));
+                }
+            }
+            shared.add(&counts);
+            if let Some(report) = progress {
+                let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                report(n, total);
+            }
+            (tile, pixels)
+        })
+        .collect();
+    let mut frame = Frame::new(opts.width, opts.height, window, opts.aovs);
+    for (tile, pixels) in results {
+        let mut it = pixels.iter();
+        for y in tile.y0..tile.y1 {
+            for x in tile.x0..tile.x1 {
+                let (c, p) = it.next().expect("one result per tile pixel");
+                let i = frame.index(x, y).expect("tiles lie inside the window");
+                frame.set(i, *c, p);
+            }
+        }
+    }
+    (frame, shared.load())
+}
+
+/// One pixel: the box-filtered mean of its samples. Its generator is seeded from
+/// (seed, x, y) only, so its value is independent of tiles, threads and crops. The AOVs
+/// come from the sample nearest the pixel centre (averaging depths or object ids across
+/// an edge would describe no surface).
+pub fn render_pixel(
+    camera: &CameraModel,
+    integrator: &Integrator,
+    opts: &RenderOptions,
+    x: u32,
+    y: u32,
+    counts: &mut RayCounts,
+) -> (Vec3, Primary) {
+    let mut rng = Rng::for_pixel(opts.seed, x, y);
+    let samples = pixel_samples(opts.spp, &mut rng);
+    let mut sum = Vec3::ZERO;
+    let mut best = (f32::INFINITY, Primary::MISS);
+    for (sx, sy) in &samples {
+        let ray = camera.ray(x as f32 + sx, y as f32 + sy);
+        let (l, primary) = integrator.camera_sample(&ray, &mut rng, counts);
+        sum += l;
+        let d = (sx - 0.5).powi(2) + (sy - 0.5).powi(2);
+        if d < best.0 {
+            best = (d, primary);
+        }
+    }
+    (sum / samples.len() as f32, best.1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tiles_cover_the_window_once() {
+        let w = Window {
+            x0: 3,
+            y0: 5,
+            x1: 70,
+            y1: 41,
+        };
+        let t = tiles(w, 32);
+        let area: u64 = t.iter().map(|t| t.pixels()).sum();
+        assert_eq!(area, w.pixels());
+        assert_eq!(t.len(), 3 * 2);
+        assert!(t
+            .iter()
+            .all(|t| t.x0 >= 3 && t.x1 <= 70 && t.y0 >= 5 && t.y1 <= 41));
+    }
+}

@@ -1,0 +1,167 @@
+//! Deterministic random numbers and stratified sample patterns.
+//!
+//! Every pixel draws from its own generator seeded by (seed, x, y), so a pixel's value
+//! never depends on the tile it fell in, the thread that rendered it or the crop window:
+//! tiles rendered on different machines merge bit for bit into the one-shot image.
+
+/// SplitMix64 finaliser: a bijective 64-bit mix with good avalanche.
+fn splitmix64(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+/// A small PCG-XSH-RR 32-bit generator.
+#[derive(Clone, Debug)]
+pub struct Rng {
+    state: u64,
+}
+
+impl Rng {
+    const MUL: u64 = 6_364_136_223_846_793_005;
+    const INC: u64 = 1_442_695_040_888_963_407;
+
+    pub fn new(seed: u64) -> Self {
+        let mut rng = Rng {
+            state: splitmix64(seed),
+        };
+        rng.next_u32();
+        rng
+    }
+
+    /// The generator of pixel (x, y) for a render seed.
+    pub fn for_pixel(seed: u64, x: u32, y: u32) -> Self {
+        let xy = ((x as u64) << 32) | y as u64;
+        Rng::new(splitmix64(seed) ^ splitmix64(xy ^ 0x5bd1_e995_u64.rotate_left(40)))
+    }
+
+    pub fn next_u32(&mut self) -> u32 {
+        let old = self.state;
+        self.state = old.wrapping_mul(Self::MUL).wrapping_add(Self::INC);
+        let xorshifted = (((old >> 18) ^ old) >> 27) as u32;
+        let rot = (old >> 59) as u32;
+        xorshifted.rotate_right(rot)
+    }
+
+    /// Uniform in [0, 1): 24 random bits, so the result is exactly representable.
+    pub fn next_f32(&mut self) -> f32 {
+        (self.next_u32() >> 8) as f32 * (1.0 / 16_777_216.0)
+    }
+
+    /// Uniform integer in [0, n).
+    pub fn below(&mut self, n: u32) -> u32 {
+        ((self.next_u32() as u64 * n as u64) >> 32) as u32
+    }
+}
+
+/// `spp` sample positions inside a pixel, each in [0, 1)².
+///
+/// * 1 sample: the pixel centre (no jitter), so a 1-spp render is a plain pinhole image.
+/// * a square count k²: a jittered k×k grid (one sample per stratum).
+/// * any other count: Latin hypercube ("N-rooks"): x and y each stratified into `spp`
+///   intervals, paired by a random permutation.
+pub fn pixel_samples(spp: u32, rng: &mut Rng) -> Vec<(f32, f32)> {
+    if spp <= 1 {
+        return vec![(0.5, 0.5)];
+    }
+    let n = spp as usize;
+    let k = (spp as f64).sqrt().round() as u32;
+    if k * k == spp {
+        let inv = 1.0 / k as f32;
+        let mut out = Vec::with_capacity(n);
+        for j in 0..k {
+            for i in 0..k {
+                let x = (i as f32 + rng.next_f32()) * inv;
+                let y = (j as f32 + rng.next_f32()) * inv;
+                out.push((x.min(ONE_MINUS), y.min(ONE_MINUS)));
+            }
+        }
+        return out;
+    }
+    let mut perm: Vec<u32> = (0..spp).collect();
+    for i in (1..n).rev() {
+        let j = rng.below(i as u32 + 1) as usize;
+        perm.swap(i, j);
+    }
+    let inv = 1.0 / spp as f32;
+    (0..n)
+        .map(|i| {
+            let x = (i as f32 + rng.next_f32()) * inv;
+            let y = (perm[i] as f32 + rng.next_f32()) * inv;
+            (x.min(ONE_MINUS), y.min(ONE_MINUS))
+        })
+        .collect()
+}
+
+/// Largest f32 below 1.
+pub const ONE_MINUS: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// Golden angle in radians: consecutive Vogel-spiral points turn by it.
+const GOLDEN_ANGLE: f32 = 2.399_963_2;
+
+/// Sample `i` of `n` on the unit disc: a Vogel spiral whose radius is stratified in area
+/// (stratum i of n, jittered by `jitter`) and whose angle is rotated by `rotation`
+/// (random per shading point, so neighbouring pixels do not share one pattern).
+pub fn disc_sample(i: u32, n: u32, jitter: f32, rotation: f32) -> (f32, f32) {
+    let area = ((i as f32 + jitter) / n as f32).min(1.0);
+    let r = area.sqrt();
+    let phi = i as f32 * GOLDEN_ANGLE + rotation;
+    (r * phi.cos(), r * phi.sin())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pixel_generators_differ_and_repeat() {
+        let a: Vec<u32> = (0..4).map(|_| Rng::for_pixel(0, 3, 4).next_u32()).collect();
+        assert!(a.iter().all(|&v| v == a[0]));
+        assert_ne!(
+            Rng::for_pixel(0, 3, 4).next_u32(),
+            Rng::for_pixel(0, 4, 3).next_u32()
+        );
+        assert_ne!(
+            Rng::for_pixel(0, 3, 4).next_u32(),
+            Rng::for_pixel(1, 3, 4).next_u32()
+        );
+    }
+
+    #[test]
+    fn square_counts_put_one_sample_per_stratum() {
+        let mut rng = Rng::new(7);
+        let s = pixel_samples(16, &mut rng);
+        let mut seen = [false; 16];
+        for (x, y) in s {
+            assert!((0.0..1.0).contains(&x) && (0.0..1.0).contains(&y));
+            seen[(y * 4.0) as usize * 4 + (x * 4.0) as usize] = true;
+        }
+        assert!(seen.iter().all(|&b| b));
+    }
+
+    #[test]
+    fn other_counts_are_latin_hypercubes() {
+        let mut rng = Rng::new(9);
+        let s = pixel_samples(5, &mut rng);
+        let mut xs: Vec<usize> = s.iter().map(|p| (p.0 * 5.0) as usize).collect();
+        let mut ys: Vec<usize> = s.iter().map(|p| (p.1 * 5.0) as usize).collect();
+        xs.sort();
+        ys.sort();
+        assert_eq!(xs, vec![0, 1, 2, 3, 4]);
+        assert_eq!(ys, vec![0, 1, 2, 3, 4]);
+    }
+
+    #[test]
+    fn one_sample_is_the_pixel_centre() {
+        assert_eq!(pixel_samples(1, &mut Rng::new(1)), vec![(0.5, 0.5)]);
+    }
+
+    #[test]
+    fn disc_samples_stay_in_the_disc() {
+        for i in 0..64 {
+            let (x, y) = disc_sample(i, 64, 0.999, 1.0);
+            assert!(x * x + y * y <= 1.0 + 1e-6);
+        }
+    }
+}

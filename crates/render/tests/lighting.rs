@@ -1,0 +1,432 @@
+//! Pixel values where the answer is known: the lighting formula, shadows, mirrors, image
+//! orientation, spot cones, directional cosines, ambient and emission.
+
+mod common;
+
+use common::*;
+use formats::{AmbientMode, Camera, Projection, Shadows};
+use glam::Vec3;
+
+const ALBEDO: Vec3 = Vec3::new(0.8, 0.6, 0.4);
+
+/// Floor at y = 0 seen from above by an orthographic camera (pixel = 0.25 m).
+fn floor_scene() -> SceneBuilder {
+    let mut s = SceneBuilder::new();
+    let m = s.diffuse(ALBEDO);
+    s.floor(0.0, 0.0, 0.0, 20.0, m);
+    s.camera(top_down_camera(Vec3::new(0.0, 10.0, 0.0), 5.0));
+    s
+}
+
+#[test]
+fn a_plane_lit_by_one_point_light_matches_the_formula() {
+    let mut s = floor_scene();
+    let light_pos = Vec3::new(1.0, 2.0, 0.5);
+    s.light(point_light(light_pos, 1.5, 6.0, Shadows::Hard));
+    let (soup, kd) = s.build();
+    let (w, h) = (40, 40);
+    let (out, _) = render(&soup, &kd, &opts(w, h));
+    let mut lit = 0;
+    for py in 0..h {
+        for px in 0..w {
+            let p = ortho_point(&soup.camera, w, h, px, py, 0.0);
+            let to = light_pos - p;
+            let d = to.length();
+            let want = ALBEDO * 1.5 * unity_falloff(d, 6.0) * (to.y / d);
+            assert_close(
+                out.frame.pixel(px, py),
+                want,
+                0.01,
+                &format!("pixel ({px}, {py})"),
+            );
+            if want.x > 0.0 {
+                lit += 1;
+            }
+        }
+    }
+    // The range (6 m from a light 2 m up) ends inside the view: both cases are checked.
+    assert!(lit > 100 && lit < (w * h) as usize, "{lit} lit pixels");
+}
+
+#[test]
+fn a_shadowed_point_is_dark_and_lit_without_shadows() {
+    for shadows in [Shadows::Hard, Shadows::None] {
+        let mut s = floor_scene();
+        // The light at (3, 4, 0) throws the occluder's shadow (x ∈ [1, 2] at y = 2)
+        // onto x ∈ [−1, 1] of the floor.
+        let m = s.diffuse(Vec3::ONE);
+        s.quad(
+            "occluder",
+            Vec3::new(1.0, 2.0, -1.0),
+            Vec3::new(0.0, 0.0, 2.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            m,
+        );
+        let light_pos = Vec3::new(3.0, 4.0, 0.0);
+        s.light(point_light(light_pos, 1.0, 20.0, shadows));
+        let (soup, kd) = s.build();
+        let (out, _) = render(&soup, &kd, &opts(40, 40));
+        let p = ortho_point(&soup.camera, 40, 40, 20, 20, 0.0);
+        assert!(p.x.abs() < 0.2 && p.z.abs() < 0.2);
+        let got = out.frame.pixel(20, 20);
+        let to = light_pos - p;
+        let d = to.length();
+        let lit = ALBEDO * unity_falloff(d, 20.0) * (to.y / d);
+        match shadows {
+            Shadows::Hard => assert_eq!(
+                got,
+                Vec3::ZERO,
+                "the shadowed point must get no direct light"
+            ),
+            _ => assert_close(got, lit, 0.01, "without shadows the point is lit"),
+        }
+        // A floor point outside the shadow is lit either way (x = −3: pixel column 7).
+        let q = ortho_point(&soup.camera, 40, 40, 7, 20, 0.0);
+        assert!(q.x > 1.5 || q.x < -1.5, "{q}");
+        let to = light_pos - q;
+        let want = ALBEDO * unity_falloff(to.length(), 20.0) * (to.y / to.length());
+        assert_close(out.frame.pixel(7, 20), want, 0.01, "unshadowed floor");
+    }
+}
+
+/// A camera at (0, 1, −5) looking at a mirror at z = 0; behind the camera, at z = −10,
+/// a red emitter that the camera cannot see directly.
+fn mirror_scene(reflectivity: f32) -> SceneBuilder {
+    let mut s = SceneBuilder::new();
+    let mirror_m = s.material(mirror(reflectivity));
+    s.quad(
+        "mirror",
+        Vec3::new(-3.0, -2.0, 0.0),
+        Vec3::new(0.0, 6.0, 0.0),
+        Vec3::new(6.0, 0.0, 0.0),
+        mirror_m,
+    );
+    let red = s.material(emissive(Vec3::new(1.0, 0.0, 0.0)));
+    s.quad(
+        "red wall",
+        Vec3::new(-10.0, -9.0, -10.0),
+        Vec3::new(20.0, 0.0, 0.0),
+        Vec3::new(0.0, 20.0, 0.0),
+        red,
+    );
+    s.camera(Camera {
+        name: "cam".into(),
+        position: Vec3::new(0.0, 1.0, -5.0),
+        forward: Vec3::Z,
+        up: Vec3::Y,
+        projection: Projection::Perspective { fov_y: 40.0 },
+        near: 0.3,
+    });
+    s
+}
+
+#[test]
+fn a_mirror_shows_the_colour_behind_the_camera() {
+    let (soup, kd) = mirror_scene(1.0).build();
+    let (out, plan) = render(&soup, &kd, &opts(32, 24));
+    assert!(plan.reflections.enabled);
+    assert_close(
+        out.frame.pixel(16, 12),
+        Vec3::new(1.0, 0.0, 0.0),
+        1e-5,
+        "mirror centre",
+    );
+    assert_eq!(
+        out.counts.reflection,
+        32 * 24,
+        "one reflection ray per mirror pixel"
+    );
+
+    // Half a mirror shows half the red.
+    let (soup, kd) = mirror_scene(0.5).build();
+    let (out, _) = render(&soup, &kd, &opts(32, 24));
+    assert_close(
+        out.frame.pixel(16, 12),
+        Vec3::new(0.5, 0.0, 0.0),
+        1e-5,
+        "50% mirror",
+    );
+
+    // Depth 0: no reflection rays, the mirror (albedo 0) is black.
+    let (soup, kd) = mirror_scene(1.0).build();
+    let mut o = opts(32, 24);
+    o.depth = 0;
+    let (out, plan) = render(&soup, &kd, &o);
+    assert!(!plan.reflections.enabled);
+    assert_eq!(out.counts.reflection, 0);
+    assert_eq!(out.frame.pixel(16, 12), Vec3::ZERO);
+}
+
+#[test]
+fn an_object_at_camera_right_lands_in_the_right_half() {
+    let mut s = SceneBuilder::new();
+    let cam = Camera::default();
+    let centre = cam.position + cam.forward * 5.0 + cam.right() * 1.5;
+    let m = s.material(emissive(Vec3::ONE));
+    s.quad(
+        "marker",
+        centre - Vec3::new(0.5, 0.5, 0.0),
+        Vec3::Y,
+        Vec3::X,
+        m,
+    );
+    s.camera(cam);
+    let (soup, kd) = s.build();
+    let (w, h) = (64, 32);
+    let (out, _) = render(&soup, &kd, &opts(w, h));
+    let mut lit = Vec::new();
+    for y in 0..h {
+        for x in 0..w {
+            if out.frame.pixel(x, y).x > 0.5 {
+                lit.push((x, y));
+            }
+        }
+    }
+    assert!(!lit.is_empty());
+    assert!(
+        lit.iter().all(|&(x, _)| x >= w / 2),
+        "marker pixels {lit:?}"
+    );
+    // Camera right is −X in the soup (forward +Z × up +Y): the marker is at x < 0.
+    assert!(centre.x < 0.0);
+}
+
+#[test]
+fn a_spot_cone_ends_at_half_its_angle() {
+    let spot_pos = Vec3::new(0.0, 4.0, 0.0);
+    let (w, h) = (80, 80);
+    for (angle, inner) in [(60.0f32, 60.0f32), (60.0, 40.0)] {
+        let mut s = floor_scene();
+        s.light(spot_light(spot_pos, -Vec3::Y, angle, inner, 30.0));
+        let (soup, kd) = s.build();
+        let (out, _) = render(&soup, &kd, &opts(w, h));
+        let (mut inside, mut outside, mut edge) = (0, 0, 0);
+        for py in 0..h {
+            for px in 0..w {
+                let p = ortho_point(&soup.camera, w, h, px, py, 0.0);
+                let to = spot_pos - p;
+                let d = to.length();
+                let theta = (to.y / d).acos().to_degrees();
+                let lit = ALBEDO * unity_falloff(d, 30.0) * (to.y / d);
+                let got = out.frame.pixel(px, py);
+                if theta > angle / 2.0 + 0.3 {
+                    assert_eq!(got, Vec3::ZERO, "θ = {theta}° is outside the {angle}° cone");
+                    outside += 1;
+                } else if theta < inner / 2.0 - 0.3 {
+                    assert_close(got, lit, 0.01, &format!("θ = {theta}° inside the core"));
+                    inside += 1;
+                } else if theta > inner / 2.0 + 0.3 && theta < angle / 2.0 - 0.3 {
+                    // Smooth edge: smoothstep on cos θ between the two half-angles.
+                    let (co, ci) = (
+                        (angle / 2.0).to_radians().cos(),
+                        (inner / 2.0).to_radians().cos(),
+                    );
+                    let t = ((theta.to_radians().cos() - co) / (ci - co)).clamp(0.0, 1.0);
+                    assert_close(
+                        got,
+                        lit * (t * t * (3.0 - 2.0 * t)),
+                        0.01,
+                        &format!("θ = {theta}° on the edge"),
+                    );
+                    edge += 1;
+                }
+            }
+        }
+        assert!(
+            inside > 50 && outside > 50,
+            "{inside} inside, {outside} outside"
+        );
+        if inner < angle {
+            assert!(edge > 50, "{edge} pixels on the smooth edge");
+        }
+    }
+}
+
+#[test]
+fn a_directional_light_shades_by_the_cosine() {
+    for deg in [0.0f32, 30.0, 60.0, 85.0] {
+        let mut s = floor_scene();
+        let r = deg.to_radians();
+        s.light(directional_light(
+            Vec3::new(r.sin(), -r.cos(), 0.0),
+            2.0,
+            Shadows::Hard,
+        ));
+        let (soup, kd) = s.build();
+        let (out, _) = render(&soup, &kd, &opts(16, 16));
+        let want = ALBEDO * 2.0 * r.cos();
+        for (x, y) in [(0, 0), (8, 8), (15, 3)] {
+            assert_close(
+                out.frame.pixel(x, y),
+                want,
+                1e-4,
+                &format!("{deg}° at ({x}, {y})"),
+            );
+        }
+    }
+}
+
+#[test]
+fn ambient_lights_a_face_no_light_reaches() {
+    for ambient_on in [false, true] {
+        let mut s = SceneBuilder::new();
+        let m = s.diffuse(Vec3::new(0.5, 0.5, 0.5));
+        s.cube(
+            "box",
+            Vec3::new(-1.0, 0.0, -1.0),
+            Vec3::new(1.0, 2.0, 1.0),
+            m,
+        );
+        // The sun shines straight down: the box's −Z side face gets no direct light.
+        s.light(directional_light(-Vec3::Y, 1.0, Shadows::Hard));
+        s.camera(Camera {
+            name: "front".into(),
+            position: Vec3::new(0.0, 1.0, -6.0),
+            forward: Vec3::Z,
+            up: Vec3::Y,
+            projection: Projection::Perspective { fov_y: 30.0 },
+            near: 0.3,
+        });
+        if ambient_on {
+            s.soup.environment.ambient = formats::Ambient {
+                mode: AmbientMode::Trilight,
+                sky: Vec3::new(0.4, 0.4, 0.6),
+                equator: Vec3::new(0.2, 0.1, 0.05),
+                ground: Vec3::new(0.05, 0.05, 0.05),
+            };
+        }
+        let (soup, kd) = s.build();
+        let (out, plan) = render(&soup, &kd, &opts(20, 20));
+        assert_eq!(plan.ambient.enabled, ambient_on);
+        let got = out.frame.pixel(10, 10);
+        if ambient_on {
+            // A vertical face (n.y = 0) gets the equator colour.
+            assert_close(
+                got,
+                Vec3::new(0.1, 0.05, 0.025),
+                1e-5,
+                "ambient on the side face",
+            );
+        } else {
+            assert_eq!(got, Vec3::ZERO, "nothing lights the side face");
+        }
+    }
+}
+
+#[test]
+fn flat_ambient_and_a_face_turned_down_get_their_colours() {
+    let mut s = SceneBuilder::new();
+    let m = s.diffuse(Vec3::ONE);
+    // Seen from below: the floor's underside faces −Y (the ground colour in trilight).
+    s.floor(0.0, 0.0, 0.0, 20.0, m);
+    s.camera(Camera {
+        name: "below".into(),
+        position: Vec3::new(0.0, -5.0, 0.0),
+        forward: Vec3::Y,
+        up: Vec3::Z,
+        projection: Projection::Orthographic { half_height: 2.0 },
+        near: 0.0,
+    });
+    let ground = Vec3::new(0.03, 0.02, 0.01);
+    s.soup.environment.ambient = formats::Ambient {
+        mode: AmbientMode::Trilight,
+        sky: Vec3::ONE,
+        equator: Vec3::splat(0.5),
+        ground,
+    };
+    let (soup, kd) = s.build();
+    let (out, _) = render(&soup, &kd, &opts(8, 8));
+    assert_close(
+        out.frame.pixel(4, 4),
+        ground,
+        1e-5,
+        "underside gets the ground colour",
+    );
+
+    let mut soup = soup;
+    soup.environment.ambient.mode = AmbientMode::Flat;
+    let (out, _) = render(&soup, &kd, &opts(8, 8));
+    assert_close(
+        out.frame.pixel(4, 4),
+        Vec3::ONE,
+        1e-5,
+        "flat ambient is the sky colour",
+    );
+}
+
+#[test]
+fn emission_is_added_where_the_material_emits() {
+    let e = Vec3::new(2.0, 1.0, 0.5);
+    let mut s = floor_scene();
+    let glow = s.material(emissive(e));
+    s.quad(
+        "panel",
+        Vec3::new(-1.0, 1.0, -1.0),
+        Vec3::new(0.0, 0.0, 2.0),
+        Vec3::new(2.0, 0.0, 0.0),
+        glow,
+    );
+    let (soup, kd) = s.build();
+    let (out, plan) = render(&soup, &kd, &opts(40, 40));
+    assert!(plan.emission.enabled);
+    assert_eq!(out.frame.pixel(20, 20), e);
+    assert_eq!(
+        out.frame.pixel(2, 2),
+        Vec3::ZERO,
+        "the unlit floor stays black"
+    );
+
+    let mut soup = soup;
+    soup.materials[glow as usize].emission = Vec3::ZERO;
+    let (out, plan) = render(&soup, &kd, &opts(40, 40));
+    assert!(!plan.emission.enabled);
+    assert_eq!(out.frame.pixel(20, 20), Vec3::ZERO);
+}
+
+#[test]
+fn the_background_is_the_clear_colour_or_a_sky() {
+    let mut s = SceneBuilder::new();
+    s.soup.environment.background = Vec3::new(0.1, 0.2, 0.3);
+    let m = s.diffuse(Vec3::ONE);
+    s.floor(-100.0, 0.0, 0.0, 1.0, m);
+    let (soup, kd) = s.build();
+    let (out, _) = render(&soup, &kd, &opts(8, 8));
+    assert_eq!(out.frame.pixel(3, 3), Vec3::new(0.1, 0.2, 0.3));
+
+    let mut soup = soup;
+    soup.environment.clear = formats::ClearFlags::Skybox;
+    let (out, _) = render(&soup, &kd, &opts(8, 64));
+    // The default camera looks at the horizon: brighter than the zenith-ward top row,
+    // and the top row is bluer than it is red.
+    let top = out.frame.pixel(4, 0);
+    assert!(top.z > top.x, "{top}");
+    assert_ne!(top, out.frame.pixel(4, 63));
+}
+
+#[test]
+fn an_orthographic_camera_spans_its_half_height() {
+    // An emitter filling exactly the upper half of the orthographic view.
+    let mut s = SceneBuilder::new();
+    let m = s.material(emissive(Vec3::ONE));
+    s.quad(
+        "upper",
+        Vec3::new(-10.0, 1.0, 0.0),
+        Vec3::new(20.0, 0.0, 0.0),
+        Vec3::new(0.0, 10.0, 0.0),
+        m,
+    );
+    s.camera(Camera {
+        name: "ortho".into(),
+        position: Vec3::new(0.0, 1.0, -5.0),
+        forward: Vec3::Z,
+        up: Vec3::Y,
+        projection: Projection::Orthographic { half_height: 2.0 },
+        near: 0.1,
+    });
+    let (soup, kd) = s.build();
+    let (out, _) = render(&soup, &kd, &opts(8, 8));
+    for y in 0..8 {
+        let want = if y < 4 { Vec3::ONE } else { Vec3::ZERO };
+        assert_eq!(out.frame.pixel(4, y), want, "row {y}");
+    }
+}
