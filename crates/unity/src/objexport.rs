@@ -25,7 +25,7 @@ pub fn to_obj(soup: &Soup) -> String {
                 .unwrap_or("?");
             let name: String = name
                 .chars()
-                .map(|c| if c.is_whitespace() { '_' } else { c })
+                .map(|c| if c == '\n' || c == '\r' { ' ' } else { c }) // the rest of an `o` line is the name
                 .collect();
             let _ = writeln!(s, "o {name}");
         }

@@ -21,6 +21,9 @@ struct Args {
     /// Treat every warning as an error.
     #[arg(long)]
     strict: bool,
+    /// List every converted object (triangles, source, materials) and light on stderr.
+    #[arg(long)]
+    list: bool,
 }
 
 fn main() {
@@ -43,6 +46,9 @@ fn run(args: &Args) -> anyhow::Result<()> {
     let secs = t0.elapsed().as_secs_f64();
     for w in &soup.warnings {
         eprintln!("warning: {w}");
+    }
+    if args.list {
+        list(&soup);
     }
     eprintln!(
         "{}: {} objects, {} triangles, {} lights, {} materials, {} warnings, {} degenerate dropped, {:.3} s",
@@ -68,4 +74,46 @@ fn run(args: &Args) -> anyhow::Result<()> {
         println!("{j}");
     }
     Ok(())
+}
+
+/// One line per object and light, for checking a conversion by eye.
+fn list(soup: &formats::Soup) {
+    let mut tris = vec![0usize; soup.objects.len()];
+    let mut mats: Vec<Vec<u32>> = vec![Vec::new(); soup.objects.len()];
+    for (&o, &m) in soup.tri_object.iter().zip(&soup.tri_material) {
+        tris[o as usize] += 1;
+        if !mats[o as usize].contains(&m) {
+            mats[o as usize].push(m);
+        }
+    }
+    for (i, o) in soup.objects.iter().enumerate() {
+        let names: Vec<String> = mats[i]
+            .iter()
+            .map(|&m| {
+                let m = &soup.materials[m as usize];
+                format!(
+                    "{} rgb({:.3},{:.3},{:.3})",
+                    m.name, m.color.x, m.color.y, m.color.z
+                )
+            })
+            .collect();
+        eprintln!(
+            "object {:?}: {} triangles from {} [{}]",
+            o.name,
+            tris[i],
+            o.source,
+            names.join("; ")
+        );
+    }
+    for l in &soup.lights {
+        eprintln!(
+            "light {:?}: {:?} at {} along {}, colour {}, intensity {}, range {}, shadows {:?}",
+            l.name, l.kind, l.position, l.direction, l.color, l.intensity, l.range, l.shadows
+        );
+    }
+    let c = &soup.camera;
+    eprintln!(
+        "camera {:?}: at {} forward {} up {} {:?}",
+        c.name, c.position, c.forward, c.up, c.projection
+    );
 }

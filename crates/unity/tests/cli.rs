@@ -1,0 +1,115 @@
+//! The `unity2soup` and `soup2obj` binaries: arguments, JSON summary, exit codes, and
+//! the OBJ export's layout.
+
+mod support;
+
+use std::process::Command;
+use support::*;
+
+fn scene() -> (tempfile::TempDir, std::path::PathBuf) {
+    let mut sc = Scene::default();
+    sc.camera(&Tf::at(0.0, 1.0, -10.0));
+    sc.light(&Tf::at(0.0, 3.0, 0.0), 2, [1.0, 1.0, 1.0], 1);
+    sc.primitive("Floor", &Tf::at(0.0, 0.0, 0.0), 0, PLANE);
+    sc.primitive("Box A", &Tf::at(2.0, 0.5, 0.0), 0, CUBE);
+    let (d, root) = project(&[("Assets/Scenes/s.unity", &sc.text)]);
+    (d, root.join("Assets/Scenes/s.unity"))
+}
+
+#[test]
+fn unity2soup_json_summary_and_soup_file() {
+    let (d, scene) = scene();
+    let out = d.path().join("s.soup");
+    let o = Command::new(env!("CARGO_BIN_EXE_unity2soup"))
+        .arg(&scene)
+        .arg("-o")
+        .arg(&out)
+        .arg("--json")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let j: serde_json::Value =
+        serde_json::from_slice(&o.stdout).expect("one JSON object on stdout");
+    assert_eq!(j["objects"], 2);
+    assert_eq!(j["triangles"], 212);
+    assert_eq!(j["lights"], 1);
+    assert_eq!(j["materials"], 1);
+    assert_eq!(j["warnings"].as_array().unwrap().len(), 0);
+    assert!(j["seconds"].as_f64().unwrap() >= 0.0);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        stderr.contains("2 objects, 212 triangles, 1 lights"),
+        "{stderr}"
+    );
+    let soup = formats::Soup::read(&out).unwrap();
+    assert_eq!(soup.triangles.len(), 212);
+
+    // soup2obj: one `o` per object, faces in soup order, a normal per corner.
+    let obj = d.path().join("s.obj");
+    let o = Command::new(env!("CARGO_BIN_EXE_soup2obj"))
+        .arg(&out)
+        .arg("-o")
+        .arg(&obj)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(&obj).unwrap();
+    let objects: Vec<&str> = text.lines().filter(|l| l.starts_with("o ")).collect();
+    assert_eq!(objects, ["o Floor", "o Box A"]);
+    assert_eq!(text.lines().filter(|l| l.starts_with("f ")).count(), 212);
+    assert_eq!(
+        text.lines().filter(|l| l.starts_with("vn ")).count(),
+        212 * 3
+    );
+    // The first face is the soup's first triangle.
+    let v: Vec<&str> = text
+        .lines()
+        .filter(|l| l.starts_with("v "))
+        .take(3)
+        .collect();
+    let t = soup.triangles[0];
+    assert_eq!(v[0], format!("v {} {} {}", t[0].x, t[0].y, t[0].z));
+    assert_eq!(v[2], format!("v {} {} {}", t[2].x, t[2].y, t[2].z));
+}
+
+#[test]
+fn errors_exit_1_with_one_line_and_bad_usage_exits_2() {
+    let d = tempfile::tempdir().unwrap();
+    let missing = d.path().join("nope.unity");
+    let o = Command::new(env!("CARGO_BIN_EXE_unity2soup"))
+        .arg(&missing)
+        .arg("-o")
+        .arg(d.path().join("x.soup"))
+        .arg("--assets")
+        .arg(d.path())
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("nope.unity") && e.lines().count() == 1, "{e}");
+
+    let (_p, root) = project(&[("Assets/b.unity", "\0\0\u{2e}K\0\0\u{36}\u{c}")]);
+    let o = Command::new(env!("CARGO_BIN_EXE_unity2soup"))
+        .arg(root.join("Assets/b.unity"))
+        .arg("-o")
+        .arg(d.path().join("x.soup"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("binary"));
+    assert!(!d.path().join("x.soup").exists(), "no output on failure");
+
+    let o = Command::new(env!("CARGO_BIN_EXE_unity2soup"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+
+    let o = Command::new(env!("CARGO_BIN_EXE_soup2obj"))
+        .arg(d.path().join("none.soup"))
+        .arg("-o")
+        .arg(d.path().join("x.obj"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("none.soup"));
+}
