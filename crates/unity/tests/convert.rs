@@ -532,3 +532,48 @@ fn strict_turns_warnings_into_an_error() {
     let err = unity::convert(&root.join("Assets/s.unity"), &opts).unwrap_err();
     assert!(err.to_string().contains("no enabled camera"), "{err}");
 }
+
+#[test]
+fn nested_prefabs_apply_overrides_outermost_last() {
+    // Base.prefab: root "Base" (Transform 400) with a child "Box" (GameObject 101,
+    // Transform 401, built-in Cube at (1, 0, 0)).
+    let base_guid = "b0000000000000000000000000000001";
+    let outer_guid = "b0000000000000000000000000000002";
+    let mut base = Scene::default();
+    base.raw("--- !u!1 &100\nGameObject:\n  m_Name: Base\n  m_IsActive: 1\n--- !u!4 &400\nTransform:\n  m_GameObject: {fileID: 100}\n  m_LocalRotation: {x: 0, y: 0, z: 0, w: 1}\n  m_LocalPosition: {x: 0, y: 0, z: 0}\n  m_LocalScale: {x: 1, y: 1, z: 1}\n  m_Father: {fileID: 0}\n--- !u!1 &101\nGameObject:\n  m_Name: Box\n  m_IsActive: 1\n--- !u!4 &401\nTransform:\n  m_GameObject: {fileID: 101}\n  m_LocalRotation: {x: 0, y: 0, z: 0, w: 1}\n  m_LocalPosition: {x: 1, y: 0, z: 0}\n  m_LocalScale: {x: 1, y: 1, z: 1}\n  m_Father: {fileID: 400}\n");
+    base.mesh(
+        101,
+        CUBE,
+        BUILTIN,
+        &[(10303, "0000000000000000f000000000000000")],
+        true,
+    );
+    // Outer.prefab: root "Outer" (Transform 410) holding an instance 900 of Base that
+    // moves Box to x = 2 (the stripped 920 stands for Base's root, parented under 410).
+    let mut outer = Scene::default();
+    outer.raw(&format!("--- !u!1 &110\nGameObject:\n  m_Name: Outer\n  m_IsActive: 1\n--- !u!4 &410\nTransform:\n  m_GameObject: {{fileID: 110}}\n  m_LocalRotation: {{x: 0, y: 0, z: 0, w: 1}}\n  m_LocalPosition: {{x: 0, y: 0, z: 0}}\n  m_LocalScale: {{x: 1, y: 1, z: 1}}\n  m_Father: {{fileID: 0}}\n--- !u!1001 &900\nPrefabInstance:\n  m_Modification:\n    m_TransformParent: {{fileID: 410}}\n    m_Modifications:\n    - target: {{fileID: 401, guid: {base_guid}, type: 3}}\n      propertyPath: m_LocalPosition.x\n      value: 2\n      objectReference: {{fileID: 0}}\n    - target: {{fileID: 401, guid: {base_guid}, type: 3}}\n      propertyPath: m_LocalPosition.y\n      value: 1\n      objectReference: {{fileID: 0}}\n  m_SourcePrefab: {{fileID: 100100000, guid: {base_guid}, type: 3}}\n"));
+    // Scene: instance 500 of Outer at x = 10; it also overrides the nested Box's y through
+    // Unity's combined id (900 ^ 401) & i64::MAX — the outermost override wins.
+    let nested_box = (900i64 ^ 401) & i64::MAX;
+    let mut sc = Scene::default();
+    sc.raw(&format!("--- !u!1001 &500\nPrefabInstance:\n  m_Modification:\n    m_TransformParent: {{fileID: 0}}\n    m_Modifications:\n    - target: {{fileID: 410, guid: {outer_guid}, type: 3}}\n      propertyPath: m_LocalPosition.x\n      value: 10\n      objectReference: {{fileID: 0}}\n    - target: {{fileID: {nested_box}, guid: {outer_guid}, type: 3}}\n      propertyPath: m_LocalPosition.y\n      value: 5\n      objectReference: {{fileID: 0}}\n  m_SourcePrefab: {{fileID: 100100000, guid: {outer_guid}, type: 3}}\n"));
+    let (_d, root) = project(&[
+        ("Assets/Base.prefab", &base.text),
+        (
+            "Assets/Base.prefab.meta",
+            &format!("fileFormatVersion: 2\nguid: {base_guid}\n"),
+        ),
+        ("Assets/Outer.prefab", &outer.text),
+        (
+            "Assets/Outer.prefab.meta",
+            &format!("fileFormatVersion: 2\nguid: {outer_guid}\n"),
+        ),
+        ("Assets/s.unity", &sc.text),
+    ]);
+    let soup = convert(&root.join("Assets/s.unity"));
+    assert_eq!(soup.objects.len(), 1);
+    assert_eq!(soup.objects[0].name, "Outer/Base/Box");
+    // Box: (2, 5, 0) under Outer at (10, 0, 0) → Unity (12, 5, 0) → soup (−12, 5, 0).
+    let c = soup.triangles.iter().flatten().copied().sum::<Vec3>() / 36.0;
+    assert!(close(c, Vec3::new(-12.0, 5.0, 0.0), 1e-5), "{c}");
+}
