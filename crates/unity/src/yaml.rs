@@ -180,13 +180,26 @@ fn logical_lines(text: &str) -> Vec<Line> {
                 continue;
             }
         }
-        depth = bracket_balance(trimmed).max(0);
+        depth = flow_value(trimmed).map_or(0, |v| bracket_balance(v).max(0));
         out.push(Line {
             indent,
             text: trimmed.to_string(),
         });
     }
     out
+}
+
+/// The value of a line when it is a flow collection (`key: {…`, `- {…`, `- key: [..`):
+/// only those can wrap onto the next line. Braces inside plain scalars (names) do not.
+fn flow_value(t: &str) -> Option<&str> {
+    let mut v = t;
+    while let Some(rest) = v.strip_prefix("- ") {
+        v = rest.trim_start();
+    }
+    if let Some((_, value)) = split_key(v) {
+        v = value;
+    }
+    (v.starts_with('{') || v.starts_with('[')).then_some(v)
 }
 
 fn looks_structural(t: &str) -> bool {
@@ -468,6 +481,20 @@ mod tests {
             mods[0].path(&["target", "guid"]).unwrap().as_str(),
             Some("abc")
         );
+    }
+
+    #[test]
+    fn braces_in_names_do_not_swallow_lines() {
+        let n = parse("GameObject:\n  m_Name: Door {left\n  m_IsActive: 0\n  m_Component:\n  - component: {fileID: 1,\n      guid: x}\n  m_Layer: 3\n");
+        let g = n.get("GameObject").unwrap();
+        assert_eq!(g.str_at("m_Name"), Some("Door {left"));
+        assert_eq!(g.i64_at("m_IsActive"), Some(0));
+        let c = &g.get("m_Component").unwrap().as_seq()[0];
+        assert_eq!(
+            c.path(&["component", "guid"]).and_then(Node::as_str),
+            Some("x")
+        );
+        assert_eq!(g.i64_at("m_Layer"), Some(3));
     }
 
     #[test]
