@@ -1,0 +1,97 @@
+//! Timing: wall-clock medians over repeated runs, inside rayon pools of a fixed size.
+
+use crate::error::BenchError;
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// A rayon pool of exactly `threads` workers. Builds and traversals run inside
+/// `pool.install`, so the k-d tree's own rayon calls use it too.
+pub fn pool(threads: usize) -> Result<rayon::ThreadPool, BenchError> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .thread_name(move |i| format!("bench-{threads}t-{i}"))
+        .build()
+        .map_err(|e| BenchError::Pool {
+            threads,
+            detail: e.to_string(),
+        })
+}
+
+/// Median of a non-empty list (the mean of the middle two for an even count).
+pub fn median(mut xs: Vec<f64>) -> f64 {
+    xs.sort_by(f64::total_cmp);
+    let n = xs.len();
+    match n {
+        0 => f64::NAN,
+        _ if n % 2 == 1 => xs[n / 2],
+        _ => 0.5 * (xs[n / 2 - 1] + xs[n / 2]),
+    }
+}
+
+/// Run `f` `runs` times (at least once); return the median wall time in seconds and the
+/// last run's result.
+pub fn timed<T>(runs: usize, mut f: impl FnMut() -> T) -> (f64, T) {
+    let mut times = Vec::with_capacity(runs);
+    let mut last = None;
+    for _ in 0..runs.max(1) {
+        let start = Instant::now();
+        let out = f();
+        times.push(start.elapsed().as_secs_f64());
+        // Drop the previous result outside the timed region.
+        drop(last.replace(out));
+    }
+    (median(times), last.expect("ran at least once"))
+}
+
+/// Rays per parallel task: small enough for work stealing to balance the two cores,
+/// large enough that task overhead is noise.
+const CHUNK: usize = 256;
+
+/// Answer every ray with `f` on `pool`'s threads, results in ray order.
+pub fn trace<R, T>(pool: &rayon::ThreadPool, rays: &[R], f: impl Fn(&R) -> T + Sync) -> Vec<T>
+where
+    R: Sync,
+    T: Send + Copy + Default,
+{
+    let mut out = vec![T::default(); rays.len()];
+    pool.install(|| {
+        out.par_chunks_mut(CHUNK)
+            .zip(rays.par_chunks(CHUNK))
+            .for_each(|(o, r)| {
+                for (slot, ray) in o.iter_mut().zip(r) {
+                    *slot = f(ray);
+                }
+            })
+    });
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn median_of_odd_and_even_lists() {
+        assert_eq!(median(vec![3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(vec![4.0, 1.0, 3.0, 2.0]), 2.5);
+    }
+
+    #[test]
+    fn trace_keeps_ray_order_on_two_threads() {
+        let p = pool(2).unwrap();
+        let input: Vec<u32> = (0..10_000).collect();
+        let out = trace(&p, &input, |x| x * 2);
+        assert!(out.iter().enumerate().all(|(i, &v)| v == 2 * i as u32));
+    }
+
+    #[test]
+    fn timed_returns_the_last_result() {
+        let mut n = 0;
+        let (secs, last) = timed(3, || {
+            n += 1;
+            n
+        });
+        assert_eq!(last, 3);
+        assert!(secs >= 0.0);
+    }
+}

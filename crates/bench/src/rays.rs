@@ -1,0 +1,190 @@
+//! The ray sets every contender traces: primary rays from a camera, shadow rays from the
+//! primary hits towards a light above the scene, and random rays inside the bounds.
+//! All are generated once per scene, so every contender sees exactly the same rays.
+
+use glam::Vec3;
+use kdtree::Ray;
+
+/// A ray from its parts (the kdtree crate's struct literal, spelled once).
+pub fn ray(origin: Vec3, dir: Vec3, tmin: f32, tmax: f32) -> Ray {
+    Ray {
+        origin,
+        dir,
+        tmin,
+        tmax,
+    }
+}
+
+/// A pinhole camera (square image).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct View {
+    pub eye: Vec3,
+    /// Unit view direction.
+    pub forward: Vec3,
+    /// Unit up vector, orthogonal to `forward`.
+    pub up: Vec3,
+    /// Vertical field of view in degrees.
+    pub fov_y: f32,
+}
+
+/// A 45° camera looking down at the bounds' centre from above and to the side, at 0.75
+/// of the distance where the bounding sphere would just fit: most primary rays hit
+/// something, as in a rendered view, while the scene still fills the frame.
+pub fn framing(bounds: [Vec3; 2]) -> View {
+    let centre = (bounds[0] + bounds[1]) * 0.5;
+    let radius = ((bounds[1] - bounds[0]).length() * 0.5).max(1e-3);
+    let fov_y = 45.0f32;
+    let dist = 0.75 * radius / (fov_y.to_radians() * 0.5).sin();
+    let from = Vec3::new(0.5, 0.8, -1.0).normalize();
+    let forward = -from;
+    let up = forward.cross(Vec3::Y).cross(forward).normalize();
+    View {
+        eye: centre + from * dist,
+        forward,
+        up,
+        fov_y,
+    }
+}
+
+/// One ray through the centre of each pixel of a `size` × `size` image, row by row from
+/// the top left. Directions are unit length; the interval is [0, ∞).
+pub fn primary(view: &View, size: u32) -> Vec<Ray> {
+    let right = view.forward.cross(view.up).normalize();
+    let up = right.cross(view.forward);
+    let half = (view.fov_y.to_radians() * 0.5).tan();
+    let mut out = Vec::with_capacity((size * size) as usize);
+    for y in 0..size {
+        for x in 0..size {
+            let sx = ((x as f32 + 0.5) / size as f32 * 2.0 - 1.0) * half;
+            let sy = (1.0 - (y as f32 + 0.5) / size as f32 * 2.0) * half;
+            let dir = (view.forward + right * sx + up * sy).normalize();
+            out.push(ray(view.eye, dir, 0.0, f32::INFINITY));
+        }
+    }
+    out
+}
+
+/// The light for shadow rays: above the centre of the bounds, one diagonal higher than
+/// the top, offset sideways so that shadows fall at an angle.
+pub fn light_above(bounds: [Vec3; 2]) -> Vec3 {
+    let centre = (bounds[0] + bounds[1]) * 0.5;
+    let diag = (bounds[1] - bounds[0]).length().max(1e-3);
+    Vec3::new(
+        centre.x + 0.3 * diag,
+        bounds[1].y + diag,
+        centre.z + 0.2 * diag,
+    )
+}
+
+/// One shadow ray per primary ray that hit: from the hit point (moved off the surface,
+/// to the light's side of the triangle's plane, by 1e-4 of the scene diagonal) to the
+/// light. Unit direction, interval [0, distance to the light].
+///
+/// `hits[i]` is the closest hit of `primary[i]` as (triangle, u, v); `None` is a miss.
+pub fn shadow(
+    triangles: &[[Vec3; 3]],
+    hits: &[Option<(u32, f32, f32)>],
+    light: Vec3,
+    bounds: [Vec3; 2],
+) -> Vec<Ray> {
+    let offset = 1e-4 * (bounds[1] - bounds[0]).length().max(1e-3);
+    hits.iter()
+        .flatten()
+        .filter_map(|&(prim, u, v)| {
+            let t = triangles.get(prim as usize)?;
+            let p = (1.0 - u - v) * t[0] + u * t[1] + v * t[2];
+            let mut n = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
+            if n.dot(light - p) < 0.0 {
+                n = -n;
+            }
+            let o = p + n * offset;
+            let to = light - o;
+            let dist = to.length();
+            (dist > 0.0 && dist.is_finite()).then(|| ray(o, to / dist, 0.0, dist))
+        })
+        .collect()
+}
+
+/// `n` rays with origins uniform in the bounds and directions uniform on the sphere,
+/// interval [0, ∞). Deterministic for a given seed.
+pub fn random(bounds: [Vec3; 2], n: usize, seed: u64) -> Vec<Ray> {
+    let mut rng = Rng(seed);
+    let ext = bounds[1] - bounds[0];
+    (0..n)
+        .map(|_| {
+            let o = bounds[0] + ext * Vec3::new(rng.unit(), rng.unit(), rng.unit());
+            let z = 2.0 * rng.unit() - 1.0;
+            let phi = std::f32::consts::TAU * rng.unit();
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            let dir = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+            ray(o, dir, 0.0, f32::INFINITY)
+        })
+        .collect()
+}
+
+/// SplitMix64: small, fast and good enough for benchmark ray sets.
+pub struct Rng(pub u64);
+
+impl Rng {
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in [0, 1).
+    pub fn unit(&mut self) -> f32 {
+        (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn primary_rays_centre_pixel_looks_forward() {
+        let v = framing([Vec3::splat(-1.0), Vec3::splat(1.0)]);
+        let rays = primary(&v, 3);
+        assert_eq!(rays.len(), 9);
+        // The centre pixel of a 3×3 image looks straight along `forward`, at the centre.
+        let c = rays[4];
+        assert!((c.dir - v.forward).length() < 1e-6);
+        let to_centre = (-c.origin).normalize();
+        assert!((to_centre - v.forward).length() < 1e-5);
+        // Top-left pixel points up and left of the view.
+        let right = v.forward.cross(v.up);
+        assert!(rays[0].dir.dot(v.up) > 0.0 && rays[0].dir.dot(right) < 0.0);
+    }
+
+    #[test]
+    fn shadow_ray_starts_on_the_lights_side() {
+        let tri = [[Vec3::ZERO, Vec3::X, Vec3::Z]]; // normal −Y, light above at +Y
+        let b = [Vec3::ZERO, Vec3::new(1.0, 0.0, 1.0)];
+        let rays = shadow(
+            &tri,
+            &[Some((0, 0.25, 0.25)), None],
+            Vec3::new(0.0, 10.0, 0.0),
+            b,
+        );
+        assert_eq!(rays.len(), 1);
+        assert!(rays[0].origin.y > 0.0);
+        assert!((rays[0].dir.length() - 1.0).abs() < 1e-6);
+        let end = rays[0].origin + rays[0].dir * rays[0].tmax;
+        assert!((end - Vec3::new(0.0, 10.0, 0.0)).length() < 1e-4);
+    }
+
+    #[test]
+    fn random_rays_are_inside_and_unit() {
+        let b = [Vec3::new(-1.0, 0.0, 2.0), Vec3::new(3.0, 1.0, 4.0)];
+        let rays = random(b, 1000, 7);
+        assert_eq!(rays.len(), 1000);
+        for r in &rays {
+            assert!(r.origin.cmpge(b[0]).all() && r.origin.cmple(b[1]).all());
+            assert!((r.dir.length() - 1.0).abs() < 1e-5);
+        }
+        assert_eq!(rays, random(b, 1000, 7));
+    }
+}

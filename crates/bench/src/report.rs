@@ -1,0 +1,256 @@
+//! The report as markdown: header, the issue's targets, build, traversal (with the
+//! kdtree/Embree ratio) and agreement tables, then notes.
+
+use crate::run::{Kind, Report, Role, SceneResult, TraceRow, BRUTE, EMBREE, KDTREE};
+use std::fmt::Write;
+
+fn trace<'a>(s: &'a SceneResult, who: &str, threads: usize, kind: Kind) -> Option<&'a TraceRow> {
+    s.traces
+        .iter()
+        .find(|r| r.contender == who && r.threads == threads && r.kind == kind)
+}
+
+/// kdtree Mrays/s over Embree Mrays/s on the same rays and thread count.
+pub fn ratio(s: &SceneResult, threads: usize, kind: Kind) -> Option<f64> {
+    let k = trace(s, KDTREE, threads, kind)?;
+    let e = trace(s, EMBREE, threads, kind)?;
+    Some(k.mrays_per_s() / e.mrays_per_s())
+}
+
+fn build_secs(s: &SceneResult, who: &str, threads: usize) -> Option<f64> {
+    s.builds
+        .iter()
+        .find(|b| b.contender == who && b.threads == threads)
+        .map(|b| b.seconds)
+}
+
+fn opt<T>(v: Option<T>, f: impl Fn(T) -> String) -> String {
+    v.map_or_else(|| "–".to_string(), f)
+}
+
+fn yes(ok: bool) -> &'static str {
+    if ok {
+        "yes"
+    } else {
+        "**no**"
+    }
+}
+
+/// The issue's targets, for the scenes this run measured.
+fn targets(r: &Report, out: &mut String) {
+    let mut rows = vec![];
+    for s in &r.scenes {
+        let key = s.role == Role::Baseline || s.name.contains("bunny");
+        if key {
+            for kind in [Kind::Primary, Kind::Shadow] {
+                if let Some(x) = ratio(s, 1, kind) {
+                    rows.push((
+                        format!(
+                            "{}: {} rays, 1 thread, kdtree ≥ 0.7× Embree",
+                            s.name,
+                            kind.name()
+                        ),
+                        format!("{x:.2}×"),
+                        x >= 0.7,
+                    ));
+                }
+            }
+        }
+        if s.role == Role::Baseline {
+            let best = r
+                .config
+                .threads
+                .iter()
+                .filter_map(|&t| build_secs(s, KDTREE, t))
+                .reduce(f64::min);
+            if let Some(secs) = best {
+                rows.push((
+                    format!("{}: tree builds in < 50 ms", s.name),
+                    format!("{:.1} ms", secs * 1e3),
+                    secs < 0.050,
+                ));
+            }
+        }
+        if s.role == Role::Generated && s.triangles >= 5_000_000 {
+            if let Some(secs) = build_secs(s, KDTREE, 2) {
+                let rate = s.triangles as f64 / secs / 1e6;
+                rows.push((
+                    format!("{}: build ≥ 1 M triangles/s on 2 cores", s.name),
+                    format!("{rate:.2} M/s"),
+                    rate >= 1.0,
+                ));
+            }
+            if let (Some(a), Some(b)) = (build_secs(s, KDTREE, 1), build_secs(s, KDTREE, 2)) {
+                rows.push((
+                    format!("{}: parallel build speed-up ≥ 1.7× on 2 cores", s.name),
+                    format!("{:.2}×", a / b),
+                    a / b >= 1.7,
+                ));
+            }
+        }
+    }
+    let worst = r
+        .scenes
+        .iter()
+        .flat_map(|s| &s.builds)
+        .filter(|b| b.contender == KDTREE)
+        .filter_map(|b| b.bytes_per_triangle.map(|x| (x, b.scene.clone())))
+        .max_by(|a, b| a.0.total_cmp(&b.0));
+    if let Some((bytes, scene)) = worst {
+        rows.push((
+            "tree memory ≤ 64 bytes per triangle (worst scene)".into(),
+            format!("{bytes:.1} ({scene})"),
+            bytes <= 64.0,
+        ));
+    }
+    if rows.is_empty() {
+        return;
+    }
+    out.push_str("## Targets (issue 4)\n\n| target | measured | met |\n|---|---:|:---:|\n");
+    for (what, measured, ok) in rows {
+        let _ = writeln!(out, "| {what} | {measured} | {} |", yes(ok));
+    }
+    out.push('\n');
+}
+
+fn builds(r: &Report, out: &mut String) {
+    out.push_str(
+        "## Build\n\n\
+         | scene | triangles | contender | threads | build ms | M tri/s | SAH cost | nodes | refs/tri | bytes/tri |\n\
+         |---|---:|---|---:|---:|---:|---:|---:|---:|---:|\n",
+    );
+    for b in r.scenes.iter().flat_map(|s| &s.builds) {
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {} | {:.1} | {:.2} | {} | {} | {} | {} |",
+            b.scene,
+            b.triangles,
+            b.contender,
+            b.threads,
+            b.seconds * 1e3,
+            b.triangles as f64 / b.seconds / 1e6,
+            opt(b.sah_cost, |x| format!("{x:.1}")),
+            opt(b.nodes, |x| x.to_string()),
+            opt(b.refs_per_triangle, |x| format!("{x:.2}")),
+            opt(b.bytes_per_triangle, |x| format!("{x:.1}")),
+        );
+    }
+    out.push('\n');
+}
+
+fn traversal(r: &Report, out: &mut String) {
+    out.push_str(
+        "## Traversal (Mrays/s)\n\n\
+         Brute force runs on a subset of each ray set (see the header). The ratio rows are \
+         kdtree ÷ Embree on the same rays with the same thread count.\n\n\
+         | scene | contender | threads | primary | shadow | random |\n\
+         |---|---|---:|---:|---:|---:|\n",
+    );
+    for s in &r.scenes {
+        let contenders = [KDTREE, EMBREE, BRUTE];
+        for who in contenders {
+            for &t in &r.config.threads {
+                let cells: Vec<Option<&TraceRow>> =
+                    Kind::ALL.iter().map(|&k| trace(s, who, t, k)).collect();
+                if cells.iter().all(Option::is_none) {
+                    continue;
+                }
+                let _ = write!(out, "| {} | {who} | {t} |", s.name);
+                for c in cells {
+                    let _ = write!(out, " {} |", opt(c, |r| format!("{:.3}", r.mrays_per_s())));
+                }
+                out.push('\n');
+            }
+        }
+        for &t in &r.config.threads {
+            let cells: Vec<Option<f64>> = Kind::ALL.iter().map(|&k| ratio(s, t, k)).collect();
+            if cells.iter().all(Option::is_none) {
+                continue;
+            }
+            let _ = write!(out, "| {} | **kdtree/Embree** | {t} |", s.name);
+            for c in cells {
+                let _ = write!(out, " {} |", opt(c, |x| format!("**{x:.2}×**")));
+            }
+            out.push('\n');
+        }
+    }
+    let counts: Vec<String> = r
+        .scenes
+        .iter()
+        .map(|s| {
+            let n = |k| trace(s, KDTREE, r.config.threads[0], k).map_or(0, |t| t.rays);
+            format!(
+                "{}: {}/{}/{}",
+                s.name,
+                n(Kind::Primary),
+                n(Kind::Shadow),
+                n(Kind::Random)
+            )
+        })
+        .collect();
+    if !r.config.threads.is_empty() && !counts.is_empty() {
+        let _ = writeln!(
+            out,
+            "\nRays per set (primary/shadow/random): {}.",
+            counts.join("; ")
+        );
+    }
+    out.push('\n');
+}
+
+fn agreement(r: &Report, out: &mut String) {
+    out.push_str(
+        "## Agreement with the k-d tree\n\n\
+         Closest hit: same triangle, or t within 1e-4 relative (ties at shared edges); \
+         shadow: same occlusion answer. The bar is 99.99% of rays.\n\n\
+         | scene | contender | primary differ | shadow differ | random differ | agreement | verdict |\n\
+         |---|---|---:|---:|---:|---:|:---:|\n",
+    );
+    for s in &r.scenes {
+        for who in [EMBREE, BRUTE] {
+            let rows: Vec<_> = s.agreement.iter().filter(|a| a.other == who).collect();
+            if rows.is_empty() {
+                continue;
+            }
+            let cell = |k: Kind| {
+                opt(rows.iter().find(|a| a.kind == k), |a| {
+                    format!("{} / {}", a.disagreements, a.compared)
+                })
+            };
+            let worst = rows.iter().map(|a| a.agreement()).fold(1.0f64, f64::min);
+            let ok = rows.iter().all(|a| a.ok());
+            let _ = writeln!(
+                out,
+                "| {} | {who} | {} | {} | {} | {:.4}% | {} |",
+                s.name,
+                cell(Kind::Primary),
+                cell(Kind::Shadow),
+                cell(Kind::Random),
+                worst * 100.0,
+                if ok { "ok" } else { "**FAIL**" }
+            );
+        }
+    }
+    out.push('\n');
+}
+
+/// The whole report as markdown.
+pub fn markdown(r: &Report) -> String {
+    let mut out = String::from("# k-d tree benchmark (kdbench)\n\n");
+    for h in &r.header {
+        let _ = writeln!(out, "- {h}");
+    }
+    out.push('\n');
+    targets(r, &mut out);
+    builds(r, &mut out);
+    traversal(r, &mut out);
+    agreement(r, &mut out);
+    if !r.notes.is_empty() {
+        out.push_str("## Notes\n\n");
+        for n in &r.notes {
+            let _ = writeln!(out, "- {n}");
+        }
+        out.push('\n');
+    }
+    out
+}

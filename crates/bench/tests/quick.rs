@@ -1,0 +1,145 @@
+//! The quick benchmark, in process, on a tiny generated scene: the report has the rows
+//! the tables need and every contender agrees with the k-d tree.
+
+use bench::run::{Kind, Role, BRUTE, EMBREE, KDTREE};
+use bench::{report, run, scenes, Config};
+use std::path::PathBuf;
+
+fn quiet() -> impl FnMut(&str) {
+    |_| {}
+}
+
+#[test]
+fn quick_run_has_every_row_and_the_contenders_agree() {
+    let cfg = Config {
+        runs: 1,
+        ..Config::quick()
+    };
+    let report = run(&cfg, &mut quiet()).unwrap();
+    assert_eq!(report.scenes.len(), 1);
+    let s = &report.scenes[0];
+    assert_eq!(s.role, Role::Generated);
+    let expected_tris = scenes::generated(cfg.generated).triangles.len();
+    assert_eq!(s.triangles, expected_tris);
+    assert!((2500..=3500).contains(&expected_tris), "{expected_tris}");
+
+    let embree = cfg!(feature = "embree");
+    let contenders: Vec<&str> = if embree {
+        vec![KDTREE, EMBREE]
+    } else {
+        vec![KDTREE]
+    };
+    // Build rows: every contender (brute force has no build) at 1 and 2 threads.
+    assert_eq!(s.builds.len(), 2 * contenders.len());
+    for b in &s.builds {
+        assert!(b.seconds > 0.0);
+        assert_eq!(b.triangles, expected_tris);
+    }
+    // The k-d tree's statistics are those of the tree itself, built directly.
+    let tris = scenes::generated(cfg.generated).triangles;
+    let direct = kdtree::build(&tris, &cfg.params, formats::soup::geometry_hash(&tris));
+    for kd in s.builds.iter().filter(|b| b.contender == KDTREE) {
+        assert_eq!(kd.nodes, Some(direct.nodes.len() as u64));
+        let sah = kd.sah_cost.unwrap();
+        assert!((sah - direct.stats.sah_cost).abs() <= 1e-9 * sah.abs().max(1.0));
+        let n = tris.len() as f64;
+        let bytes = (direct.nodes.len() * 8 + direct.leaf_tris.len() * 4) as f64 + 36.0 * n;
+        assert_eq!(kd.bytes_per_triangle, Some(bytes / n));
+        assert_eq!(
+            kd.refs_per_triangle,
+            Some(direct.leaf_tris.len() as f64 / n)
+        );
+    }
+
+    // Trace rows: every contender, brute force too (the scene is small), × 2 × 3 kinds.
+    let mut all = contenders.clone();
+    all.push(BRUTE);
+    assert_eq!(s.traces.len(), all.len() * 2 * 3);
+    let rays = |who: &str, kind: Kind| {
+        s.traces
+            .iter()
+            .find(|r| r.contender == who && r.kind == kind && r.threads == 1)
+            .unwrap()
+            .rays
+    };
+    assert_eq!(rays(KDTREE, Kind::Primary), 48 * 48);
+    assert_eq!(rays(KDTREE, Kind::Random), 2048);
+    // Shadow rays start at primary hits: most of a framed view hits the scene.
+    let shadow = rays(KDTREE, Kind::Shadow);
+    assert!(
+        shadow > 48 * 48 / 2 && shadow <= 48 * 48,
+        "{shadow} shadow rays"
+    );
+    assert_eq!(rays(BRUTE, Kind::Primary), 512);
+    for r in &s.traces {
+        assert!(r.mrays_per_s() > 0.0 && r.mrays_per_s().is_finite());
+    }
+
+    // Agreement: each non-reference contender on each kind, nothing differs.
+    assert_eq!(s.agreement.len(), (all.len() - 1) * 3);
+    for a in &s.agreement {
+        assert!(a.compared > 0);
+        assert_eq!(
+            a.disagreements, 0,
+            "{} {:?}: {:?}",
+            a.other, a.kind, a.examples
+        );
+    }
+    assert!(report.all_agree());
+
+    let md = report::markdown(&report);
+    let name = &s.name;
+    assert!(md.contains(&format!("| {name} | {expected_tris} | kdtree | 1 |")));
+    assert!(md.contains(&format!("| {name} | kdtree | 2 |")));
+    assert!(md.contains(&format!("| {name} | brute force | 1 |")));
+    assert!(md.contains(&format!(
+        "| {name} | brute force | 0 / 512 | 0 / {} | 0 / 512 | 100.0000% | ok |",
+        shadow.min(512)
+    )));
+    assert_eq!(
+        md.contains(&format!("| {name} | **kdtree/Embree** | 1 |")),
+        embree
+    );
+    assert!(!md.contains("**FAIL**"));
+    for section in [
+        "## Build",
+        "## Traversal",
+        "## Agreement",
+        "- machine: nproc",
+    ] {
+        assert!(md.contains(section), "missing {section}");
+    }
+}
+
+#[test]
+fn a_missing_baseline_is_skipped_with_a_note() {
+    let cfg = Config {
+        baseline: Some(PathBuf::from("/nonexistent/baseline.soup")),
+        generated: 0,
+        ..Config::quick()
+    };
+    let mut lines = vec![];
+    let report = run(&cfg, &mut |l: &str| lines.push(l.to_string())).unwrap();
+    assert!(report.scenes.is_empty());
+    assert_eq!(report.notes.len(), 1);
+    assert!(report.notes[0].starts_with("SKIPPED: baseline soup /nonexistent/baseline.soup"));
+    assert_eq!(lines, report.notes);
+}
+
+#[test]
+fn loads_the_corpus_suzanne_triangulated() {
+    let path =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/corpus/meshes/suzanne.obj");
+    if !path.exists() {
+        println!(
+            "SKIPPED: suzanne OBJ test because {} is absent",
+            path.display()
+        );
+        return;
+    }
+    let s = scenes::load_obj(&path).unwrap();
+    // 32 triangles + 468 quads (two triangles each), per the corpus MANIFEST.
+    assert_eq!(s.triangles.len(), 32 + 2 * 468);
+    assert_eq!(s.name, "suzanne");
+    assert!(s.notes.is_empty());
+}
