@@ -232,6 +232,7 @@ impl<'p> Graph<'p> {
         let mut map: HashMap<i64, usize> = HashMap::new();
         let mut instances: HashMap<i64, HashMap<i64, usize>> = HashMap::new();
         let mut pending_parents: Vec<(Vec<usize>, i64)> = Vec::new();
+        let mut skipped: HashMap<i64, (Vec<Node>, i64)> = HashMap::new();
 
         // 1. Prefab instances.
         for d in docs
@@ -250,25 +251,7 @@ impl<'p> Graph<'p> {
                 .and_then(|m| m.get("m_Modifications"))
                 .map(Node::as_seq)
                 .unwrap_or(&[]);
-            for md in mods {
-                let (target, _) = fref(md.get("target"));
-                let Some(&idx) = smap.get(&target) else {
-                    continue;
-                };
-                let Some(prop) = md.str_at("propertyPath") else {
-                    continue;
-                };
-                let value = md.str_at("value").unwrap_or("");
-                let objref = md.get("objectReference");
-                let (ref_id, _) = fref(objref);
-                let new = if value.is_empty() && (ref_id != 0 || is_ref_path(prop)) {
-                    tag_local(objref.cloned().unwrap_or(ref_node(0, "")), ctx)
-                } else {
-                    scalar(value)
-                };
-                let segs: Vec<&str> = prop.split('.').collect();
-                set_path(&mut self.objs[idx].body, &segs, new);
-            }
+            self.apply_mods(&smap, mods, ctx);
             for key in ["m_RemovedComponents", "m_RemovedGameObjects"] {
                 for r in m.and_then(|m| m.get(key)).map(Node::as_seq).unwrap_or(&[]) {
                     if let Some(&idx) = smap.get(&fref(Some(r)).0) {
@@ -277,6 +260,11 @@ impl<'p> Graph<'p> {
                 }
             }
             let (parent, _) = fref(m.and_then(|m| m.get("m_TransformParent")));
+            if smap.is_empty() {
+                // The source is missing: keep what the scene says about the instance so
+                // that stripped placeholders can stand in for its objects (step 2).
+                skipped.insert(d.file_id, (mods.to_vec(), parent));
+            }
             pending_parents.push((roots, parent));
             for (&f, &i) in &smap {
                 map.insert((d.file_id ^ f) & i64::MAX, i);
@@ -285,6 +273,7 @@ impl<'p> Graph<'p> {
         }
 
         // 2. Stripped placeholders stand for objects of an instance.
+        let mut stand_ins: HashMap<i64, Vec<usize>> = HashMap::new();
         for d in docs.iter().filter(|d| d.stripped) {
             let body = d.parse();
             let corr = fref(
@@ -299,6 +288,43 @@ impl<'p> Graph<'p> {
             .0;
             if let Some(&i) = instances.get(&inst).and_then(|m| m.get(&corr)) {
                 map.insert(d.file_id, i);
+            } else if let Some((mods, parent)) = skipped.get(&inst) {
+                // A stand-in for an object of a skipped instance (no geometry): its
+                // transform and activity from the modifications, so scene objects
+                // parented under it land where Unity puts them. The source's own
+                // hierarchy is unknown: a Transform is treated as the instance's root.
+                if !(is_transform(d.class) || d.class == docs::GAME_OBJECT) {
+                    continue;
+                }
+                let body = if d.class == docs::GAME_OBJECT {
+                    Node::Map(vec![
+                        ("m_Name".into(), scalar("?")),
+                        ("m_IsActive".into(), scalar(1)),
+                    ])
+                } else {
+                    identity_transform()
+                };
+                let idx = self.push(d.class, body, d.file_id, ctx);
+                let one: HashMap<i64, usize> = [(corr, idx)].into_iter().collect();
+                self.apply_mods(&one, mods, ctx);
+                if is_transform(d.class) {
+                    pending_parents.push((vec![idx], *parent));
+                }
+                stand_ins.entry(inst).or_default().push(idx);
+                map.insert(d.file_id, idx);
+            }
+        }
+        // Pair a skipped instance's stand-in Transform with its stand-in GameObject, so
+        // an m_IsActive override on it still hides the scene objects under it.
+        for objs in stand_ins.values() {
+            let go = objs
+                .iter()
+                .copied()
+                .find(|&i| self.objs[i].class == docs::GAME_OBJECT);
+            for &i in objs {
+                if is_transform(self.objs[i].class) {
+                    self.objs[i].go = go;
+                }
             }
         }
 
@@ -317,13 +343,29 @@ impl<'p> Graph<'p> {
         }
 
         // 4. Links, resolved in this file's id space.
+        let mut orphans = Vec::new();
         for &idx in &own {
             let (go, _) = fref(self.objs[idx].body.get("m_GameObject"));
             self.objs[idx].go = map.get(&go).copied();
             if is_transform(self.objs[idx].class) {
                 let (f, _) = fref(self.objs[idx].body.get("m_Father"));
                 self.objs[idx].father = map.get(&f).copied();
+                if f != 0 && self.objs[idx].father.is_none() {
+                    // Typically a child of a prefab instance that was skipped.
+                    orphans.push((idx, f));
+                }
             }
+        }
+        for (idx, f) in orphans {
+            let name = self.objs[idx]
+                .go
+                .and_then(|g| self.objs[g].body.str_at("m_Name"))
+                .unwrap_or("?")
+                .to_string();
+            self.warnings.push(format!(
+                "{rel}: object '{name}' (fileID {}): parent Transform {f} is not converted (its prefab instance was skipped); placed at the root",
+                self.objs[idx].file_id
+            ));
         }
         for (roots, parent) in pending_parents {
             if parent != 0 {
@@ -336,6 +378,30 @@ impl<'p> Graph<'p> {
         }
         self.files[ctx].text = text;
         Ok(map)
+    }
+
+    /// Apply `m_Modifications` to the objects of one instance (`smap`: source fileID →
+    /// arena index). References written without a GUID point into file `ctx`.
+    fn apply_mods(&mut self, smap: &HashMap<i64, usize>, mods: &[Node], ctx: usize) {
+        for md in mods {
+            let (target, _) = fref(md.get("target"));
+            let Some(&idx) = smap.get(&target) else {
+                continue;
+            };
+            let Some(prop) = md.str_at("propertyPath") else {
+                continue;
+            };
+            let value = md.str_at("value").unwrap_or("");
+            let objref = md.get("objectReference");
+            let (ref_id, _) = fref(objref);
+            let new = if value.is_empty() && (ref_id != 0 || is_ref_path(prop)) {
+                tag_local(objref.cloned().unwrap_or(ref_node(0, "")), ctx)
+            } else {
+                scalar(value)
+            };
+            let segs: Vec<&str> = prop.split('.').collect();
+            set_path(&mut self.objs[idx].body, &segs, new);
+        }
     }
 
     /// The objects of one instance of `d`'s source prefab or model, keyed by their
@@ -436,23 +502,8 @@ impl<'p> Graph<'p> {
                 ("m_IsActive".into(), scalar(1)),
             ])
         };
-        let tf_body = || {
-            Node::Map(vec![
-                ("m_LocalPosition".into(), xyz(0.0, 0.0, 0.0)),
-                (
-                    "m_LocalRotation".into(),
-                    Node::Map(vec![
-                        ("x".into(), scalar(0)),
-                        ("y".into(), scalar(0)),
-                        ("z".into(), scalar(0)),
-                        ("w".into(), scalar(1)),
-                    ]),
-                ),
-                ("m_LocalScale".into(), xyz(1.0, 1.0, 1.0)),
-            ])
-        };
         let root_go = self.push(docs::GAME_OBJECT, go_body(&stem), 0, ctx);
-        let root_tf = self.push(docs::TRANSFORM, tf_body(), 0, ctx);
+        let root_tf = self.push(docs::TRANSFORM, identity_transform(), 0, ctx);
         self.objs[root_tf].go = Some(root_go);
         for id in meta.ids(1, "//RootNode", "//RootNode/root") {
             map.insert(id, root_go);
@@ -464,7 +515,7 @@ impl<'p> Graph<'p> {
             let n = &g.name;
             let p = format!("//RootNode/root/{n}");
             let go = self.push(docs::GAME_OBJECT, go_body(n), 0, ctx);
-            let tf = self.push(docs::TRANSFORM, tf_body(), 0, ctx);
+            let tf = self.push(docs::TRANSFORM, identity_transform(), 0, ctx);
             self.objs[tf].go = Some(go);
             self.objs[tf].father = Some(root_tf);
             let mesh_id = meta.ids(43, n, n)[0];
@@ -503,6 +554,22 @@ impl<'p> Graph<'p> {
         }
         (map, vec![root_tf])
     }
+}
+
+fn identity_transform() -> Node {
+    Node::Map(vec![
+        ("m_LocalPosition".into(), xyz(0.0, 0.0, 0.0)),
+        (
+            "m_LocalRotation".into(),
+            Node::Map(vec![
+                ("x".into(), scalar(0)),
+                ("y".into(), scalar(0)),
+                ("z".into(), scalar(0)),
+                ("w".into(), scalar(1)),
+            ]),
+        ),
+        ("m_LocalScale".into(), xyz(1.0, 1.0, 1.0)),
+    ])
 }
 
 /// The name Unity gives a model's material for a `usemtl` name (none → `defaultMat`).

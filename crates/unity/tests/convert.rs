@@ -577,3 +577,25 @@ fn nested_prefabs_apply_overrides_outermost_last() {
     let c = soup.triangles.iter().flatten().copied().sum::<Vec3>() / 36.0;
     assert!(close(c, Vec3::new(-12.0, 5.0, 0.0), 1e-5), "{c}");
 }
+
+#[test]
+fn children_of_a_missing_prefab_keep_its_placement() {
+    // An instance of an FBX that is not in the project (guid unknown), moved to x = 4 and
+    // scaled ×2 by its modifications; a scene Cube at local (1, 0, 0) under its stripped
+    // root Transform lands at Unity (4 + 2, 0, 0) → soup (−6, 0, 0), size 2.
+    let g = "fbx00000000000000000000000000000";
+    let mut sc = Scene::default();
+    sc.raw(&format!("--- !u!1001 &700\nPrefab:\n  m_Modification:\n    m_TransformParent: {{fileID: 0}}\n    m_Modifications:\n    - target: {{fileID: 400000, guid: {g}, type: 3}}\n      propertyPath: m_LocalPosition.x\n      value: 4\n      objectReference: {{fileID: 0}}\n    - target: {{fileID: 400000, guid: {g}, type: 3}}\n      propertyPath: m_LocalScale.x\n      value: 2\n      objectReference: {{fileID: 0}}\n    - target: {{fileID: 400000, guid: {g}, type: 3}}\n      propertyPath: m_LocalScale.y\n      value: 2\n      objectReference: {{fileID: 0}}\n    - target: {{fileID: 400000, guid: {g}, type: 3}}\n      propertyPath: m_LocalScale.z\n      value: 2\n      objectReference: {{fileID: 0}}\n  m_ParentPrefab: {{fileID: 100100000, guid: {g}, type: 3}}\n  m_IsPrefabParent: 0\n--- !u!4 &701 stripped\nTransform:\n  m_PrefabParentObject: {{fileID: 400000, guid: {g}, type: 3}}\n  m_PrefabInternal: {{fileID: 700}}\n"));
+    sc.primitive("Child", &Tf::at(1.0, 0.0, 0.0), 701, CUBE);
+    let (_d, root) = project(&[("Assets/s.unity", &sc.text)]);
+    let soup = convert(&root.join("Assets/s.unity"));
+    let (lo, hi) = bounds(soup.triangles.iter().flatten().copied());
+    assert!(
+        close(lo, Vec3::new(-7.0, -1.0, -1.0), 1e-5) && close(hi, Vec3::new(-5.0, 1.0, 1.0), 1e-5),
+        "{lo} {hi}"
+    );
+    assert!(soup
+        .warnings
+        .iter()
+        .any(|w| w.contains("prefab instance") && w.contains("not in the project")));
+}
