@@ -117,11 +117,9 @@ pub fn parse(text: &str, path: &Path) -> Result<ObjModel, ObjError> {
             if v.len() < 3 {
                 return Err(bad(lno, format!("expected 3 numbers in `{line}`")));
             }
-            let v = Vec3::new(v[0], v[1], v[2]);
-            if !v.is_finite() {
-                return Err(bad(lno, format!("non-finite number in `{line}`")));
-            }
-            Ok(v)
+            // Non-finite numbers are kept: the converter refuses the mesh with an error
+            // that names the scene object using it.
+            Ok(Vec3::new(v[0], v[1], v[2]))
         };
         match tag {
             "v" => pos.push(floats(it)?),

@@ -599,3 +599,25 @@ fn children_of_a_missing_prefab_keep_its_placement() {
         .iter()
         .any(|w| w.contains("prefab instance") && w.contains("not in the project")));
 }
+
+#[test]
+fn non_finite_obj_vertex_is_an_error_naming_the_object() {
+    let obj = "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n";
+    let mut sc = Scene::default();
+    let (go, _) = sc.object("Bad Mesh", &Tf::at(0.0, 0.0, 0.0), 0, true);
+    sc.mesh(
+        go,
+        4300000,
+        OBJ_GUID,
+        &[(10303, "0000000000000000f000000000000000")],
+        true,
+    );
+    let (_d, root) = project(&[
+        ("Assets/n.obj", obj),
+        ("Assets/n.obj.meta", &legacy_meta(OBJ_GUID, &["default"])),
+        ("Assets/s.unity", &sc.text),
+    ]);
+    let err = unity::convert(&root.join("Assets/s.unity"), &unity::Options::default()).unwrap_err();
+    let msg = err.to_string();
+    assert!(msg.contains("'Bad Mesh'") && msg.contains("NaN"), "{msg}");
+}
