@@ -621,3 +621,25 @@ fn non_finite_obj_vertex_is_an_error_naming_the_object() {
     let msg = err.to_string();
     assert!(msg.contains("'Bad Mesh'") && msg.contains("NaN"), "{msg}");
 }
+
+#[test]
+fn unity5_forms_recttransform_hex_floats_and_model_scale() {
+    // Unity 5 writes component lists as `- <class>: {fileID}`; a RectTransform is a
+    // Transform; `0x40400000(3)` is 3.0 by its bits (the decimal is only a hint, here
+    // deliberately wrong). The model's .meta has globalScale 0.5.
+    let text = format!("{HEADER}--- !u!1 &1\nGameObject:\n  m_ObjectHideFlags: 0\n  m_PrefabParentObject: {{fileID: 0}}\n  m_PrefabInternal: {{fileID: 0}}\n  serializedVersion: 4\n  m_Component:\n  - 224: {{fileID: 2}}\n  - 33: {{fileID: 3}}\n  - 23: {{fileID: 4}}\n  m_Name: Old\n  m_IsActive: 1\n--- !u!224 &2\nRectTransform:\n  m_GameObject: {{fileID: 1}}\n  m_LocalRotation: {{x: 0, y: 0, z: 0, w: 1}}\n  m_LocalPosition: {{x: 0x40400000(9), y: 0, z: 0}}\n  m_LocalScale: {{x: 1, y: 1, z: 1}}\n  m_Children: []\n  m_Father: {{fileID: 0}}\n  m_AnchorMin: {{x: 0, y: 0}}\n--- !u!33 &3\nMeshFilter:\n  m_GameObject: {{fileID: 1}}\n  m_Mesh: {{fileID: 4300000, guid: {OBJ_GUID}, type: 3}}\n--- !u!23 &4\nMeshRenderer:\n  m_GameObject: {{fileID: 1}}\n  m_Enabled: 1\n  m_Materials:\n  - {{fileID: 10303, guid: 0000000000000000f000000000000000, type: 0}}\n");
+    let meta = legacy_meta(OBJ_GUID, &["default"]).replace("globalScale: 1", "globalScale: 0.5");
+    let (_d, root) = project(&[
+        ("Assets/m.obj", OBJ),
+        ("Assets/m.obj.meta", &meta),
+        ("Assets/s.unity", &text),
+    ]);
+    let soup = convert(&root.join("Assets/s.unity"));
+    assert_eq!(soup.objects[0].name, "Old");
+    // File vertex (1, 2, 3) → scaled 0.5 → Unity (−0.5, 1, 1.5) + (3, 0, 0) → soup (−2.5, 1, 1.5).
+    assert!(
+        close(soup.triangles[0][0], Vec3::new(-2.5, 1.0, 1.5), 1e-6),
+        "{}",
+        soup.triangles[0][0]
+    );
+}
