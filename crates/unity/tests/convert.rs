@@ -643,3 +643,25 @@ fn unity5_forms_recttransform_hex_floats_and_model_scale() {
         soup.triangles[0][0]
     );
 }
+
+#[test]
+fn removed_components_and_game_objects_draw_nothing() {
+    // Instance of two.obj (fileIdsGeneration 2) that removes group A's MeshRenderer and
+    // group B's GameObject: nothing of the model is drawn.
+    let h = |s: &str| unity::meta::hash_id(s);
+    let a_mr = h("Type:MeshRenderer->//RootNode/root/A/MeshRenderer0");
+    let b_go = h("Type:GameObject->//RootNode/root/B0");
+    let g = OBJ_GUID;
+    let mut sc = Scene::default();
+    sc.raw(&format!("--- !u!1001 &500\nPrefabInstance:\n  m_Modification:\n    serializedVersion: 3\n    m_TransformParent: {{fileID: 0}}\n    m_Modifications: []\n    m_RemovedComponents:\n    - {{fileID: {a_mr}, guid: {g}, type: 3}}\n    m_RemovedGameObjects:\n    - {{fileID: {b_go}, guid: {g}, type: 3}}\n    m_AddedGameObjects: []\n    m_AddedComponents: []\n  m_SourcePrefab: {{fileID: 100100000, guid: {g}, type: 3}}\n"));
+    sc.primitive("Other", &Tf::at(0.0, 0.0, 0.0), 0, CUBE);
+    let (_d, root) = project(&[
+        ("Assets/two.obj", TWO_GROUPS),
+        ("Assets/two.mtl", TWO_MTL),
+        ("Assets/two.obj.meta", &gen2_meta(g)),
+        ("Assets/s.unity", &sc.text),
+    ]);
+    let soup = convert(&root.join("Assets/s.unity"));
+    let names: Vec<_> = soup.objects.iter().map(|o| o.name.as_str()).collect();
+    assert_eq!(names, ["Other"]);
+}

@@ -377,3 +377,23 @@ fn baseline_scene_has_41833_triangles() {
     assert_eq!(r.soup.lights.len(), 2);
     assert!(r.soup.warnings.is_empty(), "{:?}", r.soup.warnings);
 }
+
+#[test]
+fn legacy_material_with_repeated_data_keys() {
+    // IceMiaoMiao mat_fence_02.mat (Unity ≤ 5.5 layout): _Glossiness .0649999976,
+    // _Color {r: .882352948, g: .946450293, b: 1}, _EmissionColor black.
+    let Some(root) = corpus() else { return };
+    let p = root
+        .join("IceMiaoMiao__Unity-Shader-Study-Projects/Assets/Models/Materials/mat_fence_02.mat");
+    let text = std::fs::read_to_string(&p).unwrap();
+    let doc = unity::docs::split(&text)
+        .into_iter()
+        .find(|d| d.class == 21)
+        .unwrap();
+    let (m, _) = unity::material::convert(&doc.parse(), "mat_fence_02.mat");
+    assert_eq!(m.name, "mat_fence_02");
+    assert!((m.smoothness - 0.065).abs() < 1e-6);
+    let want = Vec3::new(eotf(0.882_352_95), eotf(0.946_450_3), 1.0);
+    assert!((m.color - want).abs().max_element() < 1e-6, "{}", m.color);
+    assert_eq!(m.emission, Vec3::ZERO);
+}
