@@ -12,7 +12,7 @@
 use crate::counters::RayCounts;
 use crate::environment;
 use crate::lights::{basis, incident, Incident};
-use crate::offset::{hit_point, offset_origin, SHADOW_TMAX_FRACTION};
+use crate::offset::{hit_point, offset_origin, SHADOW_TMAX_FRACTION, SPAWN_TMIN};
 use crate::plan::{Plan, ShadowMode};
 use crate::sampling::{disc_sample, Rng};
 use formats::{Light, LightKind, Soup};
@@ -215,7 +215,7 @@ impl<'a> Integrator<'a> {
                     let next = Ray {
                         origin: offset_origin(p, err, ng, r),
                         dir: r,
-                        tmin: 0.0,
+                        tmin: SPAWN_TMIN,
                         tmax: f32::INFINITY,
                     };
                     l += refl * self.radiance(&next, bounce + 1, w, rng, counts, None);
@@ -233,7 +233,7 @@ impl<'a> Integrator<'a> {
             Ray {
                 origin,
                 dir,
-                tmin: 0.0,
+                tmin: SPAWN_TMIN,
                 tmax: f32::INFINITY,
             }
         } else {
@@ -244,7 +244,7 @@ impl<'a> Integrator<'a> {
             Ray {
                 origin,
                 dir: to / d,
-                tmin: 0.0,
+                tmin: SPAWN_TMIN,
                 tmax: d * SHADOW_TMAX_FRACTION,
             }
         };

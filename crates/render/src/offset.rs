@@ -49,16 +49,31 @@ pub fn offset_origin(p: Vec3, err: Vec3, ng: Vec3, w: Vec3) -> Vec3 {
     // One more ULP away from the surface on every axis the normal has a component along,
     // also when the error bound is 0 (an exactly representable point on an axis-aligned
     // plane): a ray must never start exactly on the surface it leaves.
+    // A coordinate stepped off an exact 0 would be a denormal, and products of denormals
+    // underflow to 0 inside the intersector (a "hit" at t = 0): step to the smallest
+    // normal float instead, still ~10⁻³⁸ from the surface.
     let side = side.to_array();
     for i in 0..3 {
         if side[i] > 0.0 {
             po[i] = next_up(po[i]);
+            if po[i] > 0.0 && po[i] < f32::MIN_POSITIVE {
+                po[i] = f32::MIN_POSITIVE;
+            }
         } else if side[i] < 0.0 {
             po[i] = next_down(po[i]);
+            if po[i] < 0.0 && po[i] > -f32::MIN_POSITIVE {
+                po[i] = -f32::MIN_POSITIVE;
+            }
         }
     }
     Vec3::from_array(po)
 }
+
+/// `tmin` of every spawned ray: the smallest normal f32. It only excludes t = 0 and
+/// denormal distances, which a ray leaving an offset origin can reach only through
+/// underflow inside the intersector (whose interval is closed at tmin); it is no
+/// epsilon in the geometric sense — the offset above keeps real surfaces away.
+pub const SPAWN_TMIN: f32 = f32::MIN_POSITIVE;
 
 /// Fraction of the distance to a light that a shadow ray may travel: it stops short of
 /// the light by a relative margin so that geometry at the light itself does not count.
