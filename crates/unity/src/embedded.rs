@@ -8,8 +8,8 @@ use glam::Vec3;
 
 fn hex(s: &str) -> Result<Vec<u8>, String> {
     let s = s.trim();
-    if !s.len().is_multiple_of(2) {
-        return Err("odd-length hex data".into());
+    if !s.len().is_multiple_of(2) || !s.bytes().all(|b| b.is_ascii_hexdigit()) {
+        return Err("malformed hex data".into());
     }
     (0..s.len())
         .step_by(2)
@@ -121,6 +121,9 @@ pub fn decode(body: &Node) -> Result<Mesh, String> {
         let first = sm.i64_at("firstByte").unwrap_or(0).max(0) as usize / isize_;
         let n = sm.i64_at("indexCount").unwrap_or(0).max(0) as usize;
         let base = sm.i64_at("baseVertex").unwrap_or(0);
+        if first.saturating_add(n) > ib.len() / isize_ {
+            return Err("index buffer is shorter than its sub-meshes say".into());
+        }
         let mut tris = Vec::with_capacity(n / 3);
         for t in 0..n / 3 {
             let mut tri = [0u32; 3];

@@ -143,7 +143,11 @@ struct Line {
 /// Parse one document body (the lines after a `--- !u!` header).
 pub fn parse(text: &str) -> Node {
     let lines = logical_lines(text);
-    let mut p = Parser { lines, pos: 0 };
+    let mut p = Parser {
+        lines,
+        pos: 0,
+        depth: 0,
+    };
     if p.lines.is_empty() {
         return Node::Map(vec![]);
     }
@@ -237,6 +241,7 @@ fn split_key(t: &str) -> Option<(&str, &str)> {
 struct Parser {
     lines: Vec<Line>,
     pos: usize,
+    depth: u32,
 }
 
 impl Parser {
@@ -246,11 +251,22 @@ impl Parser {
     }
 
     fn node(&mut self, indent: usize) -> Node {
-        if self.pos < self.lines.len() && self.is_item(self.pos) {
+        // Unity documents nest a handful of levels; a pathological file must not
+        // exhaust the stack: skip what lies deeper than any Unity file goes.
+        if self.depth > 128 {
+            while self.pos < self.lines.len() && self.lines[self.pos].indent >= indent {
+                self.pos += 1;
+            }
+            return Node::Scalar(String::new());
+        }
+        self.depth += 1;
+        let n = if self.pos < self.lines.len() && self.is_item(self.pos) {
             self.seq(indent)
         } else {
             self.map(indent)
-        }
+        };
+        self.depth -= 1;
+        n
     }
 
     fn map(&mut self, indent: usize) -> Node {
@@ -325,6 +341,7 @@ fn inline(s: &str) -> Node {
     let mut f = Flow {
         s: s.as_bytes(),
         i: 0,
+        depth: 0,
     };
     f.value(true)
 }
@@ -332,6 +349,7 @@ fn inline(s: &str) -> Node {
 struct Flow<'a> {
     s: &'a [u8],
     i: usize,
+    depth: u32,
 }
 
 impl Flow<'_> {
@@ -343,6 +361,21 @@ impl Flow<'_> {
 
     fn value(&mut self, top: bool) -> Node {
         self.ws();
+        // Unity nests flow collections two or three deep; anything far deeper is not a
+        // Unity file, and is kept as text rather than recursed into.
+        self.depth += 1;
+        if self.depth > 64 {
+            self.depth -= 1;
+            let rest = String::from_utf8_lossy(&self.s[self.i..]).to_string();
+            self.i = self.s.len();
+            return Node::Scalar(rest);
+        }
+        let v = self.value_inner(top);
+        self.depth -= 1;
+        v
+    }
+
+    fn value_inner(&mut self, top: bool) -> Node {
         match self.s.get(self.i) {
             Some(b'{') => {
                 self.i += 1;
@@ -495,6 +528,19 @@ mod tests {
             Some("x")
         );
         assert_eq!(g.i64_at("m_Layer"), Some(3));
+    }
+
+    #[test]
+    fn absurd_nesting_does_not_overflow_the_stack() {
+        let deep = format!("A:\n  k: {}\n", "[".repeat(100_000));
+        assert!(parse(&deep).get("A").and_then(|a| a.get("k")).is_some());
+        let items = format!("A:\n  k:\n  {}x\n  j: 1\n", "- ".repeat(100_000));
+        assert!(parse(&items).get("A").is_some());
+        let mut stairs = String::from("A:\n");
+        for i in 1..2_000 {
+            stairs += &format!("{}k{i}:\n", " ".repeat(i));
+        }
+        assert!(parse(&stairs).get("A").is_some());
     }
 
     #[test]
