@@ -21,7 +21,8 @@ struct Args {
     /// Treat every warning as an error.
     #[arg(long)]
     strict: bool,
-    /// List every converted object (triangles, source, materials) and light on stderr.
+    /// List every converted object (triangles, source, materials), light and warning on
+    /// stderr.
     #[arg(long)]
     list: bool,
 }
@@ -44,8 +45,16 @@ fn run(args: &Args) -> anyhow::Result<()> {
     soup.write(&args.output)
         .with_context(|| format!("writing {}", args.output.display()))?;
     let secs = t0.elapsed().as_secs_f64();
-    for w in &soup.warnings {
+    // A real project can have hundreds of warnings: show the first few unless asked.
+    let shown = if args.list { soup.warnings.len() } else { 20 };
+    for w in soup.warnings.iter().take(shown) {
         eprintln!("warning: {w}");
+    }
+    if soup.warnings.len() > shown {
+        eprintln!(
+            "warning: … and {} more (--list or --json shows them all)",
+            soup.warnings.len() - shown
+        );
     }
     if args.list {
         list(&soup);
