@@ -665,3 +665,42 @@ fn removed_components_and_game_objects_draw_nothing() {
     let names: Vec<_> = soup.objects.iter().map(|o| o.name.as_str()).collect();
     assert_eq!(names, ["Other"]);
 }
+
+#[test]
+fn project_root_is_found_or_given() {
+    let mut sc = Scene::default();
+    let (go, _) = sc.object("Model", &Tf::at(0.0, 0.0, 0.0), 0, true);
+    sc.mesh(
+        go,
+        4300000,
+        OBJ_GUID,
+        &[(10303, "0000000000000000f000000000000000")],
+        true,
+    );
+    let (_d, root) = project(&[
+        ("Assets/Deep/m.obj", OBJ),
+        (
+            "Assets/Deep/m.obj.meta",
+            &legacy_meta(OBJ_GUID, &["default"]),
+        ),
+        ("Assets/Scenes/Sub/s.unity", &sc.text),
+    ]);
+    let scene = root.join("Assets/Scenes/Sub/s.unity");
+    let found = convert(&scene);
+    assert_eq!(found.triangles.len(), 3);
+    for given in [root.clone(), root.join("Assets")] {
+        let opts = unity::Options {
+            project: Some(given),
+            strict: false,
+        };
+        assert_eq!(
+            unity::convert(&scene, &opts).unwrap().triangles,
+            found.triangles
+        );
+    }
+    // A scene outside any project.
+    let lone = tempfile::tempdir().unwrap();
+    std::fs::write(lone.path().join("s.unity"), &sc.text).unwrap();
+    let err = unity::convert(&lone.path().join("s.unity"), &unity::Options::default()).unwrap_err();
+    assert!(err.to_string().contains("--assets"), "{err}");
+}
