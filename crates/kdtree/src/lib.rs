@@ -1,11 +1,30 @@
-//! SAH k-d tree: build, traversal and ray/triangle intersection.
+//! SAH k-d tree: build, traversal and watertight ray/triangle intersection.
 //!
-//! PLACEHOLDER API (brute force) — the kdtree work replaces the internals, keeping
-//! these signatures, which the renderer and the `raycast` tool use.
+//! * [`build`] compiles triangles into a [`KdFile`] (Wald & Havran's O(N log N) SAH build
+//!   with perfect splits, parallel over subtrees).
+//! * [`Accel`] pairs a soup's triangles with a compiled tree and answers closest-hit
+//!   ([`Accel::intersect`]) and any-hit ([`Accel::occluded`]) queries.
+//! * [`brute`] answers the same queries by testing every triangle: the reference for
+//!   tests and benchmarks.
+//!
+//! See docs/ROBUSTNESS.md for the numerical hard cases and the tests that pin them.
 
-use formats::{BuildParams, KdFile, Soup};
+// `!(a <= b)` is deliberate throughout: it is true when either side is NaN, which is
+// exactly when a ray or a cell must be refused.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+pub mod aabb;
+pub mod build;
+pub mod gen;
+mod traverse;
+pub mod triangle;
+
+use aabb::Aabb;
+use formats::{BuildParams, KdFile, KdNode, Soup};
 use glam::Vec3;
 
+pub use build::median::build_median;
+pub use build::{build, depth_bound};
 pub use formats::Hit;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -16,18 +35,39 @@ pub struct Ray {
     pub tmax: f32,
 }
 
+impl Ray {
+    pub fn new(origin: Vec3, dir: Vec3, tmin: f32, tmax: f32) -> Ray {
+        Ray {
+            origin,
+            dir,
+            tmin,
+            tmax,
+        }
+    }
+}
+
 #[derive(Debug, thiserror::Error)]
 pub enum AccelError {
     #[error("the k-d tree was built from geometry {tree}, the soup's geometry is {soup}: rebuild it with soup2kd")]
     HashMismatch { tree: String, soup: String },
+    #[error("the k-d tree does not fit its soup: {detail}")]
+    Corrupt { detail: String },
+    #[error("the k-d tree is {depth} levels deep; traversal supports at most {max}: rebuild it with a smaller --max-depth")]
+    TooDeep { depth: u32, max: u32 },
 }
 
-/// A soup's triangles plus a compiled tree, ready for ray queries.
+/// A soup's triangles plus a compiled tree, ready for ray queries. Send + Sync: share one
+/// across threads by reference.
 pub struct Accel {
-    tris: Vec<[Vec3; 3]>,
+    /// Triangle vertices in soup order (36 bytes each), indexed by the leaves' lists.
+    tris: Vec<[[f32; 3]; 3]>,
+    nodes: Vec<KdNode>,
+    leaf_tris: Vec<u32>,
+    bounds: Aabb,
 }
 
 impl Accel {
+    /// Pair a soup with its tree; refuses a tree built from other geometry.
     pub fn new(soup: &Soup, kd: &KdFile) -> Result<Accel, AccelError> {
         if soup.geometry_hash != kd.geometry_hash {
             return Err(AccelError::HashMismatch {
@@ -35,88 +75,151 @@ impl Accel {
                 soup: formats::hex(&soup.geometry_hash),
             });
         }
+        Self::assemble(&soup.triangles, kd)
+    }
+
+    /// Pair bare triangles with their tree (the geometry hash is recomputed and checked).
+    pub fn from_triangles(triangles: &[[Vec3; 3]], kd: &KdFile) -> Result<Accel, AccelError> {
+        let hash = formats::soup::geometry_hash(triangles);
+        if hash != kd.geometry_hash {
+            return Err(AccelError::HashMismatch {
+                tree: formats::hex(&kd.geometry_hash),
+                soup: formats::hex(&hash),
+            });
+        }
+        Self::assemble(triangles, kd)
+    }
+
+    /// Build a tree with `params` and wrap it (tests, benchmarks, tools).
+    pub fn build(triangles: &[[Vec3; 3]], params: &BuildParams) -> Accel {
+        let kd = build(triangles, params, formats::soup::geometry_hash(triangles));
+        Self::assemble(triangles, &kd).expect("a freshly built tree fits its triangles")
+    }
+
+    fn assemble(triangles: &[[Vec3; 3]], kd: &KdFile) -> Result<Accel, AccelError> {
+        kd.validate()
+            .map_err(|detail| AccelError::Corrupt { detail })?;
+        if kd.stats.triangles != triangles.len() as u64 {
+            return Err(AccelError::Corrupt {
+                detail: format!(
+                    "the tree indexes {} triangles, the soup has {}",
+                    kd.stats.triangles,
+                    triangles.len()
+                ),
+            });
+        }
+        // Children always follow their parent (validate checks it), so depth can be
+        // computed back to front in one pass, even for a hostile file with shared nodes.
+        let mut height = vec![0u32; kd.nodes.len()];
+        for i in (0..kd.nodes.len()).rev() {
+            let n = kd.nodes[i];
+            if !n.is_leaf() {
+                height[i] = 1 + height[i + 1].max(height[n.above_child() as usize]);
+            }
+        }
+        let max = (traverse::STACK - 1) as u32;
+        if height[0] > max {
+            return Err(AccelError::TooDeep {
+                depth: height[0],
+                max,
+            });
+        }
         Ok(Accel {
-            tris: soup.triangles.clone(),
+            tris: triangles
+                .iter()
+                .map(|t| [t[0].to_array(), t[1].to_array(), t[2].to_array()])
+                .collect(),
+            nodes: kd.nodes.clone(),
+            leaf_tris: kd.leaf_tris.clone(),
+            bounds: Aabb {
+                lo: kd.bounds[0].to_array(),
+                hi: kd.bounds[1].to_array(),
+            },
         })
     }
 
-    /// Closest hit with t in [tmin, tmax], or None.
+    fn tree(&self) -> traverse::Tree<'_> {
+        traverse::Tree {
+            tris: &self.tris,
+            nodes: &self.nodes,
+            leaf_tris: &self.leaf_tris,
+            bounds: &self.bounds,
+        }
+    }
+
+    /// Closest hit with t in [tmin, tmax], or None. Ties in t go to the lower triangle
+    /// index. NaN/infinite rays, zero directions and tmin > tmax are misses.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        let mut best: Option<Hit> = None;
-        let mut tmax = ray.tmax;
-        for (i, t) in self.tris.iter().enumerate() {
-            if let Some((d, u, v)) = moller(ray, t) {
-                if d >= ray.tmin && d <= tmax {
-                    tmax = d;
-                    best = Some(Hit {
-                        t: d,
-                        prim: i as u32,
-                        u,
-                        v,
-                    });
-                }
-            }
-        }
-        best
+        self.tree().closest::<true>(ray)
     }
 
-    /// Whether anything blocks the ray in [tmin, tmax].
+    /// Whether anything blocks the ray in [tmin, tmax]; stops at the first blocker.
     pub fn occluded(&self, ray: &Ray) -> bool {
-        self.tris
-            .iter()
-            .any(|t| matches!(moller(ray, t), Some((d, _, _)) if d >= ray.tmin && d <= ray.tmax))
+        self.tree().any::<true>(ray)
+    }
+
+    /// Closest hit with plain Möller–Trumbore and unpadded textbook traversal: NOT
+    /// watertight. Only for measuring what robustness costs.
+    pub fn intersect_plain(&self, ray: &Ray) -> Option<Hit> {
+        self.tree().closest::<false>(ray)
+    }
+
+    /// Bytes held for queries: nodes, leaf lists and triangle data.
+    pub fn memory_bytes(&self) -> usize {
+        self.nodes.len() * std::mem::size_of::<KdNode>()
+            + self.leaf_tris.len() * 4
+            + self.tris.len() * std::mem::size_of::<[[f32; 3]; 3]>()
+    }
+
+    /// [`Accel::memory_bytes`] per input triangle.
+    pub fn bytes_per_triangle(&self) -> f64 {
+        self.memory_bytes() as f64 / self.tris.len().max(1) as f64
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.tris.len()
     }
 }
 
-fn moller(ray: &Ray, t: &[Vec3; 3]) -> Option<(f32, f32, f32)> {
-    let e1 = t[1] - t[0];
-    let e2 = t[2] - t[0];
-    let p = ray.dir.cross(e2);
-    let det = e1.dot(p);
-    if det == 0.0 {
-        return None;
+/// Brute-force queries: every triangle, the same watertight test and tie rule as the tree.
+pub mod brute {
+    use super::*;
+
+    /// Closest hit in [tmin, tmax] by testing every triangle.
+    pub fn intersect(triangles: &[[Vec3; 3]], ray: &Ray) -> Option<Hit> {
+        traverse::brute_closest(triangles, ray)
     }
-    let inv = 1.0 / det;
-    let s = ray.origin - t[0];
-    let u = s.dot(p) * inv;
-    if !(0.0..=1.0).contains(&u) {
-        return None;
+
+    /// Whether any triangle is hit in [tmin, tmax].
+    pub fn occluded(triangles: &[[Vec3; 3]], ray: &Ray) -> bool {
+        intersect(triangles, ray).is_some()
     }
-    let q = s.cross(e1);
-    let v = ray.dir.dot(q) * inv;
-    if v < 0.0 || u + v > 1.0 {
-        return None;
-    }
-    Some((e2.dot(q) * inv, u, v))
 }
 
-/// Build a tree over the triangles (placeholder: one leaf).
-pub fn build(
-    triangles: &[[Vec3; 3]],
-    params: &BuildParams,
-    geometry_hash: formats::Digest,
-) -> KdFile {
-    let mut lo = Vec3::splat(f32::INFINITY);
-    let mut hi = Vec3::splat(f32::NEG_INFINITY);
-    for t in triangles {
-        for v in t {
-            lo = lo.min(*v);
-            hi = hi.max(*v);
-        }
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn assert_send_sync<T: Send + Sync>() {}
+
+    #[test]
+    fn accel_is_send_and_sync() {
+        assert_send_sync::<Accel>();
     }
-    let n = triangles.len() as u32;
-    KdFile {
-        geometry_hash,
-        params: *params,
-        stats: formats::TreeStats {
-            triangles: n as u64,
-            nodes: 1,
-            leaves: 1,
-            references: n as u64,
-            ..Default::default()
-        },
-        bounds: [lo, hi],
-        nodes: vec![formats::KdNode::leaf(n, 0)],
-        leaf_tris: (0..n).collect(),
+
+    #[test]
+    fn refuses_other_geometry() {
+        let a = [[Vec3::ZERO, Vec3::X, Vec3::Y]];
+        let b = [[Vec3::ZERO, Vec3::X, Vec3::Z]];
+        let kd = build(
+            &a,
+            &BuildParams::default(),
+            formats::soup::geometry_hash(&a),
+        );
+        assert!(Accel::from_triangles(&a, &kd).is_ok());
+        assert!(matches!(
+            Accel::from_triangles(&b, &kd),
+            Err(AccelError::HashMismatch { .. })
+        ));
     }
 }

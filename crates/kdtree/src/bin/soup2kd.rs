@@ -1,0 +1,248 @@
+//! soup2kd: compile a soup's triangles into a SAH k-d tree, optionally through a cache.
+
+use anyhow::{bail, Context, Result};
+use clap::{CommandFactory, Parser};
+use formats::{BuildParams, KdFile, Soup};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Compile a soup's geometry into a k-d tree (.kd). The tree depends only on the triangle
+/// positions and the build parameters, so a cache folder lets renders reuse it.
+#[derive(Parser, Debug)]
+#[command(name = "soup2kd", version)]
+struct Cli {
+    /// The soup to compile (from unity2soup).
+    soup: Option<PathBuf>,
+    /// Write the tree to this file.
+    #[arg(short, long, conflicts_with = "cache")]
+    output: Option<PathBuf>,
+    /// Cache folder: reuse DIR/<geometry hash>-<params hash>.kd when valid, else build it.
+    #[arg(long, value_name = "DIR")]
+    cache: Option<PathBuf>,
+    /// Print one JSON object on stdout instead of a summary on stderr.
+    #[arg(long)]
+    json: bool,
+    /// SAH cost of one traversal step.
+    #[arg(long)]
+    traversal_cost: Option<f32>,
+    /// SAH cost of one ray/triangle test.
+    #[arg(long)]
+    intersect_cost: Option<f32>,
+    /// Fraction of the cost forgiven for splits that cut off empty space (0–1).
+    #[arg(long)]
+    empty_bonus: Option<f32>,
+    /// Depth bound (0: 8 + 1.3·log2 N; at most 60).
+    #[arg(long)]
+    max_depth: Option<u32>,
+    /// Make a leaf at or below this many triangles.
+    #[arg(long)]
+    leaf_size: Option<u32>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Print the statistics of an existing tree and exit.
+    #[arg(long, value_name = "FILE.kd", conflicts_with_all = ["soup", "output", "cache"])]
+    stats: Option<PathBuf>,
+}
+
+fn usage_error(msg: &str) -> ! {
+    Cli::command()
+        .error(clap::error::ErrorKind::MissingRequiredArgument, msg)
+        .exit()
+}
+
+fn params(cli: &Cli) -> Result<BuildParams> {
+    let mut p = BuildParams::default();
+    if let Some(v) = cli.traversal_cost {
+        p.traversal_cost = v;
+    }
+    if let Some(v) = cli.intersect_cost {
+        p.intersect_cost = v;
+    }
+    if let Some(v) = cli.empty_bonus {
+        p.empty_bonus = v;
+    }
+    if let Some(v) = cli.max_depth {
+        p.max_depth = v;
+    }
+    if let Some(v) = cli.leaf_size {
+        p.leaf_size = v;
+    }
+    if !(p.traversal_cost >= 0.0 && p.traversal_cost.is_finite()) {
+        bail!("--traversal-cost must be a finite number ≥ 0");
+    }
+    if !(p.intersect_cost > 0.0 && p.intersect_cost.is_finite()) {
+        bail!("--intersect-cost must be a finite number > 0");
+    }
+    if !(0.0..=1.0).contains(&p.empty_bonus) {
+        bail!("--empty-bonus must be between 0 and 1");
+    }
+    if p.max_depth > kdtree::build::MAX_DEPTH_LIMIT {
+        bail!(
+            "--max-depth {} is above the traversal's limit of {}",
+            p.max_depth,
+            kdtree::build::MAX_DEPTH_LIMIT
+        );
+    }
+    if p.leaf_size == 0 {
+        bail!("--leaf-size must be at least 1");
+    }
+    Ok(p)
+}
+
+/// Bytes a query structure holds per input triangle: 8-byte nodes, 4-byte leaf
+/// references and 36 bytes of vertices per triangle (see `Accel::memory_bytes`).
+fn bytes_per_triangle(kd: &KdFile) -> f64 {
+    let bytes = kd.nodes.len() * 8 + kd.leaf_tris.len() * 4 + kd.stats.triangles as usize * 36;
+    bytes as f64 / kd.stats.triangles.max(1) as f64
+}
+
+fn print_stats(path: &Path, json: bool) -> Result<()> {
+    let kd = KdFile::read(path)?;
+    let s = &kd.stats;
+    let full = s.leaves - s.empty_leaves;
+    let per_leaf = s.references as f64 / full.max(1) as f64;
+    let refs = s.references as f64 / s.triangles.max(1) as f64;
+    if json {
+        let v = serde_json::json!({
+            "path": path.display().to_string(),
+            "geometry_hash": formats::hex(&kd.geometry_hash),
+            "triangles": s.triangles, "nodes": s.nodes, "leaves": s.leaves,
+            "empty_leaves": s.empty_leaves, "max_depth": s.max_depth,
+            "references": s.references, "references_per_triangle": refs,
+            "triangles_per_leaf": per_leaf, "max_leaf_triangles": s.max_leaf_triangles,
+            "sah_cost": s.sah_cost, "build_seconds": s.build_seconds,
+            "bytes_per_triangle": bytes_per_triangle(&kd),
+            "params": {
+                "traversal_cost": kd.params.traversal_cost,
+                "intersect_cost": kd.params.intersect_cost,
+                "empty_bonus": kd.params.empty_bonus,
+                "max_depth": kd.params.max_depth,
+                "leaf_size": kd.params.leaf_size,
+            },
+        });
+        println!("{v}");
+    } else {
+        println!("{}", path.display());
+        println!("  geometry hash        {}", formats::hex(&kd.geometry_hash));
+        println!("  triangles            {}", s.triangles);
+        println!("  nodes                {}", s.nodes);
+        println!(
+            "  leaves               {} ({} empty)",
+            s.leaves, s.empty_leaves
+        );
+        println!("  max depth            {}", s.max_depth);
+        println!(
+            "  triangles per leaf   {per_leaf:.2} (non-empty leaves; max {})",
+            s.max_leaf_triangles
+        );
+        println!("  references/triangle  {refs:.3}");
+        println!("  SAH cost             {:.3}", s.sah_cost);
+        println!("  build time           {:.3} s", s.build_seconds);
+        println!(
+            "  bytes per triangle   {:.1} (nodes + leaf lists + vertices)",
+            bytes_per_triangle(&kd)
+        );
+        println!(
+            "  params               traversal {} intersect {} empty bonus {} max depth {} leaf size {}",
+            kd.params.traversal_cost,
+            kd.params.intersect_cost,
+            kd.params.empty_bonus,
+            kd.params.max_depth,
+            kd.params.leaf_size
+        );
+    }
+    Ok(())
+}
+
+fn run(cli: Cli) -> Result<()> {
+    if let Some(n) = cli.threads {
+        if n == 0 {
+            bail!("--threads must be at least 1");
+        }
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+            .context("cannot start the thread pool")?;
+    }
+    if let Some(path) = &cli.stats {
+        return print_stats(path, cli.json);
+    }
+    let Some(soup_path) = &cli.soup else {
+        usage_error("a soup file (or --stats FILE.kd) is required");
+    };
+    if cli.output.is_none() && cli.cache.is_none() {
+        usage_error("say where the tree goes: -o FILE.kd or --cache DIR");
+    }
+    let params = params(&cli)?;
+    let start = Instant::now();
+    let soup = Soup::read(soup_path)?;
+    let (path, cache) = match (&cli.output, &cli.cache) {
+        (Some(out), _) => (out.clone(), "none"),
+        (None, Some(dir)) => {
+            std::fs::create_dir_all(dir)
+                .with_context(|| format!("cannot create cache folder {}", dir.display()))?;
+            let path = dir.join(params.cache_name(&soup.geometry_hash));
+            let valid = path.exists()
+                && KdFile::read(&path)
+                    .is_ok_and(|kd| kd.geometry_hash == soup.geometry_hash && kd.params == params);
+            if valid {
+                return report(&cli, &soup, &KdFile::read(&path)?, &path, "hit", start);
+            }
+            (path, "miss")
+        }
+        (None, None) => unreachable!("checked above"),
+    };
+    let kd = kdtree::build(&soup.triangles, &params, soup.geometry_hash);
+    // Atomic (temp file + rename): concurrent builders of one cache entry both succeed.
+    kd.write(&path)?;
+    report(&cli, &soup, &kd, &path, cache, start)
+}
+
+fn report(
+    cli: &Cli,
+    soup: &Soup,
+    kd: &KdFile,
+    path: &Path,
+    cache: &str,
+    start: Instant,
+) -> Result<()> {
+    let s = &kd.stats;
+    let seconds = start.elapsed().as_secs_f64();
+    if cli.json {
+        let v = serde_json::json!({
+            "triangles": soup.triangles.len(), "nodes": s.nodes, "leaves": s.leaves,
+            "max_depth": s.max_depth, "sah_cost": s.sah_cost, "seconds": seconds,
+            "build_seconds": if cache == "hit" { 0.0 } else { s.build_seconds },
+            "bytes_per_triangle": bytes_per_triangle(kd),
+            "cache": cache, "path": path.display().to_string(),
+        });
+        println!("{v}");
+    } else if cache == "hit" {
+        eprintln!("cache hit: {}", path.display());
+    } else {
+        eprintln!(
+            "soup2kd: {} triangles -> {} nodes, {} leaves ({} empty), depth {}, {:.2} refs/triangle, SAH {:.2}, {:.1} bytes/triangle; built in {:.3} s{}",
+            soup.triangles.len(),
+            s.nodes,
+            s.leaves,
+            s.empty_leaves,
+            s.max_depth,
+            s.references as f64 / s.triangles.max(1) as f64,
+            s.sah_cost,
+            bytes_per_triangle(kd),
+            s.build_seconds,
+            if cache == "miss" { " (cache miss)" } else { "" }
+        );
+        eprintln!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+fn main() {
+    let cli = Cli::parse();
+    if let Err(e) = run(cli) {
+        eprintln!("soup2kd: {e:#}");
+        std::process::exit(1);
+    }
+}

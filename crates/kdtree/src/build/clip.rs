@@ -1,0 +1,153 @@
+//! Perfect splits: the bounds of the part of a triangle inside a cell.
+//!
+//! The triangle is clipped to the cell in f64 (Sutherland–Hodgman against the six planes)
+//! and the bounds of the clipped polygon are rounded outward to f32, then limited to the
+//! cell. Rounding outward means the f32 box always contains the true clipped part, so a
+//! triangle is never lost from a cell it enters; limiting to the cell keeps a flat cell's
+//! triangles flat (a planar event) instead of giving them a sliver of thickness.
+
+use crate::aabb::Aabb;
+use glam::Vec3;
+
+/// At most 3 + 6 vertices after clipping a triangle by six planes.
+const MAX_POLY: usize = 9;
+
+fn down(x: f64) -> f32 {
+    let f = x as f32;
+    if f as f64 > x {
+        f.next_down()
+    } else {
+        f
+    }
+}
+
+fn up(x: f64) -> f32 {
+    let f = x as f32;
+    if (f as f64) < x {
+        f.next_up()
+    } else {
+        f
+    }
+}
+
+/// Bounds of `tri ∩ cell`, or None when the triangle does not reach into the cell.
+pub fn clipped_bounds(tri: &[Vec3; 3], cell: &Aabb) -> Option<Aabb> {
+    let mut poly = [[0f64; 3]; MAX_POLY];
+    let mut n = 3;
+    for (i, v) in tri.iter().enumerate() {
+        poly[i] = [v.x as f64, v.y as f64, v.z as f64];
+    }
+    let mut next = [[0f64; 3]; MAX_POLY];
+    for axis in 0..3 {
+        for (plane, keep_above) in [(cell.lo[axis] as f64, true), (cell.hi[axis] as f64, false)] {
+            let inside = |p: &[f64; 3]| {
+                if keep_above {
+                    p[axis] >= plane
+                } else {
+                    p[axis] <= plane
+                }
+            };
+            let mut m = 0;
+            for i in 0..n {
+                let a = poly[i];
+                let b = poly[(i + 1) % n];
+                let (ia, ib) = (inside(&a), inside(&b));
+                if ia {
+                    next[m] = a;
+                    m += 1;
+                }
+                if ia != ib && m < MAX_POLY {
+                    let s = (plane - a[axis]) / (b[axis] - a[axis]);
+                    let mut p = [0f64; 3];
+                    for k in 0..3 {
+                        p[k] = a[k] + s * (b[k] - a[k]);
+                    }
+                    // The crossing point lies on the plane by construction.
+                    p[axis] = plane;
+                    next[m] = p;
+                    m += 1;
+                }
+            }
+            n = m;
+            if n == 0 {
+                return None;
+            }
+            poly[..n].copy_from_slice(&next[..n]);
+        }
+    }
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in &poly[..n] {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let mut b = Aabb::EMPTY;
+    for k in 0..3 {
+        b.lo[k] = down(lo[k]).max(cell.lo[k]);
+        b.hi[k] = up(hi[k]).min(cell.hi[k]);
+        if b.lo[k] > b.hi[k] {
+            return None;
+        }
+    }
+    Some(b)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cell(lo: [f32; 3], hi: [f32; 3]) -> Aabb {
+        Aabb { lo, hi }
+    }
+
+    #[test]
+    fn clipping_shrinks_to_the_part_inside() {
+        let t = [
+            Vec3::ZERO,
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(0.0, 2.0, 0.0),
+        ];
+        let b = clipped_bounds(&t, &cell([1.0, -1.0, -1.0], [3.0, 3.0, 1.0])).unwrap();
+        assert_eq!(b.lo, [1.0, 0.0, 0.0]);
+        assert_eq!(b.hi, [2.0, 1.0, 0.0]);
+    }
+
+    #[test]
+    fn corner_cell_outside_the_hypotenuse_is_empty() {
+        let t = [
+            Vec3::ZERO,
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(0.0, 2.0, 0.0),
+        ];
+        assert!(clipped_bounds(&t, &cell([1.5, 1.5, -1.0], [3.0, 3.0, 1.0])).is_none());
+    }
+
+    #[test]
+    fn flat_cell_keeps_its_planar_triangle() {
+        let t = [
+            Vec3::new(0.0, 0.5, 0.0),
+            Vec3::new(1.0, 0.5, 0.0),
+            Vec3::new(0.0, 0.5, 1.0),
+        ];
+        let b = clipped_bounds(&t, &cell([0.0, 0.5, 0.0], [0.25, 0.5, 1.0])).unwrap();
+        assert_eq!(b.lo, [0.0, 0.5, 0.0]);
+        assert_eq!(b.hi, [0.25, 0.5, 1.0]);
+    }
+
+    #[test]
+    fn bounds_are_rounded_outward() {
+        // The hypotenuse crosses x = 0.1 at y = 1.9 - something not representable in f32.
+        let t = [
+            Vec3::ZERO,
+            Vec3::new(3.0, 0.0, 0.0),
+            Vec3::new(0.0, 3.0, 0.0),
+        ];
+        let c = cell([0.1, 0.0, -1.0], [10.0, 10.0, 1.0]);
+        let b = clipped_bounds(&t, &c).unwrap();
+        let exact_y = 3.0 - 0.1f32 as f64;
+        assert!(b.hi[1] as f64 >= exact_y);
+        assert!((b.hi[1] as f64 - exact_y) < 1e-6);
+    }
+}

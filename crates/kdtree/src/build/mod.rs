@@ -1,0 +1,420 @@
+//! The SAH k-d tree compiler (Wald & Havran 2006, "On building fast kd-trees for ray
+//! tracing, and on doing that in O(N log N)").
+//!
+//! * Events are sorted once per axis and kept sorted through the splits: the triangles
+//!   that stay on one side keep their events (filtered in order), only the triangles that
+//!   straddle the split get new events, from clipping them to each child cell (perfect
+//!   splits, see [`clip`]), and those few are sorted and merged in.
+//! * Triangles lying in a candidate plane are tried on both sides; a split that cuts off
+//!   empty space gets the empty-space bonus; a node becomes a leaf when no split is
+//!   cheaper than intersecting all its triangles, at the depth bound, or at `leaf_size`.
+//! * Subtrees above [`PARALLEL_MIN`] triangles are built in parallel (`rayon::join`), and
+//!   the three axes' sweeps, classification and sorting run in parallel at those levels.
+
+pub mod clip;
+pub mod events;
+pub mod median;
+pub mod stats;
+
+use crate::aabb::Aabb;
+use events::{Event, END, PLANAR, START};
+use formats::{BuildParams, KdFile, KdNode};
+use glam::Vec3;
+use rayon::prelude::*;
+
+/// The traversal stack holds this many entries; the build never goes deeper.
+pub const MAX_DEPTH_LIMIT: u32 = 60;
+
+/// Nodes with at least this many triangles split their children into parallel tasks.
+const PARALLEL_MIN: usize = 8192;
+
+/// The depth bound in force: `params.max_depth`, or 8 + 1.3·log2(N) when it is 0, never
+/// above [`MAX_DEPTH_LIMIT`].
+pub fn depth_bound(params: &BuildParams, n: usize) -> u32 {
+    let d = if params.max_depth == 0 {
+        (8.0 + 1.3 * (n.max(1) as f64).log2()).round() as u32
+    } else {
+        params.max_depth
+    };
+    d.min(MAX_DEPTH_LIMIT)
+}
+
+struct Ctx<'a> {
+    tris: &'a [[Vec3; 3]],
+    kt: f64,
+    ki: f64,
+    bonus: f64,
+    leaf_size: usize,
+    max_depth: u32,
+}
+
+/// The triangles of one cell: global ids, and per axis the sorted events over local ids.
+struct Work {
+    tris: Vec<u32>,
+    events: [Vec<Event>; 3],
+    cell: Aabb,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Split {
+    cost: f64,
+    axis: usize,
+    pos: f32,
+    planar_below: bool,
+}
+
+/// A flattened subtree: node indices and leaf offsets relative to its own arrays.
+#[derive(Default)]
+struct Subtree {
+    nodes: Vec<KdNode>,
+    leaf_tris: Vec<u32>,
+}
+
+impl Subtree {
+    /// Append `other`, rebasing its child indices and leaf offsets.
+    fn append(&mut self, other: Subtree) {
+        let nb = self.nodes.len() as u32;
+        let tb = self.leaf_tris.len() as u32;
+        self.nodes.extend(other.nodes.into_iter().map(|n| {
+            if n.is_leaf() {
+                KdNode::leaf(n.count(), n.offset() + tb)
+            } else {
+                KdNode::interior(n.axis() as u32, n.split(), n.above_child() + nb)
+            }
+        }));
+        self.leaf_tris.extend(other.leaf_tris);
+    }
+}
+
+/// Build a tree over `triangles` (soup order). Non-finite triangles are left out (the
+/// soup reader refuses them anyway); every other triangle, degenerate ones included, is
+/// in the tree, so the tree answers exactly what a brute-force loop would.
+pub fn build(
+    triangles: &[[Vec3; 3]],
+    params: &BuildParams,
+    geometry_hash: formats::Digest,
+) -> KdFile {
+    let start = std::time::Instant::now();
+    let n = triangles.len();
+    let ctx = Ctx {
+        tris: triangles,
+        kt: params.traversal_cost.max(0.0) as f64,
+        ki: (params.intersect_cost as f64).max(1e-6),
+        bonus: (params.empty_bonus as f64).clamp(0.0, 1.0),
+        leaf_size: params.leaf_size.max(1) as usize,
+        max_depth: depth_bound(params, n),
+    };
+    let ids: Vec<u32> = (0..n as u32)
+        .filter(|&i| triangles[i as usize].iter().all(|v| v.is_finite()))
+        .collect();
+    let boxes: Vec<Aabb> = ids
+        .iter()
+        .map(|&i| Aabb::of_triangle(&triangles[i as usize]))
+        .collect();
+    let cell = boxes.iter().fold(Aabb::EMPTY, |a, b| a.union(b));
+    let parallel = ids.len() >= PARALLEL_MIN;
+    let events: Vec<Vec<Event>> = (0..3)
+        .into_par_iter()
+        .map(|axis| {
+            let mut ev = Vec::with_capacity(2 * boxes.len());
+            for (local, b) in boxes.iter().enumerate() {
+                events::push_events(&mut ev, b, axis, local as u32);
+            }
+            events::sort(&mut ev, parallel);
+            ev
+        })
+        .collect();
+    let [ex, ey, ez]: [Vec<Event>; 3] = events.try_into().expect("three axes");
+    drop(boxes);
+    let work = Work {
+        tris: ids,
+        events: [ex, ey, ez],
+        cell,
+    };
+    let tree = if work.tris.is_empty() {
+        Subtree {
+            nodes: vec![KdNode::leaf(0, 0)],
+            leaf_tris: vec![],
+        }
+    } else {
+        build_sub(&ctx, work, 0)
+    };
+    let bounds = if cell.is_empty() {
+        [Vec3::ZERO; 2]
+    } else {
+        cell.to_vec3()
+    };
+    let mut kd = KdFile {
+        geometry_hash,
+        params: *params,
+        stats: Default::default(),
+        bounds,
+        nodes: tree.nodes,
+        leaf_tris: tree.leaf_tris,
+    };
+    kd.stats = stats::measure(&kd, n as u64, params);
+    kd.stats.build_seconds = start.elapsed().as_secs_f64();
+    kd
+}
+
+fn build_sub(ctx: &Ctx, w: Work, depth: u32) -> Subtree {
+    let mut out = Subtree::default();
+    build_rec(ctx, w, depth, &mut out);
+    out
+}
+
+fn make_leaf(w: Work, out: &mut Subtree) {
+    out.nodes.push(KdNode::leaf(
+        w.tris.len() as u32,
+        out.leaf_tris.len() as u32,
+    ));
+    out.leaf_tris.extend_from_slice(&w.tris);
+}
+
+fn build_rec(ctx: &Ctx, w: Work, depth: u32, out: &mut Subtree) {
+    let n = w.tris.len();
+    if n <= ctx.leaf_size || depth >= ctx.max_depth {
+        return make_leaf(w, out);
+    }
+    let parallel = n >= PARALLEL_MIN;
+    let split = match find_split(ctx, &w, parallel) {
+        Some(s) if s.cost < ctx.ki * n as f64 => s,
+        _ => return make_leaf(w, out),
+    };
+    let (below, above) = split_work(ctx, w, &split, parallel);
+    let at = out.nodes.len();
+    out.nodes.push(KdNode::leaf(0, 0)); // placeholder, set once `above` has an index
+    if parallel {
+        let (b, a) = rayon::join(
+            || build_sub(ctx, below, depth + 1),
+            || build_sub(ctx, above, depth + 1),
+        );
+        out.append(b);
+        let above_at = out.nodes.len() as u32;
+        out.append(a);
+        out.nodes[at] = KdNode::interior(split.axis as u32, split.pos, above_at);
+    } else {
+        build_rec(ctx, below, depth + 1, out);
+        let above_at = out.nodes.len() as u32;
+        build_rec(ctx, above, depth + 1, out);
+        out.nodes[at] = KdNode::interior(split.axis as u32, split.pos, above_at);
+    }
+}
+
+fn find_split(ctx: &Ctx, w: &Work, parallel: bool) -> Option<Split> {
+    let area = w.cell.area();
+    if !(area > 0.0) || !area.is_finite() {
+        return None;
+    }
+    let sweep = |axis: usize| sweep_axis(ctx, &w.events[axis], axis, w.tris.len(), &w.cell, area);
+    let best = if parallel {
+        let (a, (b, c)) = rayon::join(|| sweep(0), || rayon::join(|| sweep(1), || sweep(2)));
+        [a, b, c]
+    } else {
+        [sweep(0), sweep(1), sweep(2)]
+    };
+    best.into_iter()
+        .flatten()
+        .min_by(|a, b| a.cost.total_cmp(&b.cost))
+}
+
+/// One linear sweep over an axis's sorted events, evaluating the SAH at every distinct
+/// position strictly inside the cell (a plane on the cell's face separates nothing).
+fn sweep_axis(
+    ctx: &Ctx,
+    ev: &[Event],
+    axis: usize,
+    n: usize,
+    cell: &Aabb,
+    area: f64,
+) -> Option<Split> {
+    let lo = cell.lo[axis];
+    let hi = cell.hi[axis];
+    if !(lo < hi) {
+        return None;
+    }
+    let e: [f64; 3] = std::array::from_fn(|a| cell.hi[a] as f64 - cell.lo[a] as f64);
+    let (o1, o2) = ((axis + 1) % 3, (axis + 2) % 3);
+    let cap = e[o1] * e[o2];
+    let ring = e[o1] + e[o2];
+    let inv_area = 1.0 / area;
+    let (mut nl, mut nr) = (0usize, n);
+    let mut best: Option<Split> = None;
+    let mut i = 0;
+    while i < ev.len() {
+        let p = ev[i].pos;
+        let (mut pe, mut pp, mut ps) = (0, 0, 0);
+        while i < ev.len() && ev[i].pos == p && ev[i].kind() == END {
+            pe += 1;
+            i += 1;
+        }
+        while i < ev.len() && ev[i].pos == p && ev[i].kind() == PLANAR {
+            pp += 1;
+            i += 1;
+        }
+        while i < ev.len() && ev[i].pos == p && ev[i].kind() == START {
+            ps += 1;
+            i += 1;
+        }
+        let np = pp;
+        nr -= pp + pe;
+        if p > lo && p < hi {
+            let dl = p as f64 - lo as f64;
+            let dr = hi as f64 - p as f64;
+            let pl = 2.0 * (cap + dl * ring) * inv_area;
+            let pr = 2.0 * (cap + dr * ring) * inv_area;
+            let cost = |l: usize, r: usize| {
+                let lambda = if l == 0 || r == 0 {
+                    1.0 - ctx.bonus
+                } else {
+                    1.0
+                };
+                ctx.kt + ctx.ki * lambda * (pl * l as f64 + pr * r as f64)
+            };
+            let c_below = cost(nl + np, nr);
+            let c_above = cost(nl, nr + np);
+            let (c, planar_below) = if c_below <= c_above {
+                (c_below, true)
+            } else {
+                (c_above, false)
+            };
+            if best.is_none_or(|b| c < b.cost) {
+                best = Some(Split {
+                    cost: c,
+                    axis,
+                    pos: p,
+                    planar_below,
+                });
+            }
+        }
+        nl += ps + pp;
+    }
+    best
+}
+
+const BELOW: u8 = 1;
+const ABOVE: u8 = 2;
+const BOTH: u8 = 3;
+
+/// Classify the triangles against the split and build both children's work, keeping each
+/// axis's events sorted.
+fn split_work(ctx: &Ctx, w: Work, s: &Split, parallel: bool) -> (Work, Work) {
+    let n = w.tris.len();
+    let mut side = vec![BOTH; n];
+    for e in &w.events[s.axis] {
+        let t = e.tri() as usize;
+        match e.kind() {
+            END if e.pos <= s.pos => side[t] = BELOW,
+            START if e.pos >= s.pos => side[t] = ABOVE,
+            PLANAR => {
+                side[t] = if e.pos < s.pos || (e.pos == s.pos && s.planar_below) {
+                    BELOW
+                } else {
+                    ABOVE
+                }
+            }
+            _ => {}
+        }
+    }
+    let (cell_b, cell_a) = w.cell.split(s.axis, s.pos);
+    // Straddling triangles: clip to each child (perfect splits). A triangle whose box
+    // straddles the plane may still miss one child entirely; it then leaves that child.
+    let straddlers: Vec<usize> = (0..n).filter(|&i| side[i] == BOTH).collect();
+    let clip = |&i: &usize| {
+        let tri = &ctx.tris[w.tris[i] as usize];
+        (
+            clip::clipped_bounds(tri, &cell_b),
+            clip::clipped_bounds(tri, &cell_a),
+        )
+    };
+    let clipped: Vec<(Option<Aabb>, Option<Aabb>)> = if straddlers.len() > 4096 {
+        straddlers.par_iter().map(clip).collect()
+    } else {
+        straddlers.iter().map(clip).collect()
+    };
+    // Local indices in each child: kept triangles first in parent order, then straddlers.
+    let mut map_b = vec![u32::MAX; n];
+    let mut map_a = vec![u32::MAX; n];
+    let mut tris_b = Vec::new();
+    let mut tris_a = Vec::new();
+    for i in 0..n {
+        match side[i] {
+            BELOW => {
+                map_b[i] = tris_b.len() as u32;
+                tris_b.push(w.tris[i]);
+            }
+            ABOVE => {
+                map_a[i] = tris_a.len() as u32;
+                tris_a.push(w.tris[i]);
+            }
+            _ => {}
+        }
+    }
+    let mut new_b = Vec::new(); // (local index in child, clipped box)
+    let mut new_a = Vec::new();
+    for (&i, (cb, ca)) in straddlers.iter().zip(&clipped) {
+        if let Some(b) = cb {
+            new_b.push((tris_b.len() as u32, *b));
+            tris_b.push(w.tris[i]);
+        }
+        if let Some(b) = ca {
+            new_a.push((tris_a.len() as u32, *b));
+            tris_a.push(w.tris[i]);
+        }
+    }
+    let child_events = |axis: usize, ev: &Vec<Event>| -> (Vec<Event>, Vec<Event>) {
+        let mut eb = Vec::with_capacity(ev.len() / 2 + 2 * new_b.len());
+        let mut ea = Vec::with_capacity(ev.len() / 2 + 2 * new_a.len());
+        for e in ev {
+            let t = e.tri() as usize;
+            match side[t] {
+                BELOW => eb.push(Event {
+                    pos: e.pos,
+                    code: (map_b[t] << 2) | e.kind(),
+                }),
+                ABOVE => ea.push(Event {
+                    pos: e.pos,
+                    code: (map_a[t] << 2) | e.kind(),
+                }),
+                _ => {}
+            }
+        }
+        let fresh = |list: &[(u32, Aabb)]| {
+            let mut v = Vec::with_capacity(2 * list.len());
+            for (t, b) in list {
+                events::push_events(&mut v, b, axis, *t);
+            }
+            events::sort(&mut v, false);
+            v
+        };
+        (
+            events::merge(eb, fresh(&new_b)),
+            events::merge(ea, fresh(&new_a)),
+        )
+    };
+    let Work { events: ev, .. } = w;
+    let [ex, ey, ez] = ev;
+    let ((bx, ax), ((by, ay), (bz, az))) = if parallel {
+        rayon::join(
+            || child_events(0, &ex),
+            || rayon::join(|| child_events(1, &ey), || child_events(2, &ez)),
+        )
+    } else {
+        (
+            child_events(0, &ex),
+            (child_events(1, &ey), child_events(2, &ez)),
+        )
+    };
+    (
+        Work {
+            tris: tris_b,
+            events: [bx, by, bz],
+            cell: cell_b,
+        },
+        Work {
+            tris: tris_a,
+            events: [ax, ay, az],
+            cell: cell_a,
+        },
+    )
+}

@@ -1,0 +1,333 @@
+//! Front-to-back k-d tree traversal with a fixed-size stack.
+//!
+//! Robustness rules (DESIGN §7, docs/ROBUSTNESS.md):
+//! * A direction component that is ±0 (or so small that its reciprocal overflows) never
+//!   enters a product with an infinity: the ray is parallel to that axis's planes, and the
+//!   side of a split is decided from the origin alone; a ray lying *in* a split plane
+//!   visits both children over its whole interval.
+//! * Which child comes first is decided by the direction's sign alone (the child the ray
+//!   comes from, then the one it goes to), so an origin on a split plane is handled by the
+//!   same code as every other origin.
+//! * The plane distance is compared with the cell's interval padded by a few ulps, so a
+//!   cell the ray only grazes is visited rather than skipped by rounding.
+//! * NaN or infinite rays, zero directions and empty intervals are misses, never a hang.
+//!
+//! The `ROBUST = false` instantiation (plain Möller–Trumbore, unpadded intervals and
+//! plain IEEE arithmetic on ±0) exists only for the robustness-cost benchmark.
+
+use crate::aabb::Aabb;
+use crate::triangle::{self, RawHit, RayPre};
+use crate::Ray;
+use formats::{Hit, KdNode};
+use glam::Vec3;
+
+/// Entries of the traversal stack (≥ the build's depth bound, which is at most 60).
+pub const STACK: usize = 64;
+
+/// Relative padding of cell intervals: a few ulps of the plane-distance computation
+/// ((s − o)·(1/d) rounds three times).
+const PAD: f32 = 4.0 * f32::EPSILON;
+
+#[inline(always)]
+fn pad_up(t: f32) -> f32 {
+    t + t.abs() * PAD
+}
+
+#[inline(always)]
+fn pad_down(t: f32) -> f32 {
+    t - t.abs() * PAD
+}
+
+pub(crate) struct Tree<'a> {
+    pub tris: &'a [[[f32; 3]; 3]],
+    pub nodes: &'a [KdNode],
+    pub leaf_tris: &'a [u32],
+    pub bounds: &'a Aabb,
+}
+
+/// Per-ray traversal constants.
+struct Setup {
+    pre: RayPre,
+    o: [f32; 3],
+    inv: [f32; 3],
+    parallel: [bool; 3],
+    t0: f32,
+    t1: f32,
+}
+
+/// None when the ray cannot hit anything (bad numbers, empty interval, misses the box).
+#[inline(always)]
+fn setup<const ROBUST: bool>(ray: &Ray, b: &Aabb) -> Option<Setup> {
+    if !(ray.tmin <= ray.tmax) || ray.tmax == f32::NEG_INFINITY || ray.tmin == f32::INFINITY {
+        return None;
+    }
+    let pre = RayPre::new(ray.origin, ray.dir)?;
+    let o = ray.origin.to_array();
+    let d = ray.dir.to_array();
+    let inv = [1.0 / d[0], 1.0 / d[1], 1.0 / d[2]];
+    let parallel = if ROBUST {
+        [
+            !inv[0].is_finite(),
+            !inv[1].is_finite(),
+            !inv[2].is_finite(),
+        ]
+    } else {
+        [false; 3]
+    };
+    let (mut t0, mut t1) = (ray.tmin, ray.tmax);
+    for a in 0..3 {
+        if parallel[a] {
+            if o[a] < b.lo[a] || o[a] > b.hi[a] {
+                return None;
+            }
+        } else {
+            let ta = (b.lo[a] - o[a]) * inv[a];
+            let tb = (b.hi[a] - o[a]) * inv[a];
+            let (near, far) = if inv[a] > 0.0 { (ta, tb) } else { (tb, ta) };
+            if ROBUST {
+                t0 = t0.max(near);
+                t1 = t1.min(far);
+            } else {
+                // Plain slabs: NaN from 0·inf falls through as in textbook code.
+                if near > t0 {
+                    t0 = near;
+                }
+                if far < t1 {
+                    t1 = far;
+                }
+            }
+        }
+    }
+    let open = if ROBUST {
+        pad_down(t0) <= pad_up(t1)
+    } else {
+        t0 <= t1
+    };
+    open.then_some(Setup {
+        pre,
+        o,
+        inv,
+        parallel,
+        t0,
+        t1,
+    })
+}
+
+#[inline(always)]
+fn test<const ROBUST: bool>(
+    s: &Setup,
+    ray: &Ray,
+    tri: &[[f32; 3]; 3],
+    tmax: f32,
+) -> Option<RawHit> {
+    if ROBUST {
+        triangle::intersect(&s.pre, tri, ray.tmin, tmax)
+    } else {
+        triangle::intersect_moller(ray.origin, ray.dir, tri, ray.tmin, tmax)
+    }
+}
+
+/// Children of interior node `i` to visit, in order, with their intervals.
+enum Step {
+    One(u32),
+    Two {
+        first: u32,
+        second: u32,
+        t_split: f32,
+    },
+    /// Ray in the split plane: both children over the whole interval.
+    Both,
+}
+
+#[inline(always)]
+fn step<const ROBUST: bool>(s: &Setup, i: u32, node: KdNode, t0: f32, t1: f32) -> Step {
+    let a = node.axis();
+    let below = i + 1;
+    let above = node.above_child();
+    let diff = node.split() - s.o[a];
+    if ROBUST && s.parallel[a] {
+        return if diff > 0.0 {
+            Step::One(below)
+        } else if diff < 0.0 {
+            Step::One(above)
+        } else {
+            Step::Both
+        };
+    }
+    let tp = diff * s.inv[a];
+    if ROBUST {
+        // The ray comes from the side opposite its direction and goes to the other.
+        let (first, second) = if s.inv[a] > 0.0 {
+            (below, above)
+        } else {
+            (above, below)
+        };
+        if tp > pad_up(t1) {
+            Step::One(first)
+        } else if tp < pad_down(t0) {
+            Step::One(second)
+        } else {
+            Step::Two {
+                first,
+                second,
+                t_split: tp,
+            }
+        }
+    } else {
+        // pbrt-v3's textbook rule.
+        let o = s.o[a];
+        let split = node.split();
+        let below_first = o < split || (o == split && s.inv[a] <= 0.0);
+        let (first, second) = if below_first {
+            (below, above)
+        } else {
+            (above, below)
+        };
+        if tp > t1 || tp <= 0.0 {
+            Step::One(first)
+        } else if tp < t0 {
+            Step::One(second)
+        } else {
+            Step::Two {
+                first,
+                second,
+                t_split: tp,
+            }
+        }
+    }
+}
+
+impl Tree<'_> {
+    /// Closest hit in [tmin, tmax]; ties in t go to the lower triangle index (so the
+    /// answer is the brute-force loop's, whatever the leaf order).
+    #[inline(always)]
+    pub fn closest<const ROBUST: bool>(&self, ray: &Ray) -> Option<Hit> {
+        let s = setup::<ROBUST>(ray, self.bounds)?;
+        let mut best = Hit::MISS;
+        let mut best_t = ray.tmax;
+        let mut stack = [(0u32, 0f32, 0f32); STACK];
+        let mut sp = 0;
+        let (mut node_i, mut t0, mut t1) = (0u32, s.t0, s.t1);
+        loop {
+            let node = self.nodes[node_i as usize];
+            if !node.is_leaf() {
+                match step::<ROBUST>(&s, node_i, node, t0, t1) {
+                    Step::One(c) => node_i = c,
+                    Step::Two {
+                        first,
+                        second,
+                        t_split,
+                    } => {
+                        stack[sp] = (second, t_split, t1);
+                        sp += 1;
+                        node_i = first;
+                        t1 = t_split;
+                    }
+                    Step::Both => {
+                        stack[sp] = (node.above_child(), t0, t1);
+                        sp += 1;
+                        node_i += 1;
+                    }
+                }
+                continue;
+            }
+            let off = node.offset() as usize;
+            for &p in &self.leaf_tris[off..off + node.count() as usize] {
+                if let Some(h) = test::<ROBUST>(&s, ray, &self.tris[p as usize], best_t) {
+                    if h.t < best_t || p < best.prim {
+                        best_t = h.t;
+                        best = Hit {
+                            t: h.t,
+                            prim: p,
+                            u: h.u,
+                            v: h.v,
+                        };
+                    }
+                }
+            }
+            // Next cell, skipping those that start beyond the closest hit.
+            loop {
+                if sp == 0 {
+                    return (!best.is_miss()).then_some(best);
+                }
+                sp -= 1;
+                (node_i, t0, t1) = stack[sp];
+                let enter = if ROBUST { pad_down(t0) } else { t0 };
+                if best_t >= enter {
+                    break;
+                }
+            }
+        }
+    }
+
+    /// Whether any triangle is hit in [tmin, tmax]; stops at the first one found.
+    #[inline(always)]
+    pub fn any<const ROBUST: bool>(&self, ray: &Ray) -> bool {
+        let Some(s) = setup::<ROBUST>(ray, self.bounds) else {
+            return false;
+        };
+        let mut stack = [(0u32, 0f32, 0f32); STACK];
+        let mut sp = 0;
+        let (mut node_i, mut t0, mut t1) = (0u32, s.t0, s.t1);
+        loop {
+            let node = self.nodes[node_i as usize];
+            if !node.is_leaf() {
+                match step::<ROBUST>(&s, node_i, node, t0, t1) {
+                    Step::One(c) => node_i = c,
+                    Step::Two {
+                        first,
+                        second,
+                        t_split,
+                    } => {
+                        stack[sp] = (second, t_split, t1);
+                        sp += 1;
+                        node_i = first;
+                        t1 = t_split;
+                    }
+                    Step::Both => {
+                        stack[sp] = (node.above_child(), t0, t1);
+                        sp += 1;
+                        node_i += 1;
+                    }
+                }
+                continue;
+            }
+            let off = node.offset() as usize;
+            for &p in &self.leaf_tris[off..off + node.count() as usize] {
+                if test::<ROBUST>(&s, ray, &self.tris[p as usize], ray.tmax).is_some() {
+                    return true;
+                }
+            }
+            if sp == 0 {
+                return false;
+            }
+            sp -= 1;
+            (node_i, t0, t1) = stack[sp];
+        }
+    }
+}
+
+/// Brute-force closest hit with the same intersector and tie rule as the tree.
+pub(crate) fn brute_closest(tris: &[[Vec3; 3]], ray: &Ray) -> Option<Hit> {
+    if !(ray.tmin <= ray.tmax) || ray.tmax == f32::NEG_INFINITY || ray.tmin == f32::INFINITY {
+        return None;
+    }
+    let pre = RayPre::new(ray.origin, ray.dir)?;
+    let mut best = Hit::MISS;
+    let mut best_t = ray.tmax;
+    for (i, t) in tris.iter().enumerate() {
+        let tri = [t[0].to_array(), t[1].to_array(), t[2].to_array()];
+        if let Some(h) = triangle::intersect(&pre, &tri, ray.tmin, best_t) {
+            if h.t < best_t || (i as u32) < best.prim {
+                best_t = h.t;
+                best = Hit {
+                    t: h.t,
+                    prim: i as u32,
+                    u: h.u,
+                    v: h.v,
+                };
+            }
+        }
+    }
+    (!best.is_miss()).then_some(best)
+}

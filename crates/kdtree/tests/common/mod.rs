@@ -1,0 +1,3 @@
+//! Test scenes: see `kdtree::gen`.
+#![allow(unused_imports)]
+pub use kdtree::gen::*;
