@@ -202,9 +202,11 @@ fn agreement(r: &Report, out: &mut String) {
     out.push_str(
         "## Agreement with the k-d tree\n\n\
          Closest hit: same triangle, or t within 1e-4 relative (ties at shared edges); \
-         shadow: same occlusion answer. The bar is 99.99% of rays.\n\n\
-         | scene | contender | primary differ | shadow differ | random differ | agreement | verdict |\n\
-         |---|---|---:|---:|---:|---:|:---:|\n",
+         shadow: same occlusion answer. The bar is 99.99% of rays. Where the k-d tree and \
+         Embree differ, brute force (f64) re-traces up to 200 of those rays per set: the last \
+         column counts how often it sides with each (both on ties, neither when all three differ).\n\n\
+         | scene | contender | primary differ | shadow differ | random differ | agreement | verdict | brute force sides with kdtree / other, of |\n\
+         |---|---|---:|---:|---:|---:|:---:|---:|\n",
     );
     for s in &r.scenes {
         for who in [EMBREE, BRUTE] {
@@ -219,15 +221,27 @@ fn agreement(r: &Report, out: &mut String) {
             };
             let worst = rows.iter().map(|a| a.agreement()).fold(1.0f64, f64::min);
             let ok = rows.iter().all(|a| a.ok());
+            let referee =
+                rows.iter()
+                    .filter_map(|a| a.referee)
+                    .reduce(|a, b| crate::run::Referee {
+                        checked: a.checked + b.checked,
+                        kdtree_right: a.kdtree_right + b.kdtree_right,
+                        other_right: a.other_right + b.other_right,
+                    });
             let _ = writeln!(
                 out,
-                "| {} | {who} | {} | {} | {} | {:.4}% | {} |",
+                "| {} | {who} | {} | {} | {} | {:.4}% | {} | {} |",
                 s.name,
                 cell(Kind::Primary),
                 cell(Kind::Shadow),
                 cell(Kind::Random),
                 worst * 100.0,
-                if ok { "ok" } else { "**FAIL**" }
+                if ok { "ok" } else { "**FAIL**" },
+                opt(referee, |r| format!(
+                    "{} / {} of {}",
+                    r.kdtree_right, r.other_right, r.checked
+                ))
             );
         }
     }

@@ -134,6 +134,8 @@ pub struct AgreeRow {
     pub disagreements: usize,
     /// The first few disagreements, for the log.
     pub examples: Vec<String>,
+    /// Brute force's verdict on the disagreements (Embree rows only).
+    pub referee: Option<Referee>,
 }
 
 impl AgreeRow {
@@ -331,7 +333,9 @@ impl Bench<'_> {
     }
 
     /// Compare `other`'s answers with the k-d tree's (`reference`, indexed through `idx`
-    /// when `other` ran on a subset).
+    /// when `other` ran on a subset). With `referee` triangles, up to [`REFEREE_RAYS`]
+    /// disagreements are settled by brute force.
+    #[allow(clippy::too_many_arguments)]
     fn agree(
         &mut self,
         other: &str,
@@ -340,58 +344,90 @@ impl Bench<'_> {
         reference: &Answers,
         answers: &Answers,
         idx: Option<&[usize]>,
+        referee: Option<&[[Vec3; 3]]>,
     ) {
+        let at = |j: usize| idx.map_or(j, |idx| idx[j]);
+        // (ray index, the tree's answer, the other's answer) for every disagreement.
+        let mut differ: Vec<(usize, Found, Found)> = vec![];
+        let compared = match (reference, answers) {
+            (Answers::Closest(r), Answers::Closest(a)) => {
+                for (j, b) in a.iter().enumerate() {
+                    let i = at(j);
+                    if !same_closest(r[i], *b) {
+                        differ.push((i, r[i], *b));
+                    }
+                }
+                a.len()
+            }
+            (Answers::Occluded(r), Answers::Occluded(a)) => {
+                // Occlusion as a hit at t = 0 on no particular triangle, to share the code.
+                let f = |o: bool| Found {
+                    t: if o { 0.0 } else { f32::INFINITY },
+                    prim: if o { 0 } else { u32::MAX },
+                    ..Found::default()
+                };
+                for (j, b) in a.iter().enumerate() {
+                    let i = at(j);
+                    if r[i] != *b {
+                        differ.push((i, f(r[i]), f(*b)));
+                    }
+                }
+                a.len()
+            }
+            _ => unreachable!("answers of one kind are compared with the same kind"),
+        };
         let mut row = AgreeRow {
             scene: self.out.name.clone(),
             other: other.into(),
             kind,
-            compared: 0,
-            disagreements: 0,
+            compared,
+            disagreements: differ.len(),
             examples: vec![],
+            referee: None,
         };
-        let at = |j: usize| idx.map_or(j, |idx| idx[j]);
-        match (reference, answers) {
-            (Answers::Closest(r), Answers::Closest(a)) => {
-                for (j, b) in a.iter().enumerate() {
-                    let i = at(j);
-                    row.compared += 1;
-                    if !same_closest(r[i], *b) {
-                        row.disagreements += 1;
-                        if row.examples.len() < 3 {
-                            row.examples.push(format!(
-                                "{} ray {i} {:?}: kdtree t={} prim={}, {other} t={} prim={}",
-                                kind.name(),
-                                rays[i],
-                                r[i].t,
-                                r[i].prim as i64,
-                                b.t,
-                                b.prim as i64
-                            ));
-                        }
-                    }
-                }
+        let show = |f: Found| {
+            if !f.is_hit() {
+                "miss".to_string()
+            } else if kind == Kind::Shadow {
+                "occluded".to_string()
+            } else {
+                format!("t={} prim={}", f.t, f.prim)
             }
-            (Answers::Occluded(r), Answers::Occluded(a)) => {
-                for (j, b) in a.iter().enumerate() {
-                    let i = at(j);
-                    row.compared += 1;
-                    if r[i] != *b {
-                        row.disagreements += 1;
-                        if row.examples.len() < 3 {
-                            row.examples.push(format!(
-                                "{} ray {i} {:?}: kdtree occluded={}, {other} occluded={b}",
-                                kind.name(),
-                                rays[i],
-                                r[i]
-                            ));
-                        }
-                    }
-                }
-            }
-            _ => unreachable!("answers of one kind are compared with the same kind"),
+        };
+        for (i, k, o) in differ.iter().take(3) {
+            row.examples.push(format!(
+                "{} ray {i} {:?}: kdtree {}, {other} {}",
+                kind.name(),
+                rays[*i],
+                show(*k),
+                show(*o)
+            ));
         }
+        if let Some(tris) = referee.filter(|_| !differ.is_empty()) {
+            let mut r = Referee::default();
+            for (i, k, o) in differ.iter().take(REFEREE_RAYS) {
+                let ray = &rays[*i];
+                let truth = if kind == Kind::Shadow {
+                    let occ = crate::brute::occluded(tris, ray);
+                    (occ == k.is_hit(), occ == o.is_hit())
+                } else {
+                    let b = Brute(tris).closest(ray);
+                    (same_closest(b, *k), same_closest(b, *o))
+                };
+                r.checked += 1;
+                r.kdtree_right += usize::from(truth.0);
+                r.other_right += usize::from(truth.1);
+            }
+            row.referee = Some(r);
+        }
+        let referee_note = row.referee.map_or(String::new(), |r| {
+            format!(
+                "; brute force on {} of them sides with kdtree {} times, with {other} {} times",
+                r.checked, r.kdtree_right, r.other_right
+            )
+        });
         (self.log)(&format!(
-            "  agreement kdtree vs {other} ({}): {} of {} rays differ",
+            "  agreement kdtree vs {other} ({}): {} of {} rays differ{referee_note}",
             kind.name(),
             row.disagreements,
             row.compared
@@ -401,6 +437,19 @@ impl Bench<'_> {
         }
         self.out.agreement.push(row);
     }
+}
+
+/// At most this many disagreements per ray set are settled by brute force (each costs
+/// a pass over every triangle).
+pub const REFEREE_RAYS: usize = 200;
+
+/// Brute force's verdict on disagreeing rays (a ray can side with both when the two
+/// answers are ties, or with neither).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Referee {
+    pub checked: usize,
+    pub kdtree_right: usize,
+    pub other_right: usize,
 }
 
 /// Indices of every `len / n`-th element (at most `n`), spread over the whole set.
@@ -538,13 +587,13 @@ fn run_scene(
         #[cfg(feature = "embree")]
         if let Some(e) = &embree {
             let answers = b.traverse(EMBREE, e, kind, set);
-            b.agree(EMBREE, kind, set, &reference, &answers, None);
+            b.agree(EMBREE, kind, set, &reference, &answers, None, Some(tris));
         }
         if let Some(brute) = &brute {
             let idx = subset_indices(set.len(), cfg.brute_rays);
             let sub: Vec<Ray> = idx.iter().map(|&i| set[i]).collect();
             let answers = b.traverse(BRUTE, brute, kind, &sub);
-            b.agree(BRUTE, kind, set, &reference, &answers, Some(&idx));
+            b.agree(BRUTE, kind, set, &reference, &answers, Some(&idx), None);
         }
         if kind == Kind::Primary {
             // Shadow rays start at the k-d tree's primary hits.
@@ -575,7 +624,10 @@ fn header(cfg: &Config) -> Vec<String> {
     let p = &cfg.params;
     let mut h = vec![
         format!("date: {}", utc_now()),
-        format!("machine: nproc {nproc}, CPU {cpu}"),
+        format!(
+            "machine: nproc {nproc}, CPU {cpu}; load average at start {} (other processes share the cores: compare contenders within a run, not across runs)",
+            load_average()
+        ),
         format!("command: `{}`", cfg.command),
         format!(
             "kdtree build parameters: traversal cost {}, intersection cost {}, empty bonus {}, max depth {}, leaf size {}",
@@ -616,6 +668,15 @@ fn header(cfg: &Config) -> Vec<String> {
     h
 }
 
+/// The 1, 5 and 15 minute load averages from /proc/loadavg ("unknown" elsewhere).
+pub fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .filter(|s| !s.is_empty())
+        .unwrap_or_else(|| "unknown".into())
+}
+
 /// `YYYY-MM-DD HH:MM UTC` from the system clock (civil-from-days, Howard Hinnant).
 pub fn utc_now() -> String {
     let secs = std::time::SystemTime::now()
@@ -643,6 +704,7 @@ pub fn utc_now() -> String {
 /// Missing inputs (no baseline soup, no mesh folder) are skipped with a note; a file
 /// that exists but cannot be read is an error.
 pub fn run(cfg: &Config, log: &mut dyn FnMut(&str)) -> Result<Report, BenchError> {
+    let header_start = header(cfg);
     let mut notes = vec![];
     let mut scenes_out = vec![];
     let skip = |notes: &mut Vec<String>, log: &mut dyn FnMut(&str), msg: String| {
@@ -698,9 +760,11 @@ pub fn run(cfg: &Config, log: &mut dyn FnMut(&str)) -> Result<Report, BenchError
         notes.extend(scene.notes.iter().cloned());
         scenes_out.push(run_scene(cfg, &scene, Role::Generated, log)?);
     }
+    let mut header = header_start;
+    header.push(format!("load average at the end: {}", load_average()));
     Ok(Report {
         config: cfg.clone(),
-        header: header(cfg),
+        header,
         scenes: scenes_out,
         notes,
     })
@@ -723,6 +787,81 @@ mod tests {
         assert!(same_closest(hit(2.0, 3), hit(2.0001, 4)));
         assert!(!same_closest(hit(2.0, 3), hit(2.1, 4)));
         assert!(!same_closest(hit(2.0, 3), Found::default()));
+    }
+
+    #[test]
+    fn brute_force_settles_disagreements() {
+        let tris = [[
+            Vec3::new(-1.0, -1.0, 2.0),
+            Vec3::new(1.0, -1.0, 2.0),
+            Vec3::new(0.0, 1.0, 2.0),
+        ]];
+        let rays = [
+            rays::ray(Vec3::ZERO, Vec3::Z, 0.0, f32::INFINITY),
+            rays::ray(Vec3::new(5.0, 0.0, 0.0), Vec3::Z, 0.0, f32::INFINITY),
+        ];
+        let hit = Found {
+            t: 2.0,
+            prim: 0,
+            u: 0.25,
+            v: 0.5,
+        };
+        let cfg = Config::quick();
+        let mut lines = vec![];
+        let mut log = |l: &str| lines.push(l.to_string());
+        let mut b = Bench {
+            cfg: &cfg,
+            pools: vec![],
+            log: &mut log,
+            out: SceneResult {
+                name: "t".into(),
+                role: Role::Mesh,
+                triangles: 1,
+                builds: vec![],
+                traces: vec![],
+                agreement: vec![],
+            },
+        };
+        // The tree is right on ray 0 (the other misses); the other is wrong on ray 1 too.
+        let reference = Answers::Closest(vec![hit, Found::default()]);
+        let other = Answers::Closest(vec![Found::default(), hit]);
+        b.agree(
+            "X",
+            Kind::Primary,
+            &rays,
+            &reference,
+            &other,
+            None,
+            Some(&tris),
+        );
+        let occ_ref = Answers::Occluded(vec![true, false]);
+        let occ_other = Answers::Occluded(vec![true, true]);
+        b.agree(
+            "X",
+            Kind::Shadow,
+            &rays,
+            &occ_ref,
+            &occ_other,
+            None,
+            Some(&tris),
+        );
+        let rows = b.out.agreement;
+        assert_eq!((rows[0].compared, rows[0].disagreements), (2, 2));
+        let want = Referee {
+            checked: 2,
+            kdtree_right: 2,
+            other_right: 0,
+        };
+        assert_eq!(rows[0].referee, Some(want));
+        assert!(!rows[0].ok());
+        assert_eq!((rows[1].compared, rows[1].disagreements), (2, 1));
+        let want = Referee {
+            checked: 1,
+            kdtree_right: 1,
+            other_right: 0,
+        };
+        assert_eq!(rows[1].referee, Some(want));
+        assert!(rows[1].examples[0].contains("kdtree miss, X occluded"));
     }
 
     #[test]

@@ -93,7 +93,7 @@ fn quick_run_has_every_row_and_the_contenders_agree() {
     assert!(md.contains(&format!("| {name} | kdtree | 2 |")));
     assert!(md.contains(&format!("| {name} | brute force | 1 |")));
     assert!(md.contains(&format!(
-        "| {name} | brute force | 0 / 512 | 0 / {} | 0 / 512 | 100.0000% | ok |",
+        "| {name} | brute force | 0 / 512 | 0 / {} | 0 / 512 | 100.0000% | ok | – |",
         shadow.min(512)
     )));
     assert_eq!(
