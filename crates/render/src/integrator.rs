@@ -12,7 +12,9 @@
 use crate::counters::RayCounts;
 use crate::environment;
 use crate::lights::{basis, incident, Incident};
-use crate::offset::{hit_point, offset_origin, SHADOW_TMAX_FRACTION, SPAWN_TMIN};
+use crate::offset::{
+    hit_point, intersector_margin, offset_origin, SHADOW_TMAX_FRACTION, SPAWN_TMIN,
+};
 use crate::plan::{Plan, ShadowMode};
 use crate::sampling::{disc_sample, Rng};
 use formats::{Light, LightKind, Soup};
@@ -40,6 +42,21 @@ impl Primary {
 struct ActiveLight<'a> {
     light: &'a Light,
     shadows: ShadowMode,
+}
+
+/// A shaded point and what it takes to leave it robustly (see [`crate::offset`]).
+struct Surface {
+    p: Vec3,
+    err: Vec3,
+    margin: f32,
+    /// Unit geometric normal.
+    ng: Vec3,
+}
+
+impl Surface {
+    fn spawn(&self, dir: Vec3) -> Vec3 {
+        offset_origin(self.p, self.err, self.margin, self.ng, dir)
+    }
 }
 
 pub struct Integrator<'a> {
@@ -140,6 +157,12 @@ impl<'a> Integrator<'a> {
         if ng.dot(ray.dir) > 0.0 {
             ng = -ng;
         }
+        let surf = Surface {
+            p,
+            err,
+            margin: intersector_margin(tri),
+            ng,
+        };
         let ns_tri = &self.soup.normals[prim];
         let b0 = 1.0 - hit.u - hit.v;
         let mut ns = (ns_tri[0] * b0 + ns_tri[1] * hit.u + ns_tri[2] * hit.v).normalize_or_zero();
@@ -182,15 +205,13 @@ impl<'a> Integrator<'a> {
                     ShadowMode::None => 1.0,
                     ShadowMode::Hard => {
                         counts.shadow += 1;
-                        if self.blocked(p, err, ng, inc.dir, inc.dist) {
+                        if self.blocked(&surf, inc.dir, inc.dist) {
                             0.0
                         } else {
                             1.0
                         }
                     }
-                    ShadowMode::Soft => {
-                        self.soft_visibility(p, err, ng, al.light, &inc, rng, counts)
-                    }
+                    ShadowMode::Soft => self.soft_visibility(&surf, al.light, &inc, rng, counts),
                 };
                 if visible > 0.0 {
                     l += inc.radiance * (cos * visible) * albedo;
@@ -213,7 +234,7 @@ impl<'a> Integrator<'a> {
                 if r != Vec3::ZERO {
                     counts.reflection += 1;
                     let next = Ray {
-                        origin: offset_origin(p, err, ng, r),
+                        origin: surf.spawn(r),
                         dir: r,
                         tmin: SPAWN_TMIN,
                         tmax: f32::INFINITY,
@@ -227,8 +248,9 @@ impl<'a> Integrator<'a> {
 
     /// Whether the way from the surface at `p` along unit `dir` to a light `dist` away is
     /// blocked (`dist` infinite: a directional light, the ray is unbounded).
-    fn blocked(&self, p: Vec3, err: Vec3, ng: Vec3, dir: Vec3, dist: f32) -> bool {
-        let origin = offset_origin(p, err, ng, dir);
+    fn blocked(&self, surf: &Surface, dir: Vec3, dist: f32) -> bool {
+        let origin = surf.spawn(dir);
+        let p = surf.p;
         let ray = if dist.is_infinite() {
             Ray {
                 origin,
@@ -257,9 +279,7 @@ impl<'a> Integrator<'a> {
     #[allow(clippy::too_many_arguments)]
     fn soft_visibility(
         &self,
-        p: Vec3,
-        err: Vec3,
-        ng: Vec3,
+        surf: &Surface,
         light: &Light,
         inc: &Incident,
         rng: &mut Rng,
@@ -288,16 +308,16 @@ impl<'a> Integrator<'a> {
                         (1.0, 0.0)
                     };
                     let dir = (t * (c * sin_t) + b * (s * sin_t) + inc.dir * cos_t).normalize();
-                    self.blocked(p, err, ng, dir, f32::INFINITY)
+                    self.blocked(surf, dir, f32::INFINITY)
                 }
                 LightKind::Point | LightKind::Spot { .. } => {
                     let q = light.position + (t * dx + b * dy) * light.shadow_radius;
-                    let to = q - p;
+                    let to = q - surf.p;
                     let dist = to.length();
                     if dist <= 0.0 {
                         continue;
                     }
-                    self.blocked(p, err, ng, to / dist, dist)
+                    self.blocked(surf, to / dist, dist)
                 }
             };
             if !blocked {

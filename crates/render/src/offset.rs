@@ -3,8 +3,17 @@
 //! A hit point computed in f32 from barycentrics, p = b0·p0 + b1·p1 + b2·p2, is off the
 //! true surface by at most γ₇·(|b0·p0| + |b1·p1| + |b2·p2|) per axis. A new ray leaves from
 //! p pushed along the geometric normal just past that error box, then rounded one more
-//! ULP away, so it can never re-hit the surface it left, whatever the scene's scale or
-//! distance from the origin — no fixed epsilon anywhere.
+//! ULP away, so that its origin is provably on the intended side of the surface, whatever
+//! the scene's scale or distance from the origin — no fixed epsilon anywhere.
+//!
+//! pbrt-v4 also relies on its intersector rejecting hits closer than a bound on the
+//! rounding of t (its `deltaT`). Our intersector does not promise that, so the push also
+//! covers it ([`intersector_margin`]): a watertight test translates and shears the
+//! triangle relative to the ray origin, which perturbs the triangle's plane by a few ULPs
+//! of the triangle's extent, and its barycentric rounding grows with the triangle's
+//! aspect (longest edge² / area). That margin scales with the triangle, not the scene.
+//! A spawned ray's interval starts at the smallest normal f32 ([`SPAWN_TMIN`]) so that
+//! an underflowed t = 0 never counts.
 
 use glam::Vec3;
 
@@ -21,6 +30,30 @@ pub fn hit_point(tri: &[Vec3; 3], u: f32, v: f32) -> (Vec3, Vec3) {
     let p = a + b + c;
     let err = (a.abs() + b.abs() + c.abs()) * gamma(7);
     (p, err)
+}
+
+/// Distance along the normal that covers the intersector's rounding for rays leaving
+/// triangle `tri`: γ₁₂ · L · clamp(L² / 2A, 1, 10⁴), with L the longest edge and A the area.
+pub fn intersector_margin(tri: &[Vec3; 3]) -> f32 {
+    let e0 = tri[1] - tri[0];
+    let e1 = tri[2] - tri[1];
+    let e2 = tri[0] - tri[2];
+    let l2 = e0
+        .length_squared()
+        .max(e1.length_squared())
+        .max(e2.length_squared());
+    let twice_area = e0.cross(-e2).length();
+    let aspect = if twice_area > 0.0 {
+        (l2 / twice_area).clamp(1.0, 1e4)
+    } else {
+        1e4
+    };
+    let m = gamma(12) * l2.sqrt() * aspect;
+    if m.is_finite() {
+        m
+    } else {
+        0.0
+    }
 }
 
 /// Next representable f32 towards +∞ (`f32::next_up` needs Rust 1.86; we support 1.85).
@@ -40,11 +73,12 @@ pub fn next_down(x: f32) -> f32 {
     -next_up(-x)
 }
 
-/// Origin for a ray leaving point `p` (error bound `err`) in direction `w`, on the side
-/// of the surface with geometric normal `ng` that `w` points to.
-pub fn offset_origin(p: Vec3, err: Vec3, ng: Vec3, w: Vec3) -> Vec3 {
+/// Origin for a ray leaving point `p` (error bound `err`, intersector margin `margin`)
+/// in direction `w`, on the side of the surface with unit geometric normal `ng` that `w`
+/// points to.
+pub fn offset_origin(p: Vec3, err: Vec3, margin: f32, ng: Vec3, w: Vec3) -> Vec3 {
     let side = if w.dot(ng) < 0.0 { -ng } else { ng };
-    let off = side * side.abs().dot(err);
+    let off = side * (side.abs().dot(err) + margin);
     let mut po = (p + off).to_array();
     // One more ULP away from the surface on every axis the normal has a component along,
     // also when the error bound is 0 (an exactly representable point on an axis-aligned
@@ -84,6 +118,16 @@ mod tests {
     use super::*;
 
     #[test]
+    fn the_margin_scales_with_the_triangle_and_its_aspect() {
+        let t = |s: f32, h: f32| [Vec3::ZERO, Vec3::new(s, 0.0, 0.0), Vec3::new(0.0, 0.0, h)];
+        let m1 = intersector_margin(&t(1.0, 1.0));
+        assert!((intersector_margin(&t(1000.0, 1000.0)) / m1 - 1000.0).abs() < 1.0);
+        // A needle (aspect 1000) needs a larger push than a well-shaped triangle.
+        assert!(intersector_margin(&t(1.0, 1e-3)) > m1 * 100.0);
+        assert!(m1 < 1e-5);
+    }
+
+    #[test]
     fn next_up_and_down_step_one_ulp() {
         assert_eq!(next_up(1.0), 1.0 + f32::EPSILON);
         assert_eq!(next_down(1.0), 1.0 - f32::EPSILON / 2.0);
@@ -101,14 +145,15 @@ mod tests {
                 Vec3::new(scale, 0.0, 1.0),
             ];
             let (p, err) = hit_point(&tri, 0.25, 0.25);
-            let o = offset_origin(p, err, Vec3::Y, Vec3::Y);
+            let m = intersector_margin(&tri);
+            let o = offset_origin(p, err, m, Vec3::Y, Vec3::Y);
             assert!(
                 o.y > 0.0,
                 "origin must leave the plane y = 0 at scale {scale}"
             );
             // The push is of the order of the rounding error, not a fixed epsilon.
             assert!(o.y < scale.max(1.0) * 1e-5, "{} at {scale}", o.y);
-            let below = offset_origin(p, err, Vec3::Y, -Vec3::Y);
+            let below = offset_origin(p, err, m, Vec3::Y, -Vec3::Y);
             assert!(below.y < 0.0);
         }
     }

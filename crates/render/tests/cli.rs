@@ -169,6 +169,10 @@ fn bad_input_is_one_clear_line_and_exit_1() {
             "/nonexistent/scene.kd",
         ),
         (vec![k, k, "-o", o], "scene.kd"),
+        (
+            vec![s, k, "-o", "/nonexistent/dir/x.exr"],
+            "the folder /nonexistent/dir does not exist",
+        ),
     ];
     for (args, needle) in cases {
         let out = kd2exr(&args);

@@ -114,6 +114,7 @@ fn merge(inputs: &[PathBuf], output: &std::path::Path) -> Result<()> {
         .iter()
         .map(|p| ExrImage::read(p))
         .collect::<Result<Vec<_>, _>>()?;
+    writable_folder(output)?;
     let full = render::exrio::merge(&parts)?;
     full.write(output)?;
     eprintln!(
@@ -125,6 +126,18 @@ fn merge(inputs: &[PathBuf], output: &std::path::Path) -> Result<()> {
         start.elapsed().as_secs_f64()
     );
     Ok(())
+}
+
+/// Fail early, naming the path, when an output's folder does not exist.
+fn writable_folder(path: &std::path::Path) -> Result<()> {
+    match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() && !dir.is_dir() => anyhow::bail!(
+            "cannot write {}: the folder {} does not exist",
+            path.display(),
+            dir.display()
+        ),
+        _ => Ok(()),
+    }
 }
 
 fn run(a: RenderArgs) -> Result<()> {
@@ -156,6 +169,9 @@ fn run(a: RenderArgs) -> Result<()> {
     // Everything that can be refused is refused before loading or tracing anything.
     opts.validate()?;
     memory::check(&opts, memory::available_bytes())?;
+    for p in std::iter::once(&out_path).chain(a.preview.as_ref()) {
+        writable_folder(p)?;
+    }
 
     let t_load = Instant::now();
     let soup = Soup::read(&soup_path)?;
