@@ -1,7 +1,7 @@
 //! The report as markdown: header, the issue's targets, build, traversal (with the
 //! kdtree/Embree ratio) and agreement tables, then notes.
 
-use crate::run::{Kind, Report, Role, SceneResult, TraceRow, BRUTE, EMBREE, KDTREE};
+use crate::run::{Kind, Report, Role, SceneResult, TraceRow, BRUTE, EMBREE, KDTREE, MEDIAN};
 use std::fmt::Write;
 
 fn trace<'a>(s: &'a SceneResult, who: &str, threads: usize, kind: Kind) -> Option<&'a TraceRow> {
@@ -147,7 +147,7 @@ fn traversal(r: &Report, out: &mut String) {
          |---|---|---:|---:|---:|---:|\n",
     );
     for s in &r.scenes {
-        let contenders = [KDTREE, EMBREE, BRUTE];
+        let contenders = [KDTREE, MEDIAN, EMBREE, BRUTE];
         for who in contenders {
             for &t in &r.config.threads {
                 let cells: Vec<Option<&TraceRow>> =
@@ -203,13 +203,13 @@ fn agreement(r: &Report, out: &mut String) {
         "## Agreement with the k-d tree\n\n\
          Closest hit: same triangle, or t within 1e-4 relative (ties at shared edges); \
          shadow: same occlusion answer. The bar is 99.99% of rays. Where the k-d tree and \
-         Embree differ, brute force (f64) re-traces up to 200 of those rays per set: the last \
+         Embree (or the median-split tree) differ, brute force (f64) re-traces up to 200 of those rays per set: the last \
          column counts how often it sides with each (both on ties, neither when all three differ).\n\n\
          | scene | contender | primary differ | shadow differ | random differ | agreement | verdict | brute force sides with kdtree / other, of |\n\
          |---|---|---:|---:|---:|---:|:---:|---:|\n",
     );
     for s in &r.scenes {
-        for who in [EMBREE, BRUTE] {
+        for who in [EMBREE, MEDIAN, BRUTE] {
             let rows: Vec<_> = s.agreement.iter().filter(|a| a.other == who).collect();
             if rows.is_empty() {
                 continue;

@@ -11,6 +11,7 @@ use kdtree::{Accel, Ray};
 use std::path::PathBuf;
 
 pub const KDTREE: &str = "kdtree";
+pub const MEDIAN: &str = "kdtree median";
 pub const EMBREE: &str = "Embree";
 pub const BRUTE: &str = "brute force";
 
@@ -319,7 +320,7 @@ impl Bench<'_> {
                 seconds,
             };
             (self.log)(&format!(
-                "  {:<12} {:<7} {} thread(s): {:>8.3} Mrays/s ({} rays)",
+                "  {:<13} {:<7} {} thread(s): {:>8.3} Mrays/s ({} rays)",
                 name,
                 kind.name(),
                 threads,
@@ -330,6 +331,47 @@ impl Bench<'_> {
             answers = Some(a);
         }
         answers.unwrap_or(Answers::Closest(vec![]))
+    }
+
+    /// Build a k-d tree with `builder` for every thread count, record the builds, and
+    /// return the last tree ready for queries (None when no thread count is configured).
+    fn build_tree(
+        &mut self,
+        name: &str,
+        builder: fn(&[[Vec3; 3]], &BuildParams, formats::Digest) -> formats::KdFile,
+        tris: &[[Vec3; 3]],
+        hash: formats::Digest,
+    ) -> Result<Option<Accel>, BenchError> {
+        let n = tris.len();
+        let mut kd = None;
+        for (threads, pool) in &self.pools {
+            let (seconds, tree) = timed(self.cfg.runs, || {
+                pool.install(|| builder(tris, &self.cfg.params, hash))
+            });
+            (self.log)(&format!(
+                "  {name:<13} build {threads} thread(s): {:.1} ms",
+                seconds * 1e3
+            ));
+            self.out.builds.push(BuildRow {
+                scene: self.out.name.clone(),
+                triangles: n,
+                contender: name.into(),
+                threads: *threads,
+                seconds,
+                sah_cost: Some(tree.stats.sah_cost),
+                nodes: Some(tree.nodes.len() as u64),
+                refs_per_triangle: Some(tree.leaf_tris.len() as f64 / n.max(1) as f64),
+                bytes_per_triangle: Some(kd_bytes(&tree, n) as f64 / n.max(1) as f64),
+            });
+            kd = Some(tree);
+        }
+        kd.map(|kd| {
+            Accel::from_triangles(tris, &kd).map_err(|e| BenchError::Accel {
+                scene: self.out.name.clone(),
+                detail: format!("{name}: {e}"),
+            })
+        })
+        .transpose()
     }
 
     /// Compare `other`'s answers with the k-d tree's (`reference`, indexed through `idx`
@@ -497,42 +539,11 @@ fn run_scene(
     };
     let hash = formats::soup::geometry_hash(tris);
 
-    // Builds, 1 and 2 threads; the last tree is kept for tracing.
-    let mut kd = None;
-    for (threads, pool) in &b.pools {
-        let (seconds, tree) = timed(cfg.runs, || {
-            pool.install(|| kdtree::build(tris, &cfg.params, hash))
-        });
-        (b.log)(&format!(
-            "  {KDTREE:<12} build {threads} thread(s): {:.1} ms",
-            seconds * 1e3
-        ));
-        b.out.builds.push(BuildRow {
-            scene: name.clone(),
-            triangles: n,
-            contender: KDTREE.into(),
-            threads: *threads,
-            seconds,
-            sah_cost: Some(tree.stats.sah_cost),
-            nodes: Some(tree.nodes.len() as u64),
-            refs_per_triangle: Some(tree.leaf_tris.len() as f64 / n.max(1) as f64),
-            bytes_per_triangle: Some(kd_bytes(&tree, n) as f64 / n.max(1) as f64),
-        });
-        kd = Some(tree);
-    }
-    let Some(kd) = kd else {
+    // Builds, 1 and 2 threads; the last tree of each kind is kept for tracing.
+    let Some(accel) = b.build_tree(KDTREE, kdtree::build, tris, hash)? else {
         return Ok(b.out);
     };
-    let accel = {
-        let mut soup = formats::Soup::empty();
-        soup.triangles = tris.clone();
-        soup.geometry_hash = hash;
-        Accel::new(&soup, &kd).map_err(|e| BenchError::Accel {
-            scene: name.clone(),
-            detail: e.to_string(),
-        })?
-    };
-    drop(kd);
+    let median = b.build_tree(MEDIAN, kdtree::build_median, tris, hash)?;
 
     #[cfg(feature = "embree")]
     let embree = {
@@ -550,7 +561,7 @@ fn run_scene(
             });
             let s = s.map_err(err)?;
             (b.log)(&format!(
-                "  {EMBREE:<12} build {threads} thread(s): {:.1} ms",
+                "  {EMBREE:<13} build {threads} thread(s): {:.1} ms",
                 seconds * 1e3
             ));
             b.out.builds.push(BuildRow {
@@ -584,6 +595,10 @@ fn run_scene(
             Kind::Random => &random,
         };
         let reference = b.traverse(KDTREE, &accel, kind, set);
+        if let Some(m) = &median {
+            let answers = b.traverse(MEDIAN, m, kind, set);
+            b.agree(MEDIAN, kind, set, &reference, &answers, None, Some(tris));
+        }
         #[cfg(feature = "embree")]
         if let Some(e) = &embree {
             let answers = b.traverse(EMBREE, e, kind, set);

@@ -1,7 +1,7 @@
 //! The quick benchmark, in process, on a tiny generated scene: the report has the rows
 //! the tables need and every contender agrees with the k-d tree.
 
-use bench::run::{Kind, Role, BRUTE, EMBREE, KDTREE};
+use bench::run::{Kind, Role, BRUTE, EMBREE, KDTREE, MEDIAN};
 use bench::{report, run, scenes, Config};
 use std::path::PathBuf;
 
@@ -25,9 +25,9 @@ fn quick_run_has_every_row_and_the_contenders_agree() {
 
     let embree = cfg!(feature = "embree");
     let contenders: Vec<&str> = if embree {
-        vec![KDTREE, EMBREE]
+        vec![KDTREE, MEDIAN, EMBREE]
     } else {
-        vec![KDTREE]
+        vec![KDTREE, MEDIAN]
     };
     // Build rows: every contender (brute force has no build) at 1 and 2 threads.
     assert_eq!(s.builds.len(), 2 * contenders.len());
@@ -50,6 +50,11 @@ fn quick_run_has_every_row_and_the_contenders_agree() {
             Some(direct.leaf_tris.len() as f64 / n)
         );
     }
+    // The median-split tree is the k-d tree crate's too, and costs more by the SAH.
+    let median = kdtree::build_median(&tris, &cfg.params, formats::soup::geometry_hash(&tris));
+    let m = s.builds.iter().find(|b| b.contender == MEDIAN).unwrap();
+    assert_eq!(m.nodes, Some(median.nodes.len() as u64));
+    assert!(m.sah_cost.unwrap() > direct.stats.sah_cost);
 
     // Trace rows: every contender, brute force too (the scene is small), × 2 × 3 kinds.
     let mut all = contenders.clone();
@@ -91,6 +96,7 @@ fn quick_run_has_every_row_and_the_contenders_agree() {
     let name = &s.name;
     assert!(md.contains(&format!("| {name} | {expected_tris} | kdtree | 1 |")));
     assert!(md.contains(&format!("| {name} | kdtree | 2 |")));
+    assert!(md.contains(&format!("| {name} | kdtree median | 1 |")));
     assert!(md.contains(&format!("| {name} | brute force | 1 |")));
     assert!(md.contains(&format!(
         "| {name} | brute force | 0 / 512 | 0 / {} | 0 / 512 | 100.0000% | ok | – |",
