@@ -2,13 +2,14 @@
 //! trace the same primary, shadow and random rays with each, and check that they agree.
 
 use crate::error::BenchError;
-use crate::measure::{pool, timed, trace};
+use crate::measure::{median, pool, timed, trace};
 use crate::rays::{self, View};
 use crate::scenes::{self, Scene};
 use formats::BuildParams;
 use glam::Vec3;
 use kdtree::{Accel, Ray};
 use std::path::PathBuf;
+use std::time::Instant;
 
 pub const KDTREE: &str = "kdtree";
 pub const MEDIAN: &str = "kdtree median";
@@ -296,41 +297,51 @@ struct Bench<'a> {
 }
 
 impl Bench<'_> {
-    /// Time `tracer` on `rays` for every thread count; return the answers (identical
-    /// across runs and thread counts, so the last is kept).
-    fn traverse<T: Tracer>(&mut self, name: &str, tracer: &T, kind: Kind, rays: &[Ray]) -> Answers {
-        let mut answers = None;
+    /// Time every tracer in `who` on `rays` for every thread count, and return their
+    /// answers (identical across runs and thread counts, so the last is kept). Runs go
+    /// round-robin over the tracers, so a burst of load from other processes on the
+    /// shared machine hits every contender's runs alike rather than one contender's.
+    fn traverse(&mut self, who: &[(&str, &dyn Tracer)], kind: Kind, rays: &[Ray]) -> Vec<Answers> {
+        let mut answers: Vec<Option<Answers>> = who.iter().map(|_| None).collect();
         for (threads, pool) in &self.pools {
-            let (seconds, a) = match kind {
-                Kind::Shadow => {
-                    let (s, a) = timed(self.cfg.runs, || trace(pool, rays, |r| tracer.occluded(r)));
-                    (s, Answers::Occluded(a))
+            let mut times = vec![Vec::new(); who.len()];
+            for _ in 0..self.cfg.runs.max(1) {
+                for (c, (_, tracer)) in who.iter().enumerate() {
+                    let start = Instant::now();
+                    let a = match kind {
+                        Kind::Shadow => {
+                            Answers::Occluded(trace(pool, rays, |r| tracer.occluded(r)))
+                        }
+                        _ => Answers::Closest(trace(pool, rays, |r| tracer.closest(r))),
+                    };
+                    times[c].push(start.elapsed().as_secs_f64());
+                    answers[c] = Some(a);
                 }
-                _ => {
-                    let (s, a) = timed(self.cfg.runs, || trace(pool, rays, |r| tracer.closest(r)));
-                    (s, Answers::Closest(a))
-                }
-            };
-            let row = TraceRow {
-                scene: self.out.name.clone(),
-                contender: name.into(),
-                threads: *threads,
-                kind,
-                rays: rays.len(),
-                seconds,
-            };
-            (self.log)(&format!(
-                "  {:<13} {:<7} {} thread(s): {:>8.3} Mrays/s ({} rays)",
-                name,
-                kind.name(),
-                threads,
-                row.mrays_per_s(),
-                rays.len()
-            ));
-            self.out.traces.push(row);
-            answers = Some(a);
+            }
+            for ((name, _), t) in who.iter().zip(times) {
+                let row = TraceRow {
+                    scene: self.out.name.clone(),
+                    contender: (*name).into(),
+                    threads: *threads,
+                    kind,
+                    rays: rays.len(),
+                    seconds: median(t),
+                };
+                (self.log)(&format!(
+                    "  {:<13} {:<7} {} thread(s): {:>8.3} Mrays/s ({} rays)",
+                    name,
+                    kind.name(),
+                    threads,
+                    row.mrays_per_s(),
+                    rays.len()
+                ));
+                self.out.traces.push(row);
+            }
         }
-        answers.unwrap_or(Answers::Closest(vec![]))
+        answers
+            .into_iter()
+            .map(|a| a.unwrap_or(Answers::Closest(vec![])))
+            .collect()
     }
 
     /// Build a k-d tree with `builder` for every thread count, record the builds, and
@@ -594,21 +605,25 @@ fn run_scene(
             Kind::Shadow => &shadow,
             Kind::Random => &random,
         };
-        let reference = b.traverse(KDTREE, &accel, kind, set);
+        // The k-d tree first: its answers are the reference the others are checked on.
+        let mut who: Vec<(&str, &dyn Tracer)> = vec![(KDTREE, &accel)];
         if let Some(m) = &median {
-            let answers = b.traverse(MEDIAN, m, kind, set);
-            b.agree(MEDIAN, kind, set, &reference, &answers, None, Some(tris));
+            who.push((MEDIAN, m));
         }
         #[cfg(feature = "embree")]
         if let Some(e) = &embree {
-            let answers = b.traverse(EMBREE, e, kind, set);
-            b.agree(EMBREE, kind, set, &reference, &answers, None, Some(tris));
+            who.push((EMBREE, e));
+        }
+        let mut answers = b.traverse(&who, kind, set).into_iter();
+        let reference = answers.next().unwrap_or(Answers::Closest(vec![]));
+        for ((name, _), a) in who.iter().skip(1).zip(answers) {
+            b.agree(name, kind, set, &reference, &a, None, Some(tris));
         }
         if let Some(brute) = &brute {
             let idx = subset_indices(set.len(), cfg.brute_rays);
             let sub: Vec<Ray> = idx.iter().map(|&i| set[i]).collect();
-            let answers = b.traverse(BRUTE, brute, kind, &sub);
-            b.agree(BRUTE, kind, set, &reference, &answers, Some(&idx), None);
+            let answers = b.traverse(&[(BRUTE, brute)], kind, &sub);
+            b.agree(BRUTE, kind, set, &reference, &answers[0], Some(&idx), None);
         }
         if kind == Kind::Primary {
             // Shadow rays start at the k-d tree's primary hits.
@@ -659,7 +674,7 @@ fn header(cfg: &Config) -> Vec<String> {
             cfg.image, cfg.random_rays
         ),
         format!(
-            "timing: median of {} runs; threads {:?} (rayon pools of that size; Embree builds on a device of that many threads); \
+            "timing: median of {} runs (traversal runs go round-robin over the contenders); threads {:?} (rayon pools of that size; Embree builds on a device of that many threads); \
              brute force only on scenes ≤ {} triangles, on {} rays of each set",
             cfg.runs.max(1),
             cfg.threads,
