@@ -198,6 +198,32 @@ fn step<const ROBUST: bool>(s: &Setup, i: u32, node: KdNode, t0: f32, t1: f32) -
 }
 
 impl Tree<'_> {
+    #[inline(always)]
+    fn node(&self, i: u32) -> KdNode {
+        debug_assert!((i as usize) < self.nodes.len());
+        // SAFETY: `Accel::assemble` ran `KdFile::validate`, which proves every child index
+        // (i + 1 and `above_child`) of an interior node is inside `nodes`; traversal only
+        // visits node 0 and such children.
+        unsafe { *self.nodes.get_unchecked(i as usize) }
+    }
+
+    #[inline(always)]
+    fn leaf(&self, node: KdNode) -> &[u32] {
+        let off = node.offset() as usize;
+        let end = off + node.count() as usize;
+        debug_assert!(end <= self.leaf_tris.len());
+        // SAFETY: `KdFile::validate` proves offset + count ≤ leaf_tris.len() for leaves.
+        unsafe { self.leaf_tris.get_unchecked(off..end) }
+    }
+
+    #[inline(always)]
+    fn tri(&self, p: u32) -> &[[f32; 3]; 3] {
+        debug_assert!((p as usize) < self.tris.len());
+        // SAFETY: `KdFile::validate` proves every leaf entry < stats.triangles, and
+        // `Accel::assemble` checks stats.triangles == tris.len().
+        unsafe { self.tris.get_unchecked(p as usize) }
+    }
+
     /// Closest hit in [tmin, tmax]; ties in t go to the lower triangle index (so the
     /// answer is the brute-force loop's, whatever the leaf order).
     #[inline(always)]
@@ -209,7 +235,7 @@ impl Tree<'_> {
         let mut sp = 0;
         let (mut node_i, mut t0, mut t1) = (0u32, s.t0, s.t1);
         loop {
-            let node = self.nodes[node_i as usize];
+            let node = self.node(node_i);
             if !node.is_leaf() {
                 match step::<ROBUST>(&s, node_i, node, t0, t1) {
                     Step::One(c) => node_i = c,
@@ -231,9 +257,8 @@ impl Tree<'_> {
                 }
                 continue;
             }
-            let off = node.offset() as usize;
-            for &p in &self.leaf_tris[off..off + node.count() as usize] {
-                if let Some(h) = test::<ROBUST>(&s, ray, &self.tris[p as usize], best_t) {
+            for &p in self.leaf(node) {
+                if let Some(h) = test::<ROBUST>(&s, ray, self.tri(p), best_t) {
                     if h.t < best_t || p < best.prim {
                         best_t = h.t;
                         best = Hit {
@@ -270,7 +295,7 @@ impl Tree<'_> {
         let mut sp = 0;
         let (mut node_i, mut t0, mut t1) = (0u32, s.t0, s.t1);
         loop {
-            let node = self.nodes[node_i as usize];
+            let node = self.node(node_i);
             if !node.is_leaf() {
                 match step::<ROBUST>(&s, node_i, node, t0, t1) {
                     Step::One(c) => node_i = c,
@@ -292,9 +317,8 @@ impl Tree<'_> {
                 }
                 continue;
             }
-            let off = node.offset() as usize;
-            for &p in &self.leaf_tris[off..off + node.count() as usize] {
-                if test::<ROBUST>(&s, ray, &self.tris[p as usize], ray.tmax).is_some() {
+            for &p in self.leaf(node) {
+                if test::<ROBUST>(&s, ray, self.tri(p), ray.tmax).is_some() {
                     return true;
                 }
             }

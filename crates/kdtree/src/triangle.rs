@@ -73,10 +73,13 @@ pub struct RawHit {
 #[inline(always)]
 pub fn intersect(r: &RayPre, tri: &[[f32; 3]; 3], tmin: f32, tmax: f32) -> Option<RawHit> {
     let o = r.origin;
-    let (kx, ky, kz) = (r.kx, r.ky, r.kz);
-    let a = [tri[0][0] - o[0], tri[0][1] - o[1], tri[0][2] - o[2]];
-    let b = [tri[1][0] - o[0], tri[1][1] - o[1], tri[1][2] - o[2]];
-    let c = [tri[2][0] - o[0], tri[2][1] - o[1], tri[2][2] - o[2]];
+    // Length-4 arrays indexed with `k & 3`: the compiler sees every index in bounds, so
+    // the permutation costs no bounds checks (kx, ky, kz are always < 3).
+    let rel = |p: &[f32; 3]| [p[0] - o[0], p[1] - o[1], p[2] - o[2], 0.0];
+    let (kx, ky, kz) = (r.kx & 3, r.ky & 3, r.kz & 3);
+    let a = rel(&tri[0]);
+    let b = rel(&tri[1]);
+    let c = rel(&tri[2]);
     let ax = a[kx] - r.sx * a[kz];
     let ay = a[ky] - r.sy * a[kz];
     let bx = b[kx] - r.sx * b[kz];
