@@ -43,6 +43,18 @@ pub fn timed<T>(runs: usize, mut f: impl FnMut() -> T) -> (f64, T) {
     (median(times), last.expect("ran at least once"))
 }
 
+/// CPU seconds (user + system, all threads) this process has used so far, from
+/// /proc/self/stat in clock ticks (USER_HZ, 100 on Linux); None elsewhere.
+pub fn process_cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command name, which is in parentheses and may hold spaces.
+    let rest = stat.rsplit_once(')')?.1;
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let utime: f64 = f.get(11)?.parse().ok()?;
+    let stime: f64 = f.get(12)?.parse().ok()?;
+    Some((utime + stime) / 100.0)
+}
+
 /// Rays per parallel task: small enough for work stealing to balance the two cores,
 /// large enough that task overhead is noise.
 const CHUNK: usize = 256;
@@ -82,6 +94,23 @@ mod tests {
         let input: Vec<u32> = (0..10_000).collect();
         let out = trace(&p, &input, |x| x * 2);
         assert!(out.iter().enumerate().all(|(i, &v)| v == 2 * i as u32));
+    }
+
+    #[test]
+    fn process_cpu_time_grows_with_work() {
+        // Spin until the clock-tick counter moves (10 ms of CPU); give up after 5 s.
+        let a = process_cpu_seconds().unwrap();
+        let start = Instant::now();
+        let mut x = 0u64;
+        let mut b = a;
+        while b == a && start.elapsed().as_secs() < 5 {
+            for _ in 0..100_000 {
+                x = std::hint::black_box(x.wrapping_mul(6364136223846793005).wrapping_add(1));
+            }
+            b = process_cpu_seconds().unwrap();
+        }
+        assert!(b > a, "CPU time stayed at {a} s");
+        assert!(b - a < 5.0 * std::thread::available_parallelism().map_or(1, |n| n.get()) as f64);
     }
 
     #[test]

@@ -174,6 +174,27 @@ fn traversal(r: &Report, out: &mut String) {
             out.push('\n');
         }
     }
+    let cores: Vec<String> = r
+        .scenes
+        .iter()
+        .map(|s| {
+            let per: Vec<String> = s
+                .cpu
+                .iter()
+                .filter(|(_, (_, wall))| *wall > 0.0)
+                .map(|(t, (cpu, wall))| format!("{t} thread(s) got {:.2}", cpu / wall))
+                .collect();
+            format!("{}: {}", s.name, per.join(", "))
+        })
+        .collect();
+    if !cores.is_empty() {
+        let _ = writeln!(
+            out,
+            "\nCores this process actually got while tracing (CPU time ÷ wall time; other \
+             processes share the machine, so 2 threads may get less than 2): {}.",
+            cores.join("; ")
+        );
+    }
     let counts: Vec<String> = r
         .scenes
         .iter()

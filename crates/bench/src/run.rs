@@ -2,7 +2,7 @@
 //! trace the same primary, shadow and random rays with each, and check that they agree.
 
 use crate::error::BenchError;
-use crate::measure::{median, pool, timed, trace};
+use crate::measure::{median, pool, process_cpu_seconds, timed, trace};
 use crate::rays::{self, View};
 use crate::scenes::{self, Scene};
 use formats::BuildParams;
@@ -169,6 +169,9 @@ pub struct SceneResult {
     pub builds: Vec<BuildRow>,
     pub traces: Vec<TraceRow>,
     pub agreement: Vec<AgreeRow>,
+    /// Per thread count: (CPU seconds, wall seconds) this process spent tracing. Their
+    /// ratio is the number of cores the run actually got on a shared machine.
+    pub cpu: std::collections::BTreeMap<usize, (f64, f64)>,
 }
 
 pub struct Report {
@@ -304,6 +307,8 @@ impl Bench<'_> {
     fn traverse(&mut self, who: &[(&str, &dyn Tracer)], kind: Kind, rays: &[Ray]) -> Vec<Answers> {
         let mut answers: Vec<Option<Answers>> = who.iter().map(|_| None).collect();
         for (threads, pool) in &self.pools {
+            let cpu0 = process_cpu_seconds();
+            let wall0 = Instant::now();
             let mut times = vec![Vec::new(); who.len()];
             for _ in 0..self.cfg.runs.max(1) {
                 for (c, (_, tracer)) in who.iter().enumerate() {
@@ -317,6 +322,11 @@ impl Bench<'_> {
                     times[c].push(start.elapsed().as_secs_f64());
                     answers[c] = Some(a);
                 }
+            }
+            if let Some((c0, c1)) = cpu0.zip(process_cpu_seconds()) {
+                let e = self.out.cpu.entry(*threads).or_default();
+                e.0 += c1 - c0;
+                e.1 += wall0.elapsed().as_secs_f64();
             }
             for ((name, _), t) in who.iter().zip(times) {
                 let row = TraceRow {
@@ -546,6 +556,7 @@ fn run_scene(
             builds: vec![],
             traces: vec![],
             agreement: vec![],
+            cpu: Default::default(),
         },
     };
     let hash = formats::soup::geometry_hash(tris);
@@ -850,6 +861,7 @@ mod tests {
                 builds: vec![],
                 traces: vec![],
                 agreement: vec![],
+                cpu: Default::default(),
             },
         };
         // The tree is right on ray 0 (the other misses); the other is wrong on ray 1 too.
