@@ -12,7 +12,7 @@
 use crate::docs::{self, Doc};
 use crate::meta::hash_id;
 use crate::project::{ext, Project};
-use crate::yaml::Node;
+use crate::yaml::{self, Node};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -52,6 +52,8 @@ pub enum LoadError {
         #[source]
         source: std::io::Error,
     },
+    #[error("{0}: the file is empty (0 bytes)")]
+    Empty(PathBuf),
     #[error("{0}: is a binary Unity file, not text YAML; in Unity set Edit > Project Settings > Editor > Asset Serialization > Mode to \"Force Text\" and save the scene again")]
     Binary(PathBuf),
 }
@@ -208,7 +210,64 @@ impl<'p> Graph<'p> {
     /// Load the top-level scene.
     pub fn load_scene(&mut self, path: &Path) -> Result<(), LoadError> {
         self.load_file(path, true)?;
+        self.break_parent_cycles();
         Ok(())
+    }
+
+    /// A Transform whose `m_Father` chain loops back on itself has no place in the
+    /// world. Each loop is cut where it is found (that Transform goes to the root) with
+    /// a warning naming every object in the loop, so the objects still convert.
+    fn break_parent_cycles(&mut self) {
+        // 0 unvisited, 1 on the chain being walked, 2 done.
+        let mut state = vec![0u8; self.objs.len()];
+        for start in 0..self.objs.len() {
+            if state[start] != 0 || !is_transform(self.objs[start].class) {
+                continue;
+            }
+            let mut chain = Vec::new();
+            let mut cur = Some(start);
+            while let Some(i) = cur {
+                if state[i] != 0 {
+                    break;
+                }
+                state[i] = 1;
+                chain.push(i);
+                cur = self.objs[i].father;
+            }
+            if let Some(i) = cur.filter(|&i| state[i] == 1) {
+                // `i` is on this chain: the loop is chain[pos(i)..], closed by the last.
+                let at = chain.iter().position(|&c| c == i).unwrap_or(0);
+                let names: Vec<String> = chain[at..]
+                    .iter()
+                    .map(|&t| format!("'{}'", self.go_name(t)))
+                    .collect();
+                let last = *chain.last().unwrap_or(&i);
+                let file = self
+                    .files
+                    .get(self.objs[last].ctx)
+                    .map(|f| self.project.rel(&f.path))
+                    .unwrap_or_default();
+                self.warnings.push(format!(
+                    "{file}: object {} (fileID {}): parent cycle ({} -> {}); placed at the root",
+                    names.last().cloned().unwrap_or_default(),
+                    self.objs[last].file_id,
+                    names.join(" -> "),
+                    names[0],
+                ));
+                self.objs[last].father = None;
+            }
+            for c in chain {
+                state[c] = 2;
+            }
+        }
+    }
+
+    /// The GameObject name of a Transform (`?` when it has none).
+    fn go_name(&self, t: usize) -> &str {
+        self.objs[t]
+            .go
+            .and_then(|g| self.objs[g].body.str_at("m_Name"))
+            .unwrap_or("?")
     }
 
     /// Load a scene or prefab file; returns fileID → arena index for its objects
@@ -218,6 +277,9 @@ impl<'p> Graph<'p> {
             path: path.to_path_buf(),
             source,
         })?;
+        if bytes.is_empty() {
+            return Err(LoadError::Empty(path.to_path_buf()));
+        }
         if !docs::is_text_yaml(&bytes) {
             return Err(LoadError::Binary(path.to_path_buf()));
         }
@@ -336,6 +398,18 @@ impl<'p> Graph<'p> {
             }
             if !wanted(d.class) {
                 continue;
+            }
+            if let Some((line, what)) = yaml::malformed(d.body) {
+                // Line numbers count from the file's start: the header line is just
+                // before the body.
+                let offset = d.body.as_ptr() as usize - text.as_ptr() as usize;
+                let first = text[..offset].matches('\n').count() + 1;
+                self.warnings.push(format!(
+                    "{rel}:{}: document fileID {} ({}): malformed YAML: {what}; read what could be read",
+                    first + line - 1,
+                    d.file_id,
+                    d.body.lines().next().unwrap_or("").trim_end_matches(':'),
+                ));
             }
             let idx = self.push(d.class, d.parse(), d.file_id, ctx);
             map.insert(d.file_id, idx);
@@ -489,6 +563,12 @@ impl<'p> Graph<'p> {
                 return Default::default();
             }
         };
+        if asset.obj.groups.is_empty() {
+            self.warnings.push(format!(
+                "{what}: {} has no faces; nothing to convert",
+                self.project.rel(path)
+            ));
+        }
         let ctx = usize::MAX; // synthesised objects hold no local references
         let meta = &asset.meta;
         let stem = path

@@ -70,6 +70,9 @@ pub fn convert_report(scene: &Path, opts: &Options) -> Result<Report, ConvertErr
         path: scene.to_path_buf(),
         source,
     })?;
+    if bytes.is_empty() {
+        return Err(graph::LoadError::Empty(scene.to_path_buf()).into());
+    }
     if !docs::is_text_yaml(&bytes) {
         return Err(graph::LoadError::Binary(scene.to_path_buf()).into());
     }

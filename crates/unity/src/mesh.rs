@@ -6,6 +6,7 @@
 //! which does what Unity's importer does: negate X and reverse each triangle's winding.
 
 use glam::{Vec2, Vec3};
+use std::collections::HashMap;
 
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Mesh {
@@ -60,10 +61,15 @@ fn newell(poly: &[Vec3]) -> Vec3 {
     n
 }
 
+/// Largest polygon that is ear-clipped. Ear clipping costs up to n³ steps, so a file
+/// with one 20 000-corner face would hang the converter; larger non-convex polygons are
+/// fanned like convex ones (they are not real modelling data).
+pub const EAR_CLIP_MAX: usize = 512;
+
 /// Triangulate a polygon given by its corner positions, returning corner-index triples
 /// with the polygon's own orientation. Convex polygons are fanned from the first corner
-/// (as Unity's importer does for quads); non-convex ones are ear-clipped in the
-/// polygon's best-fit plane.
+/// (as Unity's importer does for quads); non-convex ones up to [`EAR_CLIP_MAX`] corners
+/// are ear-clipped in the polygon's best-fit plane.
 pub fn triangulate(poly: &[Vec3]) -> Vec<[usize; 3]> {
     let n = poly.len();
     if n < 3 {
@@ -73,7 +79,7 @@ pub fn triangulate(poly: &[Vec3]) -> Vec<[usize; 3]> {
         return vec![[0, 1, 2]];
     }
     let normal = newell(poly);
-    if normal.length_squared() == 0.0 || !normal.is_finite() {
+    if normal.length_squared() == 0.0 || !normal.is_finite() || n > EAR_CLIP_MAX {
         return (1..n - 1).map(|i| [0, i, i + 1]).collect();
     }
     // Project onto the plane: a 2D frame (u, v) with u × v along the normal, so the
@@ -144,35 +150,61 @@ pub fn smooth_normals(positions: &[Vec3], tris: &[[u32; 3]], crease_deg: f32) ->
         let e2 = positions[t[(k + 2) % 3] as usize] - p;
         e1.angle_between(e2)
     };
-    let mut incident: Vec<Vec<(u32, u8)>> = vec![Vec::new(); positions.len()];
+    // Faces around a position are grouped by their exact normal: every corner whose
+    // face has the same normal gets the same smoothed normal, so the crease comparison
+    // runs once per pair of distinct normals, not per pair of faces (a 20 000-triangle
+    // fan around one vertex is one group, not 4·10⁸ comparisons).
+    let key = |n: Vec3| n.to_array().map(f32::to_bits);
+    let mut groups: Vec<Vec<(Vec3, Vec3)>> = vec![Vec::new(); positions.len()]; // (normal, Σ n·w)
+    let mut group_ix: Vec<HashMap<[u32; 3], u32>> = vec![HashMap::new(); positions.len()];
+    let mut corner_group = vec![0u32; tris.len() * 3];
     for (ti, t) in tris.iter().enumerate() {
+        let nf = face_n[ti];
         for (k, &v) in t.iter().enumerate() {
-            incident[v as usize].push((ti as u32, k as u8));
+            let v = v as usize;
+            let gi = *group_ix[v].entry(key(nf)).or_insert_with(|| {
+                groups[v].push((nf, Vec3::ZERO));
+                (groups[v].len() - 1) as u32
+            });
+            let w = corner_angle(t, k);
+            if w.is_finite() {
+                groups[v][gi as usize].1 += nf * w;
+            }
+            corner_group[ti * 3 + k] = gi;
         }
     }
     let cos_crease = crease_deg.to_radians().cos();
+    // Smoothed normal per (position, group). Past this many distinct normals at one
+    // position (never in modelling data) the crease is ignored to stay linear.
+    const MAX_CREASE_GROUPS: usize = 1024;
+    let smoothed: Vec<Vec<Vec3>> = groups
+        .iter()
+        .map(|gs| {
+            let all: Vec3 = gs.iter().map(|g| g.1).sum();
+            gs.iter()
+                .map(|&(nf, _)| {
+                    let sum = if gs.len() > MAX_CREASE_GROUPS {
+                        all
+                    } else {
+                        gs.iter()
+                            .filter(|g| g.0.dot(nf) >= cos_crease)
+                            .map(|g| g.1)
+                            .sum()
+                    };
+                    let s = sum.normalize_or_zero();
+                    if s != Vec3::ZERO {
+                        s
+                    } else {
+                        nf
+                    }
+                })
+                .collect()
+        })
+        .collect();
     tris.iter()
         .enumerate()
         .map(|(ti, t)| {
-            let nf = face_n[ti];
-            let mut out = [nf; 3];
-            for (k, o) in out.iter_mut().enumerate() {
-                let mut sum = Vec3::ZERO;
-                for &(tj, kj) in &incident[t[k] as usize] {
-                    let ng = face_n[tj as usize];
-                    if ng.dot(nf) >= cos_crease {
-                        let w = corner_angle(&tris[tj as usize], kj as usize);
-                        if w.is_finite() {
-                            sum += ng * w;
-                        }
-                    }
-                }
-                let s = sum.normalize_or_zero();
-                if s != Vec3::ZERO {
-                    *o = s;
-                }
-            }
-            out
+            std::array::from_fn(|k| smoothed[t[k] as usize][corner_group[ti * 3 + k] as usize])
         })
         .collect()
 }

@@ -2,7 +2,7 @@
 //! decide which fileID names which object inside a model (DESIGN §4).
 
 use crate::yaml::{self, Node};
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 use xxhash_rust::xxh64::xxh64;
 
@@ -14,21 +14,70 @@ pub struct GuidIndex {
 }
 
 impl GuidIndex {
+    /// Symbolic links are followed only when they lead to a file or folder inside
+    /// `assets` (never outside the project), and each real folder is walked once, so a
+    /// link loop cannot hang the walk.
     pub fn build(assets: &Path) -> GuidIndex {
         let mut idx = GuidIndex::default();
+        let Ok(inside) = assets.canonicalize() else {
+            return idx;
+        };
+        let mut seen: HashSet<PathBuf> = [inside.clone()].into_iter().collect();
         let mut stack = vec![assets.to_path_buf()];
         while let Some(dir) = stack.pop() {
             let Ok(rd) = std::fs::read_dir(&dir) else {
                 continue;
             };
-            let mut entries: Vec<_> = rd.filter_map(Result::ok).map(|e| e.path()).collect();
-            entries.sort();
-            for p in entries {
-                if p.is_dir() {
+            let mut entries: Vec<_> = rd
+                .filter_map(Result::ok)
+                .filter_map(|e| Some((e.path(), e.file_type().ok()?)))
+                .collect();
+            entries.sort_by(|a, b| a.0.cmp(&b.0));
+            for (p, ty) in entries {
+                let is_dir = if ty.is_symlink() {
+                    match p.canonicalize() {
+                        Ok(real) if real.starts_with(&inside) => {
+                            if real.is_dir() && !seen.insert(real) {
+                                continue; // a folder already walked (link loop)
+                            }
+                            p.is_dir()
+                        }
+                        Ok(real) => {
+                            idx.warnings.push(format!(
+                                "{}: symbolic link to {}, outside the project; not read",
+                                p.display(),
+                                real.display()
+                            ));
+                            continue;
+                        }
+                        Err(_) => continue, // dangling link
+                    }
+                } else {
+                    if ty.is_dir() {
+                        if let Ok(real) = p.canonicalize() {
+                            seen.insert(real);
+                        }
+                    }
+                    ty.is_dir()
+                };
+                if is_dir {
                     stack.push(p);
                 } else if p.extension().is_some_and(|e| e == "meta") {
                     if let Some(guid) = read_guid(&p) {
                         let asset = p.with_extension("");
+                        // The asset itself may be a link out of the project.
+                        if let Some(real) = asset
+                            .canonicalize()
+                            .ok()
+                            .filter(|r| !r.starts_with(&inside))
+                        {
+                            idx.warnings.push(format!(
+                                "{}: symbolic link to {}, outside the project; not read",
+                                asset.display(),
+                                real.display()
+                            ));
+                            continue;
+                        }
                         if let Some(prev) = idx.map.get(&guid) {
                             idx.warnings.push(format!(
                                 "duplicate GUID {guid} in {} and {}; using the first",
@@ -52,7 +101,11 @@ impl GuidIndex {
 
 /// The `guid:` line of a `.meta` file (read as a string, never as a number).
 fn read_guid(meta: &Path) -> Option<String> {
-    let text = std::fs::read_to_string(meta).ok()?;
+    guid_of(&std::fs::read_to_string(meta).ok()?)
+}
+
+/// The GUID a `.meta` file's text declares, if any.
+pub fn guid_of(text: &str) -> Option<String> {
     text.lines()
         .find_map(|l| l.strip_prefix("guid:"))
         .map(|g| g.trim().to_string())

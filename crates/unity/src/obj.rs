@@ -68,7 +68,14 @@ fn resolve(idx: i64, len: usize) -> Option<u32> {
     (i >= 0 && (i as usize) < len).then_some(i as u32)
 }
 
+/// Load an OBJ, reading `mtllib` files only inside the OBJ's own folder.
 pub fn load(path: &Path) -> Result<ObjModel, ObjError> {
+    load_in(path, path.parent().unwrap_or(Path::new(".")))
+}
+
+/// Load an OBJ whose `mtllib` files may be anywhere under `root` (the project), and
+/// nowhere else: a `../../x.mtl` or absolute path that leaves it is not read.
+pub fn load_in(path: &Path, root: &Path) -> Result<ObjModel, ObjError> {
     let bytes = std::fs::read(path).map_err(|source| ObjError::Io {
         path: path.to_path_buf(),
         source,
@@ -77,10 +84,16 @@ pub fn load(path: &Path) -> Result<ObjModel, ObjError> {
         return Err(ObjError::LfsPointer(path.to_path_buf()));
     }
     let text = String::from_utf8_lossy(&bytes);
-    parse(&text, path)
+    parse_in(&text, path, root)
 }
 
+/// Parse OBJ text read from `path` (`mtllib` files only inside its folder).
 pub fn parse(text: &str, path: &Path) -> Result<ObjModel, ObjError> {
+    parse_in(text, path, path.parent().unwrap_or(Path::new(".")))
+}
+
+/// Parse OBJ text read from `path`, reading `mtllib` files only under `root`.
+pub fn parse_in(text: &str, path: &Path, root: &Path) -> Result<ObjModel, ObjError> {
     let mut pos: Vec<Vec3> = Vec::new();
     let mut nrm: Vec<Vec3> = Vec::new();
     let mut groups: Vec<GroupAcc> = Vec::new();
@@ -88,6 +101,8 @@ pub fn parse(text: &str, path: &Path) -> Result<ObjModel, ObjError> {
     let mut current_group = "default".to_string();
     let mut current_mtl = String::new();
     let mut mtllibs: Vec<String> = Vec::new();
+    // Faces of 0–2 corners (Unity skips them): how many, and the first line.
+    let mut short_faces = (0usize, 0usize);
     let bad = |line: usize, detail: String| ObjError::Parse {
         path: path.to_path_buf(),
         line,
@@ -162,6 +177,10 @@ pub fn parse(text: &str, path: &Path) -> Result<ObjModel, ObjError> {
                     poly.push((v, n));
                 }
                 if poly.len() < 3 {
+                    if short_faces.0 == 0 {
+                        short_faces.1 = lno;
+                    }
+                    short_faces.0 += 1;
                     continue;
                 }
                 let gi = *group_of.entry(current_group.clone()).or_insert_with(|| {
@@ -186,12 +205,30 @@ pub fn parse(text: &str, path: &Path) -> Result<ObjModel, ObjError> {
     }
 
     let mut warnings = Vec::new();
+    if short_faces.0 > 0 {
+        warnings.push(format!(
+            "{} faces with fewer than 3 corners skipped (the first on line {})",
+            short_faces.0, short_faces.1
+        ));
+    }
     let mut mtl_colors = HashMap::new();
     let dir = path.parent().unwrap_or(Path::new("."));
+    let root = root.canonicalize().ok();
     for lib in &mtllibs {
-        let p = dir.join(lib);
-        match std::fs::read_to_string(&p) {
-            Ok(t) => parse_mtl(&t, &mut mtl_colors),
+        // Resolve links and `..` before deciding: only files under the root are read.
+        let p = dir.join(lib).canonicalize();
+        match p {
+            Ok(p) if root.as_ref().is_some_and(|r| p.starts_with(r)) => {
+                match std::fs::read_to_string(&p) {
+                    Ok(t) => parse_mtl(&t, &mut mtl_colors),
+                    Err(e) => warnings.push(format!(
+                        "material library {lib}: {e}; its materials use Unity's default"
+                    )),
+                }
+            }
+            Ok(_) => warnings.push(format!(
+                "material library {lib} is outside the project; not read, its materials use Unity's default"
+            )),
             Err(_) => warnings.push(format!(
                 "material library {lib} not found; its materials use Unity's default"
             )),

@@ -137,7 +137,7 @@ impl Project {
 
 impl Project {
     fn load_model(&self, path: &Path) -> Result<ModelAsset, String> {
-        let obj = obj::load(path).map_err(|e| {
+        let obj = obj::load_in(path, &self.root).map_err(|e| {
             // Name the file relative to the project, as every other message does.
             e.to_string()
                 .replace(&path.display().to_string(), &self.rel(path))

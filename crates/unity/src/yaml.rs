@@ -155,6 +155,64 @@ pub fn parse(text: &str) -> Node {
     p.node(indent)
 }
 
+/// The first sign that a document body is not YAML as Unity writes it: a flow
+/// collection that is never closed or closes more than it opened, or a line that is
+/// neither `key: value` nor a list item. Returns the 1-based line within `text` and what
+/// is wrong. [`parse`] still reads what it can of such a body; this lets the converter
+/// say which document it had to guess at.
+pub fn malformed(text: &str) -> Option<(usize, String)> {
+    let mut depth: i64 = 0;
+    let mut opened = 0usize;
+    // Indent of the previous structural line, and whether it ended with `:`.
+    let mut prev: Option<(usize, bool)> = None;
+    for (i, raw) in text.lines().enumerate() {
+        let raw = raw.trim_end_matches('\r');
+        let t = raw.trim_start_matches(' ');
+        if depth > 0 {
+            depth += bracket_balance(t);
+            if depth < 0 {
+                return Some((i + 1, "a flow collection closes more than it opened".into()));
+            }
+            continue;
+        }
+        if t.is_empty() || t.starts_with('#') || t.starts_with('%') {
+            continue;
+        }
+        let indent = raw.len() - t.len();
+        let structural = looks_structural(t);
+        if let Some((pi, colon)) = prev {
+            // A deeper plain line continues a multi-line scalar (see logical_lines).
+            if indent > pi && !structural && !colon {
+                continue;
+            }
+        }
+        if !structural {
+            let shown: String = t.chars().take(40).collect();
+            return Some((
+                i + 1,
+                format!("`{shown}` is neither `key: value` nor a list item"),
+            ));
+        }
+        if let Some(v) = flow_value(t) {
+            let b = bracket_balance(v);
+            if b < 0 {
+                return Some((i + 1, "a flow collection closes more than it opened".into()));
+            }
+            if b > 0 {
+                depth = b;
+                opened = i + 1;
+            }
+        }
+        prev = Some((indent, t.ends_with(':')));
+    }
+    (depth > 0).then(|| {
+        (
+            opened,
+            "a flow collection opened here is never closed".into(),
+        )
+    })
+}
+
 /// Split into lines, dropping blanks and comments, and join flow collections that wrap
 /// onto following lines (Unity wraps long `{fileID: …, guid: …, type: 3}` values).
 fn logical_lines(text: &str) -> Vec<Line> {
@@ -426,7 +484,15 @@ impl Flow<'_> {
                             self.i += 1;
                             continue;
                         }
-                        _ => items.push(self.value(false)),
+                        _ => {
+                            let at = self.i;
+                            items.push(self.value(false));
+                            // A stray `}` ends a scalar without being consumed; step over
+                            // it, or `[a}` would loop forever (found by fuzzing).
+                            if self.i == at {
+                                self.i += 1;
+                            }
+                        }
                     }
                 }
                 Node::Seq(items)
@@ -549,5 +615,47 @@ mod tests {
         assert_eq!(parse_f32("0x3f800000(9)"), Some(1.0));
         assert_eq!(parse_f32(".5"), Some(0.5));
         assert_eq!(parse_f32("-.25"), Some(-0.25));
+        // Wrapped flow maps, multi-line names and empty values are Unity's own forms.
+        let body = "Transform:\n  m_GameObject: {fileID: 12}\n  m_LocalRotation: {x: 0, y: 0.7071068, z: 0,\n    w: 0.7071068}\n  m_Children:\n  - {fileID: 5}\n  m_Component:\n  - component: {fileID: 7}\n  - 4: {fileID: 8}\n  field of view: 60\n  m_Name: My Thing: 2\n  empty:\n";
+        assert_eq!(malformed(body), None);
+        assert_eq!(
+            malformed("GameObject:\n  m_Name: a long\n    name\n  m_Tag: {\n    a: 1}\n"),
+            None
+        );
+    }
+
+    #[test]
+    fn stray_closing_brace_in_a_flow_sequence_ends() {
+        // Fuzzer find (unity_meta): `[… }` used to loop forever, growing the list.
+        let n = parse("A:\n  k: [9cd+6f\0}\n  j: [a, }, b]\n");
+        let a = n.get("A").unwrap();
+        assert_eq!(a.get("k").unwrap().as_seq().len(), 2);
+        let j: Vec<_> = a
+            .get("j")
+            .unwrap()
+            .as_seq()
+            .iter()
+            .map(|x| x.as_str())
+            .collect();
+        assert_eq!(j, [Some("a"), Some(""), Some("b")]);
+    }
+
+    #[test]
+    fn malformed_bodies_name_the_line() {
+        let open = "GameObject:\n  m_Component:\n  - component: {fileID: 301\n  m_Name: x\n";
+        assert_eq!(
+            malformed(open),
+            Some((3, "a flow collection opened here is never closed".into()))
+        );
+        let extra = "Transform:\n  m_LocalPosition: {x: 1, y: 2}}\n";
+        assert_eq!(
+            malformed(extra).map(|m| m.0),
+            Some(2),
+            "an extra closing brace"
+        );
+        let stray = "Transform:\n  m_Father: {fileID: 0}\n  just words here\n";
+        let (line, what) = malformed(stray).unwrap();
+        assert_eq!(line, 3);
+        assert!(what.contains("`just words here`"), "{what}");
     }
 }
