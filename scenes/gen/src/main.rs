@@ -1,1 +1,44 @@
-fn main() {}
+//! `scenegen [SCENES_DIR] [--only NAME]`: (re)write the bundled Unity projects.
+
+use anyhow::{bail, Context, Result};
+use clap::Parser;
+use std::path::PathBuf;
+
+#[derive(Parser)]
+#[command(about = "Write the bundled Unity projects (baseline and effect scenes)")]
+struct Args {
+    /// Folder that holds the projects (one sub-folder each).
+    #[arg(default_value = "scenes")]
+    dir: PathBuf,
+    /// Only this project (e.g. `baseline`, `spot`).
+    #[arg(long)]
+    only: Option<String>,
+}
+
+fn main() {
+    if let Err(e) = run() {
+        eprintln!("scenegen: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+fn run() -> Result<()> {
+    let args = Args::parse();
+    let projects: Vec<_> = scenegen::all_projects()
+        .into_iter()
+        .filter(|p| args.only.as_deref().is_none_or(|o| o == p.name))
+        .collect();
+    if projects.is_empty() {
+        bail!("no project named {:?}", args.only.unwrap_or_default());
+    }
+    for p in &projects {
+        let stale = p
+            .write(&args.dir)
+            .with_context(|| format!("writing {}", args.dir.join(&p.name).display()))?;
+        for s in stale {
+            eprintln!("removed stale {}/{}/{s}", args.dir.display(), p.name);
+        }
+        println!("{}: {} files", args.dir.join(&p.name).display(), p.files.len());
+    }
+    Ok(())
+}

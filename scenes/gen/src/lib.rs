@@ -1,0 +1,22 @@
+//! Generator of the Unity projects bundled in `scenes/`: the seed's baseline scene (OBJ
+//! models at exact triangle counts) and one small project per rendering effect.
+//!
+//! Everything is built in memory first ([`project::Project`]), so the same bytes are
+//! written to disk by the binary and compared with the committed files by the tests.
+
+pub mod baseline;
+pub mod effects;
+pub mod ids;
+pub mod material;
+pub mod mesh;
+pub mod meta;
+pub mod models;
+pub mod project;
+pub mod unity;
+
+/// Every bundled project, baseline first.
+pub fn all_projects() -> Vec<project::Project> {
+    let mut v = vec![baseline::project()];
+    v.extend(effects::all());
+    v
+}

@@ -1,0 +1,176 @@
+//! Standard-shader `.mat` files as Unity 2022.3 writes them (Material serializedVersion 8).
+
+use crate::unity::{num, rgba};
+use std::fmt::Write;
+
+/// One look. Colours are sRGB, as the inspector stores them.
+#[derive(Clone, Debug)]
+pub struct MatDesc {
+    pub name: &'static str,
+    pub color: [f32; 3],
+    pub metallic: f32,
+    pub glossiness: f32,
+    /// unitrace's own `_Reflectivity` float: overrides metallic·smoothness when present.
+    pub reflectivity: Option<f32>,
+    /// `_EmissionColor` (HDR, sRGB-encoded); `Some` also turns on the `_EMISSION` keyword.
+    pub emission: Option<[f32; 3]>,
+}
+
+impl MatDesc {
+    /// A non-metallic matte colour.
+    pub fn matte(name: &'static str, color: [f32; 3]) -> Self {
+        MatDesc {
+            name,
+            color,
+            metallic: 0.0,
+            glossiness: 0.2,
+            reflectivity: None,
+            emission: None,
+        }
+    }
+
+    /// A perfect mirror: metallic 1, smoothness 1.
+    pub fn mirror(name: &'static str) -> Self {
+        MatDesc {
+            name,
+            color: [1.0, 1.0, 1.0],
+            metallic: 1.0,
+            glossiness: 1.0,
+            reflectivity: None,
+            emission: None,
+        }
+    }
+}
+
+const TEXTURES: [&str; 9] = [
+    "_BumpMap",
+    "_DetailAlbedoMap",
+    "_DetailMask",
+    "_DetailNormalMap",
+    "_EmissionMap",
+    "_MainTex",
+    "_MetallicGlossMap",
+    "_OcclusionMap",
+    "_ParallaxMap",
+];
+
+pub fn write_material(m: &MatDesc) -> String {
+    let mut s = String::from("%YAML 1.1\n%TAG !u! tag:unity3d.com,2011:\n--- !u!21 &2100000\nMaterial:\n");
+    let keywords = if m.emission.is_some() {
+        "\n  - _EMISSION"
+    } else {
+        " []"
+    };
+    // Emissive materials default to realtime GI emission (1); others to "emissive is
+    // black" (4), exactly as the inspector sets them.
+    let lightmap_flags = if m.emission.is_some() { 1 } else { 4 };
+    let _ = write!(
+        s,
+        "  serializedVersion: 8
+  m_ObjectHideFlags: 0
+  m_CorrespondingSourceObject: {{fileID: 0}}
+  m_PrefabInstance: {{fileID: 0}}
+  m_PrefabAsset: {{fileID: 0}}
+  m_Name: {name}
+  m_Shader: {{fileID: 46, guid: 0000000000000000f000000000000000, type: 0}}
+  m_Parent: {{fileID: 0}}
+  m_ModifiedSerializedProperties: 0
+  m_ValidKeywords:{keywords}
+  m_InvalidKeywords: []
+  m_LightmapFlags: {lightmap_flags}
+  m_EnableInstancingVariants: 0
+  m_DoubleSidedGI: 0
+  m_CustomRenderQueue: -1
+  stringTagMap: {{}}
+  disabledShaderPasses: []
+  m_LockedProperties: 
+  m_SavedProperties:
+    serializedVersion: 3
+    m_TexEnvs:
+",
+        name = m.name
+    );
+    for t in TEXTURES {
+        let _ = write!(
+            s,
+            "    - {t}:
+        m_Texture: {{fileID: 0}}
+        m_Scale: {{x: 1, y: 1}}
+        m_Offset: {{x: 0, y: 0}}
+"
+        );
+    }
+    s += "    m_Ints: []\n    m_Floats:\n";
+    // Unity keeps properties sorted by name; `_Reflectivity` slots in among them.
+    let mut floats: Vec<(&str, f32)> = vec![
+        ("_BumpScale", 1.0),
+        ("_Cutoff", 0.5),
+        ("_DetailNormalMapScale", 1.0),
+        ("_DstBlend", 0.0),
+        ("_GlossMapScale", 1.0),
+        ("_Glossiness", m.glossiness),
+        ("_GlossyReflections", 1.0),
+        ("_Metallic", m.metallic),
+        ("_Mode", 0.0),
+        ("_OcclusionStrength", 1.0),
+        ("_Parallax", 0.02),
+        ("_SmoothnessTextureChannel", 0.0),
+        ("_SpecularHighlights", 1.0),
+        ("_SrcBlend", 1.0),
+        ("_UVSec", 0.0),
+        ("_ZWrite", 1.0),
+    ];
+    if let Some(r) = m.reflectivity {
+        floats.push(("_Reflectivity", r));
+    }
+    floats.sort_by(|a, b| a.0.cmp(b.0));
+    for (k, v) in floats {
+        let _ = writeln!(s, "    - {k}: {}", num(v));
+    }
+    let emission = m.emission.unwrap_or([0.0, 0.0, 0.0]);
+    let _ = write!(
+        s,
+        "    m_Colors:
+    - _Color: {}
+    - _EmissionColor: {}
+  m_BuildTextureStacks: []
+",
+        rgba(m.color, 1.0),
+        rgba(emission, 1.0)
+    );
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn floor_material_carries_reflectivity_in_sorted_order() {
+        let m = MatDesc {
+            name: "Floor",
+            color: [0.1, 0.2, 0.9],
+            metallic: 0.6,
+            glossiness: 1.0,
+            reflectivity: Some(0.8),
+            emission: None,
+        };
+        let text = write_material(&m);
+        let p = text.find("    - _Parallax: 0.02").unwrap();
+        let r = text.find("    - _Reflectivity: 0.8").unwrap();
+        let sm = text.find("    - _SmoothnessTextureChannel: 0").unwrap();
+        assert!(p < r && r < sm);
+        assert!(text.contains("    - _Metallic: 0.6\n"));
+        assert!(text.contains("    - _Color: {r: 0.1, g: 0.2, b: 0.9, a: 1}\n"));
+        assert!(text.contains("  m_ValidKeywords: []\n"));
+    }
+
+    #[test]
+    fn emission_turns_on_the_keyword() {
+        let mut m = MatDesc::matte("Glow", [1.0, 1.0, 1.0]);
+        m.emission = Some([2.0, 1.0, 0.25]);
+        let text = write_material(&m);
+        assert!(text.contains("  m_ValidKeywords:\n  - _EMISSION\n"));
+        assert!(text.contains("    - _EmissionColor: {r: 2, g: 1, b: 0.25, a: 1}\n"));
+    }
+}

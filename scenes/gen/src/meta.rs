@@ -1,0 +1,157 @@
+//! `.meta` files: the importer settings Unity 2022.3 writes next to every asset.
+
+/// A model's `.meta`: ModelImporter with Unity 2022's defaults, `fileIdsGeneration: 2`
+/// (so mesh fileIDs are xxHash64 of `Type:Mesh-><name>0`), scale 1.
+pub fn model(guid: &str) -> String {
+    format!("fileFormatVersion: 2\nguid: {guid}\n{MODEL_IMPORTER}")
+}
+
+/// A `.mat` file's `.meta`: the material is object 2100000 of its file.
+pub fn material(guid: &str) -> String {
+    format!(
+        "fileFormatVersion: 2\nguid: {guid}\nNativeFormatImporter:\n  externalObjects: {{}}\n  mainObjectFileID: 2100000\n{TAIL}"
+    )
+}
+
+/// A scene's `.meta`.
+pub fn scene(guid: &str) -> String {
+    format!("fileFormatVersion: 2\nguid: {guid}\nDefaultImporter:\n  externalObjects: {{}}\n{TAIL}")
+}
+
+/// A folder's `.meta`.
+pub fn folder(guid: &str) -> String {
+    format!(
+        "fileFormatVersion: 2\nguid: {guid}\nfolderAsset: yes\nDefaultImporter:\n  externalObjects: {{}}\n{TAIL}"
+    )
+}
+
+// Unity writes these three keys with a trailing space when they are empty.
+const TAIL: &str = "  userData: \n  assetBundleName: \n  assetBundleVariant: \n";
+
+const MODEL_IMPORTER: &str = "ModelImporter:
+  serializedVersion: 22200
+  internalIDToNameTable: []
+  externalObjects: {}
+  materials:
+    materialImportMode: 2
+    materialName: 0
+    materialSearch: 1
+    materialLocation: 1
+  animations:
+    legacyGenerateAnimations: 4
+    bakeSimulation: 0
+    resampleCurves: 1
+    optimizeGameObjects: 0
+    removeConstantScaleCurves: 0
+    motionNodeName: 
+    animationImportErrors: 
+    animationImportWarnings: 
+    animationRetargetingWarnings: 
+    animationDoRetargetingWarnings: 0
+    importAnimatedCustomProperties: 0
+    importConstraints: 0
+    animationCompression: 1
+    animationRotationError: 0.5
+    animationPositionError: 0.5
+    animationScaleError: 0.5
+    animationWrapMode: 0
+    extraExposedTransformPaths: []
+    extraUserProperties: []
+    clipAnimations: []
+    isReadable: 1
+  meshes:
+    lODScreenPercentages: []
+    globalScale: 1
+    meshCompression: 0
+    addColliders: 0
+    useSRGBMaterialColor: 1
+    sortHierarchyByName: 1
+    importPhysicalCameras: 1
+    importVisibility: 1
+    importBlendShapes: 1
+    importCameras: 1
+    importLights: 1
+    nodeNameCollisionStrategy: 1
+    fileIdsGeneration: 2
+    swapUVChannels: 0
+    generateSecondaryUV: 0
+    useFileUnits: 1
+    keepQuads: 0
+    weldVertices: 1
+    bakeAxisConversion: 0
+    preserveHierarchy: 0
+    skinWeightsMode: 0
+    maxBonesPerVertex: 4
+    minBoneWeight: 0.001
+    optimizeBones: 1
+    meshOptimizationFlags: -1
+    indexFormat: 0
+    secondaryUVAngleDistortion: 8
+    secondaryUVAreaDistortion: 15.000001
+    secondaryUVHardAngle: 88
+    secondaryUVMarginMethod: 1
+    secondaryUVMinLightmapResolution: 40
+    secondaryUVMinObjectScale: 1
+    secondaryUVPackMargin: 4
+    useFileScale: 1
+    strictVertexDataChecks: 0
+  tangentSpace:
+    normalSmoothAngle: 60
+    normalImportMode: 0
+    tangentImportMode: 3
+    normalCalculationMode: 4
+    legacyComputeAllNormalsFromSmoothingGroupsWhenMeshHasBlendShapes: 0
+    blendShapeNormalImportMode: 1
+    normalSmoothingSource: 0
+  referencedClips: []
+  importAnimation: 1
+  humanDescription:
+    serializedVersion: 3
+    human: []
+    skeleton: []
+    armTwist: 0.5
+    foreArmTwist: 0.5
+    upperLegTwist: 0.5
+    legTwist: 0.5
+    armStretch: 0.05
+    legStretch: 0.05
+    feetSpacing: 0
+    globalScale: 1
+    rootMotionBoneName: 
+    hasTranslationDoF: 0
+    hasExtraRoot: 0
+    skeletonHasParents: 1
+  lastHumanDescriptionAvatarSource: {instanceID: 0}
+  autoGenerateAvatarMappingIfUnspecified: 1
+  animationType: 2
+  humanoidOversampling: 1
+  avatarSetup: 0
+  addHumanoidExtraRootOnlyWhenUsingAvatar: 1
+  importBlendShapeDeformPercent: 1
+  remapMaterialsIfMaterialImportModeIsNone: 0
+  additionalBone: 0
+  userData: 
+  assetBundleName: 
+  assetBundleVariant: 
+";
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn model_meta_has_the_keys_the_converter_reads() {
+        let m = model("0123456789abcdef0123456789abcdef");
+        assert!(m.starts_with("fileFormatVersion: 2\nguid: 0123456789abcdef0123456789abcdef\nModelImporter:\n  serializedVersion: 22200\n  internalIDToNameTable: []\n"));
+        for key in ["    fileIdsGeneration: 2\n", "    globalScale: 1\n", "    useFileScale: 1\n"] {
+            assert!(m.contains(key), "missing {key:?}");
+        }
+        assert!(m.ends_with("  assetBundleVariant: \n"));
+    }
+
+    #[test]
+    fn material_meta_names_the_main_object() {
+        let m = material("00000000000000000000000000000001");
+        assert!(m.contains("NativeFormatImporter:\n  externalObjects: {}\n  mainObjectFileID: 2100000\n"));
+    }
+}
