@@ -267,4 +267,44 @@ mod tests {
         let s = smooth_normals(&p, &tris, 180.0);
         assert!(s[0][0].y > 0.1 && s[0][0].z > 0.1);
     }
+
+    #[test]
+    fn huge_fans_and_polygons_stay_bounded() {
+        // A 20 000-corner star (non-convex): fanned, not ear-clipped (n³).
+        let n = 20_000;
+        let star: Vec<Vec3> = (0..n)
+            .map(|i| {
+                let a = i as f32 / n as f32 * std::f32::consts::TAU;
+                let r = if i % 2 == 0 { 1.0 } else { 0.5 };
+                Vec3::new(r * a.cos(), r * a.sin(), 0.0)
+            })
+            .collect();
+        let tris = triangulate(&star);
+        assert_eq!(tris.len(), n - 2);
+        assert_eq!(tris[5], [0, 6, 7]);
+        // All of them share corner 0: one normal group there, so smoothing is linear;
+        // every corner of this flat fan gets the fan's normal (+Z for CCW corners).
+        let t32: Vec<[u32; 3]> = tris.iter().map(|t| t.map(|i| i as u32)).collect();
+        let sn = smooth_normals(&star, &t32, 60.0);
+        assert_eq!(sn.len(), n - 2);
+        let flat = sn.iter().flatten().filter(|v| v.z.abs() > 0.999).count();
+        assert_eq!(flat, 3 * (n - 2));
+        // A cone of 3 000 distinct face normals around its apex: past the group cap the
+        // apex normal is the plain weighted average (straight up), still unit length.
+        let m = 3_000;
+        let mut pts = vec![Vec3::new(0.0, 1.0, 0.0)];
+        pts.extend((0..m).map(|i| {
+            let a = i as f32 / m as f32 * std::f32::consts::TAU;
+            Vec3::new(a.cos(), 0.0, -a.sin())
+        }));
+        let cone: Vec<[u32; 3]> = (0..m as u32)
+            .map(|i| [0, 1 + i, 1 + (i + 1) % m as u32])
+            .collect();
+        let cn = smooth_normals(&pts, &cone, 60.0);
+        assert!(
+            cn.iter().all(|t| (t[0] - Vec3::Y).length() < 1e-3),
+            "{:?}",
+            cn[0][0]
+        );
+    }
 }

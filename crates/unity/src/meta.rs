@@ -42,6 +42,11 @@ impl GuidIndex {
                             }
                             p.is_dir()
                         }
+                        // Other linked files are only read through their .meta,
+                        // which reports them (below).
+                        Ok(real) if real.is_file() && p.extension().is_none_or(|e| e != "meta") => {
+                            continue;
+                        }
                         Ok(real) => {
                             idx.warnings.push(format!(
                                 "{}: symbolic link to {}, outside the project; not read",
@@ -244,6 +249,31 @@ mod tests {
         assert_eq!(hash_id("Type:GameObject->//RootNode0"), -927199367670048503);
         assert_eq!(hash_id("Type:Transform->//RootNode0"), -4216859302048453862);
         assert_eq!(hash_id("Type:Transform->default0"), -5975033157549033438);
+    }
+
+    #[test]
+    fn links_out_of_assets_and_link_loops_are_not_followed() {
+        let dir = tempfile::tempdir().unwrap();
+        let assets = dir.path().join("Assets");
+        let outside = dir.path().join("outside");
+        std::fs::create_dir_all(assets.join("in")).unwrap();
+        std::fs::create_dir_all(&outside).unwrap();
+        std::fs::write(assets.join("in/a.obj.meta"), "guid: aaaa\n").unwrap();
+        std::fs::write(outside.join("b.obj.meta"), "guid: bbbb\n").unwrap();
+        std::fs::write(outside.join("c.obj"), "v 0 0 0\n").unwrap();
+        std::os::unix::fs::symlink(&outside, assets.join("out")).unwrap();
+        std::os::unix::fs::symlink(&assets, assets.join("in/loop")).unwrap();
+        // An asset inside whose file is a link out of the project.
+        std::os::unix::fs::symlink(outside.join("c.obj"), assets.join("c.obj")).unwrap();
+        std::fs::write(assets.join("c.obj.meta"), "guid: cccc\n").unwrap();
+        let idx = GuidIndex::build(&assets);
+        assert_eq!(idx.map.len(), 1, "{:?}", idx.map);
+        assert!(idx.get("aaaa").is_some());
+        assert_eq!(idx.warnings.len(), 2, "{:?}", idx.warnings);
+        assert!(idx
+            .warnings
+            .iter()
+            .all(|w| w.contains("outside the project")));
     }
 
     #[test]

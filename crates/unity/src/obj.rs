@@ -347,6 +347,36 @@ mod tests {
     }
 
     #[test]
+    fn short_faces_are_counted_and_mtllib_stays_inside_the_root() {
+        let dir = tempfile::tempdir().unwrap();
+        let root = dir.path().join("Proj");
+        std::fs::create_dir_all(root.join("Assets/m")).unwrap();
+        std::fs::write(dir.path().join("out.mtl"), "newmtl red\nKd 0.1 0.2 0.3\n").unwrap();
+        std::fs::write(root.join("Assets/in.mtl"), "newmtl blue\nKd 0 0 1\n").unwrap();
+        let text = "mtllib ../../../out.mtl\nmtllib ../in.mtl\nmtllib /etc/hostname\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\nf 3\nf 1 2 3\n";
+        let m = parse_in(text, &root.join("Assets/m/a.obj"), &root).unwrap();
+        assert_eq!(m.triangle_count(), 1);
+        assert!(
+            !m.mtl_colors.contains_key("red"),
+            "read outside the project"
+        );
+        assert_eq!(m.mtl_colors.get("blue"), Some(&Vec3::Z));
+        let outside: Vec<_> = m
+            .warnings
+            .iter()
+            .filter(|w| w.contains("outside the project"))
+            .collect();
+        assert_eq!(outside.len(), 2, "{:?}", m.warnings);
+        assert!(
+            m.warnings.contains(
+                &"2 faces with fewer than 3 corners skipped (the first on line 7)".to_string()
+            ),
+            "{:?}",
+            m.warnings
+        );
+    }
+
+    #[test]
     fn lfs_pointer_is_refused() {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("b.obj");
