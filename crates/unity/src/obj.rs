@@ -63,6 +63,27 @@ struct GroupAcc {
     subs: Vec<(String, Vec<Vec<Corner>>)>,
 }
 
+/// A line or token as quoted in a message: at most 40 characters, control and
+/// replacement characters shown as `?`, so binary garbage cannot flood or drive the
+/// terminal.
+fn shown(s: &str) -> String {
+    let mut out: String = s
+        .chars()
+        .take(40)
+        .map(|c| {
+            if c.is_control() || c == char::REPLACEMENT_CHARACTER {
+                '?'
+            } else {
+                c
+            }
+        })
+        .collect();
+    if s.chars().nth(40).is_some() {
+        out.push('…');
+    }
+    out
+}
+
 fn resolve(idx: i64, len: usize) -> Option<u32> {
     let i = if idx < 0 { len as i64 + idx } else { idx - 1 };
     (i >= 0 && (i as usize) < len).then_some(i as u32)
@@ -128,9 +149,9 @@ pub fn parse_in(text: &str, path: &Path, root: &Path) -> Result<ObjModel, ObjErr
                 .take(3)
                 .map(|s| s.parse::<f32>())
                 .collect::<Result<_, _>>()
-                .map_err(|e| bad(lno, format!("bad number in `{line}`: {e}")))?;
+                .map_err(|e| bad(lno, format!("bad number in `{}`: {e}", shown(line))))?;
             if v.len() < 3 {
-                return Err(bad(lno, format!("expected 3 numbers in `{line}`")));
+                return Err(bad(lno, format!("expected 3 numbers in `{}`", shown(line))));
             }
             // Non-finite numbers are kept: the converter refuses the mesh with an error
             // that names the scene object using it.
@@ -159,15 +180,15 @@ pub fn parse_in(text: &str, path: &Path, root: &Path) -> Result<ObjModel, ObjErr
                     let vi: i64 = parts
                         .next()
                         .and_then(|s| s.parse().ok())
-                        .ok_or_else(|| bad(lno, format!("bad face corner `{c}`")))?;
+                        .ok_or_else(|| bad(lno, format!("bad face corner `{}`", shown(c))))?;
                     let v = resolve(vi, pos.len())
                         .ok_or_else(|| bad(lno, format!("vertex index {vi} out of range")))?;
                     let _vt = parts.next();
                     let n = match parts.next().filter(|s| !s.is_empty()) {
                         Some(s) => {
-                            let ni: i64 = s
-                                .parse()
-                                .map_err(|_| bad(lno, format!("bad normal index in `{c}`")))?;
+                            let ni: i64 = s.parse().map_err(|_| {
+                                bad(lno, format!("bad normal index in `{}`", shown(c)))
+                            })?;
                             Some(resolve(ni, nrm.len()).ok_or_else(|| {
                                 bad(lno, format!("normal index {ni} out of range"))
                             })?)
@@ -374,6 +395,15 @@ mod tests {
             "{:?}",
             m.warnings
         );
+    }
+
+    #[test]
+    fn garbage_is_quoted_short_and_escaped() {
+        let text = format!("v \u{1b}[2J{}\n", "\u{fffd}".repeat(100));
+        let e = parse(&text, Path::new("g.obj")).unwrap_err().to_string();
+        assert!(e.starts_with("g.obj:1: bad number in `v ?[2J???"), "{e}");
+        assert!(e.contains("…`"), "{e}");
+        assert!(e.chars().count() < 90, "{e}");
     }
 
     #[test]
