@@ -40,6 +40,8 @@ pub struct Config {
     pub embree_quality: crate::embree::Quality,
     /// The exact command line, for the report's header.
     pub command: String,
+    /// Extra header lines (e.g. which commit of the k-d tree was measured).
+    pub remarks: Vec<String>,
 }
 
 impl Config {
@@ -59,6 +61,7 @@ impl Config {
             #[cfg(feature = "embree")]
             embree_quality: crate::embree::Quality::High,
             command: String::new(),
+            remarks: vec![],
         }
     }
 
@@ -693,6 +696,7 @@ fn header(cfg: &Config) -> Vec<String> {
             cfg.brute_rays
         ),
     ];
+    h.extend(cfg.remarks.iter().cloned());
     #[cfg(feature = "embree")]
     {
         let version = crate::embree::Device::new(1)

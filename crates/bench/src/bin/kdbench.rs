@@ -36,6 +36,9 @@ struct Args {
     /// Write the markdown report here too (atomically).
     #[arg(long)]
     out: Option<PathBuf>,
+    /// A line for the report's header (repeatable), e.g. "kdtree at commit 1c08420".
+    #[arg(long)]
+    note: Vec<String>,
     /// Smoke test: one small generated scene and few rays; finishes in seconds.
     #[arg(long)]
     quick: bool,
@@ -86,6 +89,7 @@ fn real_main(args: Args) -> Result<()> {
         };
     }
     cfg.command = std::env::args().collect::<Vec<_>>().join(" ");
+    cfg.remarks = args.note.clone();
     let report = run(&cfg, &mut |line| eprintln!("{line}"))?;
     let md = report::markdown(&report);
     print!("{md}");
