@@ -223,3 +223,117 @@ mod tests {
         ));
     }
 }
+
+#[cfg(test)]
+mod tree_tests {
+    use super::*;
+
+    fn scene() -> Vec<[Vec3; 3]> {
+        let mut t = gen::sphere(Vec3::new(0.0, 1.0, 0.0), 1.0, 16, 32);
+        t.extend(gen::grid(8, 8.0, 0.0));
+        t
+    }
+
+    #[test]
+    fn stats_describe_the_tree() {
+        let tris = scene();
+        let kd = build(&tris, &BuildParams::default(), [7; 32]);
+        let s = &kd.stats;
+        assert_eq!(s.triangles, tris.len() as u64);
+        assert_eq!(s.nodes, kd.nodes.len() as u64);
+        assert_eq!(
+            s.leaves,
+            kd.nodes.iter().filter(|n| n.is_leaf()).count() as u64
+        );
+        assert_eq!(s.nodes, 2 * s.leaves - 1, "a full binary tree");
+        assert_eq!(s.references, kd.leaf_tris.len() as u64);
+        assert!(
+            s.references >= tris.len() as u64,
+            "every triangle is in some leaf"
+        );
+        let mut seen = vec![false; tris.len()];
+        for &t in &kd.leaf_tris {
+            seen[t as usize] = true;
+        }
+        assert!(seen.iter().all(|&b| b));
+        assert!(s.max_depth <= depth_bound(&BuildParams::default(), tris.len()));
+        assert!(s.sah_cost > 0.0 && s.sah_cost < tris.len() as f64);
+        // The SAH tree is cheaper than the spatial-median tree on the same input.
+        let median = build_median(&tris, &BuildParams::default(), [7; 32]);
+        assert!(
+            s.sah_cost < median.stats.sah_cost,
+            "{} vs {}",
+            s.sah_cost,
+            median.stats.sah_cost
+        );
+        assert!(kd.validate().is_ok());
+    }
+
+    #[test]
+    fn depth_bound_and_leaf_size_are_obeyed() {
+        let tris = scene();
+        for (max_depth, leaf_size) in [(1, 1), (4, 1), (0, 16)] {
+            let p = BuildParams {
+                max_depth,
+                leaf_size,
+                ..BuildParams::default()
+            };
+            let kd = build(&tris, &p, [0; 32]);
+            assert!(kd.stats.max_depth <= depth_bound(&p, tris.len()), "{p:?}");
+            if max_depth == 1 {
+                assert_eq!(kd.stats.nodes, 3);
+            }
+        }
+        assert_eq!(depth_bound(&BuildParams::default(), 1 << 20), 34);
+        let huge = BuildParams {
+            max_depth: 500,
+            ..BuildParams::default()
+        };
+        assert_eq!(depth_bound(&huge, 10), build::MAX_DEPTH_LIMIT);
+    }
+
+    #[test]
+    fn refuses_corrupt_and_too_deep_trees() {
+        let tris = scene();
+        let hash = formats::soup::geometry_hash(&tris);
+        // A chain of 70 interior nodes: deeper than the traversal stack.
+        let mut nodes = Vec::new();
+        for i in 0..70u32 {
+            nodes.push(KdNode::interior(0, 0.0, 2 * i + 2));
+            nodes.push(KdNode::leaf(0, 0));
+        }
+        nodes.pop();
+        nodes.push(KdNode::leaf(0, 0));
+        nodes.push(KdNode::leaf(0, 0));
+        let mut kd = build(&tris, &BuildParams::default(), hash);
+        kd.nodes = nodes;
+        assert!(kd.validate().is_ok(), "{:?}", kd.validate());
+        assert!(matches!(
+            Accel::from_triangles(&tris, &kd),
+            Err(AccelError::TooDeep { .. })
+        ));
+        // A tree indexing fewer triangles than the soup holds.
+        let mut kd = build(&tris, &BuildParams::default(), hash);
+        kd.stats.triangles -= 1;
+        kd.leaf_tris.retain(|&t| (t as u64) < kd.stats.triangles);
+        kd.nodes = vec![KdNode::leaf(kd.leaf_tris.len() as u32, 0)];
+        assert!(matches!(
+            Accel::from_triangles(&tris, &kd),
+            Err(AccelError::Corrupt { .. })
+        ));
+    }
+
+    #[test]
+    fn empty_soup_builds_and_misses() {
+        let kd = build(
+            &[],
+            &BuildParams::default(),
+            formats::soup::geometry_hash(&[]),
+        );
+        assert_eq!(kd.stats.nodes, 1);
+        let a = Accel::from_triangles(&[], &kd).unwrap();
+        let r = Ray::new(Vec3::ZERO, Vec3::Z, 0.0, f32::INFINITY);
+        assert_eq!(a.intersect(&r), None);
+        assert!(!a.occluded(&r));
+    }
+}
