@@ -142,7 +142,7 @@ fn bench_scene(name: &str, tris: &[[Vec3; 3]], cli: &Cli, params: &BuildParams, 
     eprintln!("  SAH tree: {:?}", kd2.stats);
     eprintln!("  median tree: {:?}", kdm.stats);
     let rays = make_rays(&sah, tris, cli.rays);
-    let brute_sample = (2_000_000_000 / tris.len().max(1)).clamp(50, 20_000);
+    let brute_sample = (200_000_000 / tris.len().max(1)).clamp(50, 20_000);
     let mut row = format!(
         "| {name} | {} | {:.3} | {:.3} | {:.2}× | {:.2} | {:.2} | {:.2} | {:.1} |",
         tris.len(),
