@@ -22,7 +22,8 @@ pub const HEADER_LEN: usize = 52;
 
 /// bincode configuration of every payload: little-endian, fixed-width integers (so the
 /// layout documented in SOUP.md / KD.md is simple to read from any language).
-fn config() -> impl bincode::config::Config {
+fn config() -> bincode::config::Configuration<bincode::config::LittleEndian, bincode::config::Fixint>
+{
     bincode::config::standard()
         .with_little_endian()
         .with_fixed_int_encoding()
@@ -112,11 +113,10 @@ pub fn decode<T: DeserializeOwned>(
             detail: "payload checksum mismatch (bytes changed after writing)".into(),
         });
     }
-    let (value, used) =
-        bincode::serde::decode_from_slice(payload, config()).map_err(|e| FormatError::Corrupt {
-            path: p(),
-            detail: format!("payload does not decode: {e}"),
-        })?;
+    let (value, used) = decode_payload(payload).map_err(|e| FormatError::Corrupt {
+        path: p(),
+        detail: format!("payload does not decode: {e}"),
+    })?;
     if used != payload.len() {
         return Err(FormatError::Corrupt {
             path: p(),
@@ -124,6 +124,30 @@ pub fn decode<T: DeserializeOwned>(
         });
     }
     Ok(value)
+}
+
+/// Decode a payload with a byte limit no smaller than the payload and at most 4× it.
+///
+/// bincode allocates a string's bytes (`vec![0; len]`) before reading them, trusting the
+/// length field; only a configured limit makes it check the length first. Without one a
+/// well-framed payload whose string length reads 2·10¹⁸ aborted the process on the
+/// allocation (found by `cargo fuzz run soup`). The limit is a const generic, hence the
+/// tiers.
+fn decode_payload<T: DeserializeOwned>(
+    payload: &[u8],
+) -> Result<(T, usize), bincode::error::DecodeError> {
+    macro_rules! tiers {
+        ($($shift:literal)*) => {$(
+            if payload.len() <= 1usize << $shift {
+                return bincode::serde::decode_from_slice(
+                    payload,
+                    config().with_limit::<{ 1usize << $shift }>(),
+                );
+            }
+        )*};
+    }
+    tiers!(12 14 16 18 20 22 24 26 28 30 32 34 36 38 40 42 44 46);
+    bincode::serde::decode_from_slice(payload, config().with_limit::<{ usize::MAX }>())
 }
 
 /// Read a whole file, naming it in the error.

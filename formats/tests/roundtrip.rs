@@ -129,6 +129,30 @@ fn a_length_field_claiming_a_trillion_elements_fails_fast() {
     assert!(msg.contains("does not decode"), "{msg}");
 }
 
+/// Fuzzer find (`cargo fuzz run soup`): bincode allocated a string's claimed length
+/// before reading it, so a string length of 2·10¹⁸ behind a valid checksum aborted the
+/// process. Strings, and every other length, are now checked against the payload size.
+#[test]
+fn a_string_length_claiming_exabytes_fails_fast() {
+    let p = Path::new("huge-name.soup");
+    for claim in [0x2074_6c75_6166_6544u64, 1 << 40, 1 << 20] {
+        let good = sample_soup().to_bytes(p).unwrap();
+        let mut payload = good[52..].to_vec();
+        // The object name "Cube" is preceded by its u64 length.
+        let at = payload.windows(4).position(|w| w == b"Cube").unwrap() - 8;
+        assert_eq!(&payload[at..at + 8], &4u64.to_le_bytes());
+        payload[at..at + 8].copy_from_slice(&claim.to_le_bytes());
+        let mut bytes = good[..20].to_vec();
+        bytes.extend_from_slice(blake3::hash(&payload).as_bytes());
+        bytes.extend_from_slice(&payload);
+        let msg = Soup::from_bytes(&bytes, p).unwrap_err().to_string();
+        assert!(
+            msg.starts_with("huge-name.soup: corrupted: payload does not decode"),
+            "{msg}"
+        );
+    }
+}
+
 #[test]
 fn kd_with_a_dangling_child_is_refused() {
     let p = Path::new("bad.kd");
@@ -196,21 +220,39 @@ fn payload_layout_matches_soup_md() {
     // triangles: u64 count, then 9 f32 per triangle, no inner lengths.
     assert_eq!(u64_at(0), 2);
     assert_eq!(f32_at(8 + 36 + 24), 1.0); // second triangle, second vertex (X), x
-    // normals follow directly.
+                                          // normals follow directly.
     assert_eq!(u64_at(8 + 72), 2);
     // The last 32 bytes are the geometry hash.
     assert_eq!(&payload[payload.len() - 32..], &s.geometry_hash);
     // Option<f32> is one tag byte then the value; enums are a u32 index.
-    let m = Material { reflectivity: Some(0.5), ..Material::unity_default() };
+    let m = Material {
+        reflectivity: Some(0.5),
+        ..Material::unity_default()
+    };
     let mut one = Soup::empty();
     one.materials = vec![m];
     one.lights = s.lights.clone();
     let b = one.to_bytes(p).unwrap();
     let payload = &b[52..];
-    let find = |needle: &[u8]| payload.windows(needle.len()).position(|w| w == needle).unwrap();
+    let find = |needle: &[u8]| {
+        payload
+            .windows(needle.len())
+            .position(|w| w == needle)
+            .unwrap()
+    };
     let refl = find(&[1, 0, 0, 0, 0x3f]); // tag 1, then 0.5f32 = 00 00 00 3f
-    assert_eq!(f32::from_le_bytes(payload[refl + 1..refl + 5].try_into().unwrap()), 0.5);
+    assert_eq!(
+        f32::from_le_bytes(payload[refl + 1..refl + 5].try_into().unwrap()),
+        0.5
+    );
     let spot = find(b"Point Light") + "Point Light".len();
-    assert_eq!(u32::from_le_bytes(payload[spot..spot + 4].try_into().unwrap()), 1, "Spot is variant 1");
-    assert_eq!(f32::from_le_bytes(payload[spot + 4..spot + 8].try_into().unwrap()), 30.0);
+    assert_eq!(
+        u32::from_le_bytes(payload[spot..spot + 4].try_into().unwrap()),
+        1,
+        "Spot is variant 1"
+    );
+    assert_eq!(
+        f32::from_le_bytes(payload[spot + 4..spot + 8].try_into().unwrap()),
+        30.0
+    );
 }
