@@ -336,6 +336,14 @@ fn damaged_soup_and_kd_files_are_refused_by_every_reader() {
         std::fs::write(&p, bytes).unwrap();
         soup_inputs.push((label.to_string(), p));
     }
+    // A string length of 2·10¹⁸ behind a valid checksum (the object name "Box"): bincode
+    // used to allocate it before reading (found by cargo fuzz).
+    let mut payload = good_soup[52..].to_vec();
+    let at = payload.windows(3).position(|w| w == b"Box").unwrap() - 8;
+    payload[at..at + 8].copy_from_slice(&0x2074_6c75_6166_6544u64.to_le_bytes());
+    let p = dir.join("huge-name.soup");
+    std::fs::write(&p, frame(formats::soup::MAGIC, 1, &payload)).unwrap();
+    soup_inputs.push(("string length 2·10^18 (valid checksum)".into(), p));
     for (label, p) in &soup_inputs {
         let what = format!(".soup {label}");
         let ps = s(p);
