@@ -1,0 +1,61 @@
+# unitrace recipes. `just` renders the bundled baseline scene; `just --list` shows the rest.
+set shell := ["bash", "-euo", "pipefail", "-c"]
+
+bin := justfile_directory() / "target/release"
+
+# Render the bundled baseline scene to out/baseline.exr and out/baseline.png.
+default: (scene "scenes/baseline/Assets/Scenes/Baseline.unity" "baseline")
+
+# Build the release binaries (once; cargo skips the work when nothing changed).
+build:
+    cargo build --release --workspace --bins --quiet
+
+# Convert, compile (cached) and render one Unity scene to out/NAME.exr and out/NAME.png.
+scene SCENE NAME *RENDER_ARGS: build
+    mkdir -p "$(dirname "out/{{NAME}}")"
+    {{bin}}/unity2soup "{{SCENE}}" -o "out/{{NAME}}.soup"
+    kd=$(just --quiet compile "out/{{NAME}}.soup") && \
+        {{bin}}/kd2exr "out/{{NAME}}.soup" "$kd" -o "out/{{NAME}}.exr" --preview "out/{{NAME}}.png" {{RENDER_ARGS}}
+
+# Stage 1: Unity scene -> triangle soup.
+convert SCENE OUT: build
+    {{bin}}/unity2soup "{{SCENE}}" -o "{{OUT}}"
+
+# Stage 2: soup -> k-d tree in cache/ (reused when the geometry is unchanged); prints the tree's path.
+compile SOUP: build
+    #!/usr/bin/env bash
+    set -euo pipefail
+    json=$({{bin}}/soup2kd "{{SOUP}}" --cache cache --json)
+    path=$(sed -n 's/.*"path":"\([^"]*\)".*/\1/p' <<<"$json")
+    cache=$(sed -n 's/.*"cache":"\([^"]*\)".*/\1/p' <<<"$json")
+    echo "soup2kd: cache $cache: $path" >&2
+    echo "$path"
+
+# Stage 3: soup + tree -> EXR and PNG preview.
+render SOUP KD OUT *ARGS: build
+    {{bin}}/kd2exr "{{SOUP}}" "{{KD}}" -o "{{OUT}}" --preview "{{without_extension(OUT)}}.png" {{ARGS}}
+
+# Run the whole test suite (the README's test command).
+test:
+    cargo test --workspace
+
+# Regenerate the bundled Unity projects under scenes/ (meshes, .unity, .meta, .mat).
+scenes:
+    cargo run --release --quiet -p scenegen -- scenes
+
+# Render every effect scene to out/gallery/NAME.png.
+gallery: build
+    #!/usr/bin/env bash
+    set -euo pipefail
+    for dir in scenes/*/; do
+        name=$(basename "$dir")
+        [ "$name" = gen ] || [ "$name" = baseline ] && continue
+        for scene in "$dir"Assets/Scenes/*.unity; do
+            just --quiet scene "$scene" "gallery/$name" --width 480 --height 360 --spp 4
+        done
+    done
+    ls out/gallery/*.png
+
+# Tracer and build benchmarks against brute force and a median-split tree (add `--features embree` via EMBREE=1).
+bench: (scene "scenes/baseline/Assets/Scenes/Baseline.unity" "baseline")
+    cargo run --release --quiet -p bench {{ if env_var_or_default("EMBREE", "") == "1" { "--features embree" } else { "" } }} --bin kdbench -- --baseline out/baseline.soup --out reports/bench.md
