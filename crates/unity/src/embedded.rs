@@ -54,6 +54,24 @@ pub fn decode(body: &Node) -> Result<Mesh, String> {
     if channels.first().is_none_or(|c| c.dim < 3) {
         return Err("no position channel".into());
     }
+    // Every size below comes from the file: bound them before any arithmetic or
+    // allocation (a stream number of 8·10¹⁷ made a vector of that length; fuzzer find).
+    // Unity has at most 4 vertex streams and strides under 256 bytes.
+    for c in channels.iter().filter(|c| c.dim > 0) {
+        if c.stream > 3 || c.offset > 255 {
+            return Err(format!(
+                "vertex channel at stream {} offset {} is outside Unity's 4 streams of at most 256 bytes",
+                c.stream, c.offset
+            ));
+        }
+    }
+    // Positions alone take 12 bytes a vertex.
+    if count > data.len() / 12 {
+        return Err(format!(
+            "m_VertexCount {count} needs more than the {} bytes of vertex data",
+            data.len()
+        ));
+    }
     // Streams follow each other, each `stride × count` bytes, aligned to 16.
     let n_streams = channels
         .iter()
@@ -188,5 +206,24 @@ mod tests {
         assert_eq!(m.positions[1], Vec3::Y);
         assert_eq!(m.normals[2], Vec3::NEG_Z);
         assert_eq!(m.submeshes, vec![vec![[0, 1, 2]]]);
+
+        // Fuzzer find: a stream number of 8·10¹⁷ asked for a vector that long; absurd
+        // streams, offsets and counts are errors before anything is allocated.
+        for (from, to) in [
+            (
+                "- stream: 0\n      offset: 12",
+                "- stream: 800000000000000000\n      offset: 12",
+            ),
+            (
+                "- stream: 0\n      offset: 12",
+                "- stream: 0\n      offset: 9223372036854775807",
+            ),
+            ("m_VertexCount: 3", "m_VertexCount: 9223372036854775807"),
+            ("m_VertexCount: 3", "m_VertexCount: 7"),
+        ] {
+            let bad = text.replace(from, to);
+            let e = decode(parse(&bad).get("Mesh").unwrap()).unwrap_err();
+            assert!(e.contains("stream") || e.contains("m_VertexCount"), "{e}");
+        }
     }
 }
