@@ -8,12 +8,14 @@ use scenegen::mesh::Mesh;
 const CELL: usize = 220;
 
 fn main() -> anyhow::Result<()> {
-    let out = std::env::args().nth(1).unwrap_or_else(|| "models.png".into());
+    let out = std::env::args()
+        .nth(1)
+        .unwrap_or_else(|| "models.png".into());
     let models = scenegen::models::all();
     let views = [
-        Mat3::IDENTITY,                                    // front (model faces +Z, camera at +Z)
+        Mat3::IDENTITY, // front (model faces +Z, camera at +Z)
         Mat3::from_rotation_y(-std::f32::consts::FRAC_PI_2), // side
-        Mat3::from_rotation_x(std::f32::consts::FRAC_PI_2),  // top
+        Mat3::from_rotation_x(std::f32::consts::FRAC_PI_2), // top
         Mat3::from_rotation_x(0.4) * Mat3::from_rotation_y(-0.7), // three-quarter
     ];
     let (w, h) = (CELL * views.len(), CELL * models.len());
@@ -36,7 +38,9 @@ fn draw(m: &Mesh, view: Mat3, img: &mut [u8], w: usize, x0: usize, y0: usize) {
     let pts: Vec<Vec3> = m.positions.iter().map(|&p| view * p).collect();
     let (lo, hi) = pts
         .iter()
-        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), &p| (l.min(p), h.max(p)));
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), &p| {
+            (l.min(p), h.max(p))
+        });
     let size = (hi - lo).max_element().max(1e-6);
     let scale = (CELL as f32 - 20.0) / size;
     let centre = (lo + hi) * 0.5;

@@ -48,10 +48,7 @@ pub fn project() -> Project {
             model.mesh.triangle_count()
         );
         let g = p.add_asset(&path, model.mesh.to_obj(model.name, &comment), meta::model);
-        model_ref.insert(
-            model.name,
-            (ids::mesh_file_id(model.name), g),
-        );
+        model_ref.insert(model.name, (ids::mesh_file_id(model.name), g));
     }
     let mesh = |name: &str, model: &str, look: &str, xform: Xform| {
         let (file_id, guid) = model_ref[model].clone();
@@ -87,18 +84,63 @@ pub fn project() -> Project {
                 ..CameraDesc::default()
             }),
         },
-        light("Key Light", [1.0, 0.97, 0.92], 1.3, Xform::at(-6.0, 7.0, -4.0)),
-        light("Fill Light", [0.92, 0.95, 1.0], 1.1, Xform::at(6.0, 6.5, -2.0)),
+        light(
+            "Key Light",
+            [1.0, 0.97, 0.92],
+            1.3,
+            Xform::at(-6.0, 7.0, -4.0),
+        ),
+        light(
+            "Fill Light",
+            [0.92, 0.95, 1.0],
+            1.1,
+            Xform::at(6.0, 6.5, -2.0),
+        ),
         floor,
-        mesh("Mirror Sphere", "MirrorSphere", "Mirror", Xform::at(0.0, 1.3, 0.5).uniform(1.3)),
+        mesh(
+            "Mirror Sphere",
+            "MirrorSphere",
+            "Mirror",
+            Xform::at(0.0, 1.3, 0.5).uniform(1.3),
+        ),
         // Facing the camera (the model faces +Z), turned a little to the sphere.
-        mesh("Man", "Man", "ManGreen", Xform::at(-3.2, 0.0, -1.0).euler(0.0, 200.0, 0.0)),
-        mesh("Car", "Car", "CarYellow", Xform::at(3.8, 0.0, 1.8).euler(0.0, -35.0, 0.0)),
-        mesh("Pig", "Pig", "PigPink", Xform::at(-1.7, 0.0, -3.4).euler(0.0, 150.0, 0.0)),
-        mesh("Pig (1)", "Pig", "PigPink", Xform::at(1.6, 0.0, -3.9).euler(0.0, 235.0, 0.0)),
+        mesh(
+            "Man",
+            "Man",
+            "ManGreen",
+            Xform::at(-3.2, 0.0, -1.0).euler(0.0, 200.0, 0.0),
+        ),
+        mesh(
+            "Car",
+            "Car",
+            "CarYellow",
+            Xform::at(3.8, 0.0, 1.8).euler(0.0, -35.0, 0.0),
+        ),
+        mesh(
+            "Pig",
+            "Pig",
+            "PigPink",
+            Xform::at(-1.7, 0.0, -3.4).euler(0.0, 150.0, 0.0),
+        ),
+        mesh(
+            "Pig (1)",
+            "Pig",
+            "PigPink",
+            Xform::at(1.6, 0.0, -3.9).euler(0.0, 235.0, 0.0),
+        ),
         // Nosing down a slight slope: a small tilt on top of the turn.
-        mesh("Pig (2)", "Pig", "PigPink", Xform::at(-5.0, 0.0, 2.8).euler(-4.0, 80.0, 3.0)),
-        mesh("Tree", "Tree", "TreeGreen", Xform::at(-6.5, 0.0, 6.0).uniform(1.2)),
+        mesh(
+            "Pig (2)",
+            "Pig",
+            "PigPink",
+            Xform::at(-5.0, 0.0, 2.8).euler(-4.0, 80.0, 3.0),
+        ),
+        mesh(
+            "Tree",
+            "Tree",
+            "TreeGreen",
+            Xform::at(-6.5, 0.0, 6.0).uniform(1.2),
+        ),
         // Leaning a few degrees, as real trees do.
         mesh(
             "Tree (1)",
@@ -137,11 +179,19 @@ mod tests {
                 total += 12;
                 continue;
             }
-            let guid = line.split("guid: ").nth(1).unwrap().split(',').next().unwrap();
+            let guid = line
+                .split("guid: ")
+                .nth(1)
+                .unwrap()
+                .split(',')
+                .next()
+                .unwrap();
             let (path, _) = p
                 .files
                 .iter()
-                .find(|(k, v)| k.ends_with(".obj.meta") && String::from_utf8_lossy(v).contains(guid))
+                .find(|(k, v)| {
+                    k.ends_with(".obj.meta") && String::from_utf8_lossy(v).contains(guid)
+                })
                 .expect("mesh guid resolves to a model");
             let obj = String::from_utf8(p.files[path.trim_end_matches(".meta")].clone()).unwrap();
             let group = obj.lines().find_map(|l| l.strip_prefix("g ")).unwrap();

@@ -22,7 +22,10 @@ impl Builder {
         let mut mats = BTreeMap::new();
         for m in looks {
             let path = format!("Assets/Materials/{}.mat", m.name);
-            mats.insert(m.name, project.add_asset(&path, write_material(m), meta::material));
+            mats.insert(
+                m.name,
+                project.add_asset(&path, write_material(m), meta::material),
+            );
         }
         Builder {
             project,
@@ -96,10 +99,18 @@ fn basic_looks() -> Vec<MatDesc> {
 /// A 10 m plane, a cube and a sphere, seen from the front and above: the stage most
 /// effect scenes share.
 fn stage(b: &mut Builder) -> &mut Builder {
-    b.camera(Xform::at(0.0, 3.0, -7.0).euler(18.0, 0.0, 0.0), camera_desc())
-        .mesh("Ground", unity::PLANE, "Grey", Xform::at(0.0, 0.0, 0.0))
-        .mesh("Cube", unity::CUBE, "Red", Xform::at(-1.0, 0.5, 0.0).euler(0.0, 30.0, 0.0))
-        .mesh("Sphere", unity::SPHERE, "Blue", Xform::at(1.2, 0.5, 0.5))
+    b.camera(
+        Xform::at(0.0, 3.0, -7.0).euler(18.0, 0.0, 0.0),
+        camera_desc(),
+    )
+    .mesh("Ground", unity::PLANE, "Grey", Xform::at(0.0, 0.0, 0.0))
+    .mesh(
+        "Cube",
+        unity::CUBE,
+        "Red",
+        Xform::at(-1.0, 0.5, 0.0).euler(0.0, 30.0, 0.0),
+    )
+    .mesh("Sphere", unity::SPHERE, "Blue", Xform::at(1.2, 0.5, 0.5))
 }
 
 fn point(color: [f32; 3], intensity: f32, range: f32, shadows: u8) -> LightDesc {
@@ -171,13 +182,42 @@ pub fn reflection_depth() -> Project {
     let mut looks = basic_looks();
     looks.push(MatDesc::mirror("Mirror"));
     let mut b = Builder::new("reflection-depth", &looks);
-    b.camera(Xform::at(-1.2, 1.6, -3.2).euler(8.0, 30.0, 0.0), camera_desc())
-        .mesh("Ground", unity::PLANE, "Grey", Xform::at(0.0, 0.0, 0.0))
-        .mesh("Mirror Left", unity::CUBE, "Mirror", Xform::at(-2.0, 1.5, 0.0).scale(0.1, 3.0, 4.0))
-        .mesh("Mirror Right", unity::CUBE, "Mirror", Xform::at(2.0, 1.5, 0.0).scale(0.1, 3.0, 4.0))
-        .mesh("Sphere", unity::SPHERE, "Red", Xform::at(0.0, 0.8, 0.5).uniform(0.8))
-        .mesh("Cube", unity::CUBE, "Blue", Xform::at(0.6, 0.25, -0.6).euler(0.0, 20.0, 0.0).uniform(0.5))
-        .light("Point Light", Xform::at(0.0, 4.0, -1.5), point([1.0, 1.0, 1.0], 1.3, 20.0, 1));
+    b.camera(
+        Xform::at(-1.2, 1.6, -3.2).euler(8.0, 30.0, 0.0),
+        camera_desc(),
+    )
+    .mesh("Ground", unity::PLANE, "Grey", Xform::at(0.0, 0.0, 0.0))
+    .mesh(
+        "Mirror Left",
+        unity::CUBE,
+        "Mirror",
+        Xform::at(-2.0, 1.5, 0.0).scale(0.1, 3.0, 4.0),
+    )
+    .mesh(
+        "Mirror Right",
+        unity::CUBE,
+        "Mirror",
+        Xform::at(2.0, 1.5, 0.0).scale(0.1, 3.0, 4.0),
+    )
+    .mesh(
+        "Sphere",
+        unity::SPHERE,
+        "Red",
+        Xform::at(0.0, 0.8, 0.5).uniform(0.8),
+    )
+    .mesh(
+        "Cube",
+        unity::CUBE,
+        "Blue",
+        Xform::at(0.6, 0.25, -0.6)
+            .euler(0.0, 20.0, 0.0)
+            .uniform(0.5),
+    )
+    .light(
+        "Point Light",
+        Xform::at(0.0, 4.0, -1.5),
+        point([1.0, 1.0, 1.0], 1.3, 20.0, 1),
+    );
     b.finish("ReflectionDepth", NO_AMBIENT)
 }
 
@@ -189,10 +229,23 @@ pub fn ambient() -> Project {
         MatDesc::matte("Grey", [0.75, 0.75, 0.75]),
     ];
     let mut b = Builder::new("ambient", &looks);
-    b.camera(Xform::at(0.0, 3.0, -7.0).euler(18.0, 0.0, 0.0), camera_desc())
-        .mesh("Ground", unity::PLANE, "Grey", Xform::at(0.0, 0.0, 0.0))
-        .mesh("Cube", unity::CUBE, "White", Xform::at(-1.2, 0.5, 0.0).euler(0.0, 30.0, 0.0))
-        .mesh("Sphere", unity::SPHERE, "White", Xform::at(1.2, 0.75, 0.0).uniform(1.5));
+    b.camera(
+        Xform::at(0.0, 3.0, -7.0).euler(18.0, 0.0, 0.0),
+        camera_desc(),
+    )
+    .mesh("Ground", unity::PLANE, "Grey", Xform::at(0.0, 0.0, 0.0))
+    .mesh(
+        "Cube",
+        unity::CUBE,
+        "White",
+        Xform::at(-1.2, 0.5, 0.0).euler(0.0, 30.0, 0.0),
+    )
+    .mesh(
+        "Sphere",
+        unity::SPHERE,
+        "White",
+        Xform::at(1.2, 0.75, 0.0).uniform(1.5),
+    );
     b.finish(
         "Ambient",
         Ambient::Trilight([0.55, 0.7, 1.0], [0.5, 0.45, 0.4], [0.25, 0.2, 0.15]),
@@ -221,9 +274,23 @@ pub fn emission() -> Project {
         },
     )
     .mesh("Ground", unity::PLANE, "Grey", Xform::at(0.0, 0.0, 0.0))
-    .mesh("Glowing Sphere", unity::SPHERE, "GlowOrange", Xform::at(-1.0, 0.6, 0.0).uniform(1.2))
-    .mesh("Glowing Cube", unity::CUBE, "GlowCyan", Xform::at(1.3, 0.5, 0.3).euler(0.0, 45.0, 0.0))
-    .light("Dim Light", Xform::at(0.0, 4.0, -3.0), point([1.0, 1.0, 1.0], 0.3, 15.0, 1));
+    .mesh(
+        "Glowing Sphere",
+        unity::SPHERE,
+        "GlowOrange",
+        Xform::at(-1.0, 0.6, 0.0).uniform(1.2),
+    )
+    .mesh(
+        "Glowing Cube",
+        unity::CUBE,
+        "GlowCyan",
+        Xform::at(1.3, 0.5, 0.3).euler(0.0, 45.0, 0.0),
+    )
+    .light(
+        "Dim Light",
+        Xform::at(0.0, 4.0, -3.0),
+        point([1.0, 1.0, 1.0], 0.3, 15.0, 1),
+    );
     b.finish("Emission", NO_AMBIENT)
 }
 
@@ -241,10 +308,24 @@ pub fn orthographic() -> Project {
     .mesh("Ground", unity::PLANE, "Grey", Xform::at(0.0, 0.0, 0.0));
     for (k, z) in [-2.0f32, 0.0, 2.0].into_iter().enumerate() {
         let x = -1.5 + 1.5 * k as f32;
-        b.mesh(&format!("Cube ({k})"), unity::CUBE, "Red", Xform::at(x, 0.5, z));
-        b.mesh(&format!("Sphere ({k})"), unity::SPHERE, "Blue", Xform::at(x + 0.75, 0.5, z - 1.0));
+        b.mesh(
+            &format!("Cube ({k})"),
+            unity::CUBE,
+            "Red",
+            Xform::at(x, 0.5, z),
+        );
+        b.mesh(
+            &format!("Sphere ({k})"),
+            unity::SPHERE,
+            "Blue",
+            Xform::at(x + 0.75, 0.5, z - 1.0),
+        );
     }
-    b.light("Point Light", Xform::at(-2.0, 5.0, -2.0), point([1.0, 1.0, 1.0], 1.5, 25.0, 1));
+    b.light(
+        "Point Light",
+        Xform::at(-2.0, 5.0, -2.0),
+        point([1.0, 1.0, 1.0], 1.5, 25.0, 1),
+    );
     b.finish("Orthographic", NO_AMBIENT)
 }
 
@@ -279,7 +360,10 @@ mod tests {
     fn each_scene_sets_its_effect() {
         assert!(scene_text(&shadows_hard()).contains("  m_Shadows:\n    m_Type: 1\n"));
         let soft = scene_text(&shadows_soft());
-        assert!(soft.contains("  m_Shadows:\n    m_Type: 2\n") && soft.contains("  m_ShadowRadius: 0.5\n"));
+        assert!(
+            soft.contains("  m_Shadows:\n    m_Type: 2\n")
+                && soft.contains("  m_ShadowRadius: 0.5\n")
+        );
         let spot = scene_text(&spot());
         assert!(spot.contains("  m_Type: 0\n") && spot.contains("  m_SpotAngle: 50\n"));
         assert!(spot.contains("  m_InnerSpotAngle: 30\n"));
@@ -291,7 +375,8 @@ mod tests {
         assert!(emission
             .files
             .iter()
-            .any(|(k, v)| k.ends_with(".mat") && String::from_utf8_lossy(v).contains("  - _EMISSION\n")));
+            .any(|(k, v)| k.ends_with(".mat")
+                && String::from_utf8_lossy(v).contains("  - _EMISSION\n")));
         let mirrors = scene_text(&reflection_depth());
         assert_eq!(mirrors.matches("  m_Name: Mirror ").count(), 2);
     }

@@ -54,7 +54,9 @@ mod tests {
     fn guids_are_32_hex_and_stable() {
         let g = guid("baseline", "Assets/Models/Man.obj");
         assert_eq!(g.len(), 32);
-        assert!(g.bytes().all(|b| b.is_ascii_hexdigit() && !b.is_ascii_uppercase()));
+        assert!(g
+            .bytes()
+            .all(|b| b.is_ascii_hexdigit() && !b.is_ascii_uppercase()));
         assert_eq!(g, guid("baseline", "Assets/Models/Man.obj"));
         assert_ne!(g, guid("baseline", "Assets/Models/Car.obj"));
     }
@@ -66,6 +68,9 @@ mod tests {
         let b = ids.block("same", 4);
         assert_eq!(a.len(), 4);
         assert!(a.iter().all(|x| !b.contains(x)));
-        assert!(a.iter().chain(&b).all(|&x| x > 0 && x < i64::from(i32::MAX)));
+        assert!(a
+            .iter()
+            .chain(&b)
+            .all(|&x| x > 0 && x < i64::from(i32::MAX)));
     }
 }

@@ -38,7 +38,11 @@ fn run() -> Result<()> {
         for s in stale {
             eprintln!("removed stale {}/{}/{s}", args.dir.display(), p.name);
         }
-        println!("{}: {} files", args.dir.join(&p.name).display(), p.files.len());
+        println!(
+            "{}: {} files",
+            args.dir.join(&p.name).display(),
+            p.files.len()
+        );
     }
     Ok(())
 }

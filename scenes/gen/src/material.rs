@@ -55,7 +55,8 @@ const TEXTURES: [&str; 9] = [
 ];
 
 pub fn write_material(m: &MatDesc) -> String {
-    let mut s = String::from("%YAML 1.1\n%TAG !u! tag:unity3d.com,2011:\n--- !u!21 &2100000\nMaterial:\n");
+    let mut s =
+        String::from("%YAML 1.1\n%TAG !u! tag:unity3d.com,2011:\n--- !u!21 &2100000\nMaterial:\n");
     let keywords = if m.emission.is_some() {
         "\n  - _EMISSION"
     } else {

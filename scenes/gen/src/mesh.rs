@@ -95,7 +95,11 @@ fn num(x: f32) -> String {
 
 /// Point on the unit sphere at polar angle `theta` (from +Y) and azimuth `phi`.
 fn spherical(theta: f32, phi: f32) -> Vec3 {
-    Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin())
+    Vec3::new(
+        theta.sin() * phi.cos(),
+        theta.cos(),
+        theta.sin() * phi.sin(),
+    )
 }
 
 /// Unit UV sphere at the origin: `2·segments·(rings − 1)` triangles (triangle fans at
@@ -180,7 +184,10 @@ pub fn tapered(segments: u32, stacks: u32, bottom: f32, top: f32) -> Mesh {
     // Caps get their own vertices so the rim stays a hard edge.
     let mut bottom_cap = disc(segments);
     flip(&mut bottom_cap);
-    m.add(&bottom_cap, Affine3A::from_scale(Vec3::new(bottom, 1.0, bottom)));
+    m.add(
+        &bottom_cap,
+        Affine3A::from_scale(Vec3::new(bottom, 1.0, bottom)),
+    );
     let top_cap = disc(segments);
     m.add(
         &top_cap,
@@ -396,7 +403,10 @@ mod tests {
         assert!((v - PI / 3.0).abs() < 0.01, "cone volume {v}");
         let v = volume(&torus(64, 32, 1.0, 0.25));
         let exact = 2.0 * PI * PI * 1.0 * 0.25 * 0.25;
-        assert!((v - exact).abs() < 0.01 * exact, "torus volume {v} vs {exact}");
+        assert!(
+            (v - exact).abs() < 0.01 * exact,
+            "torus volume {v} vs {exact}"
+        );
     }
 
     #[test]
@@ -410,7 +420,10 @@ mod tests {
     #[test]
     fn mirrored_parts_keep_outward_winding() {
         let mut m = Mesh::default();
-        m.add(&box_grid(1), Affine3A::from_scale(Vec3::new(-2.0, 1.0, 1.0)));
+        m.add(
+            &box_grid(1),
+            Affine3A::from_scale(Vec3::new(-2.0, 1.0, 1.0)),
+        );
         assert!((volume(&m) - 2.0).abs() < 1e-5);
     }
 

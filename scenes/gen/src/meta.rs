@@ -143,7 +143,11 @@ mod tests {
     fn model_meta_has_the_keys_the_converter_reads() {
         let m = model("0123456789abcdef0123456789abcdef");
         assert!(m.starts_with("fileFormatVersion: 2\nguid: 0123456789abcdef0123456789abcdef\nModelImporter:\n  serializedVersion: 22200\n  internalIDToNameTable: []\n"));
-        for key in ["    fileIdsGeneration: 2\n", "    globalScale: 1\n", "    useFileScale: 1\n"] {
+        for key in [
+            "    fileIdsGeneration: 2\n",
+            "    globalScale: 1\n",
+            "    useFileScale: 1\n",
+        ] {
             assert!(m.contains(key), "missing {key:?}");
         }
         assert!(m.ends_with("  assetBundleVariant: \n"));
@@ -152,6 +156,8 @@ mod tests {
     #[test]
     fn material_meta_names_the_main_object() {
         let m = material("00000000000000000000000000000001");
-        assert!(m.contains("NativeFormatImporter:\n  externalObjects: {}\n  mainObjectFileID: 2100000\n"));
+        assert!(m.contains(
+            "NativeFormatImporter:\n  externalObjects: {}\n  mainObjectFileID: 2100000\n"
+        ));
     }
 }

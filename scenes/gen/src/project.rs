@@ -32,7 +32,8 @@ impl Project {
     }
 
     pub fn add(&mut self, path: &str, text: impl Into<String>) {
-        self.files.insert(path.to_string(), text.into().into_bytes());
+        self.files
+            .insert(path.to_string(), text.into().into_bytes());
     }
 
     /// Add an asset and its `.meta` (made by `meta_of` from the asset's GUID); returns the GUID.

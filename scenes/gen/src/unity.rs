@@ -113,7 +113,10 @@ impl Default for CameraDesc {
 }
 
 pub enum Body {
-    Mesh { mesh: MeshRef, materials: Vec<String> },
+    Mesh {
+        mesh: MeshRef,
+        materials: Vec<String>,
+    },
     Light(LightDesc),
     Camera(CameraDesc),
 }
@@ -204,7 +207,10 @@ pub fn write_scene(scene_key: &str, scene: &SceneDesc) -> String {
     for (_, d) in docs {
         s += &d;
     }
-    let _ = writeln!(s, "--- !u!1660057539 &{SCENE_ROOTS_ID}\nSceneRoots:\n  m_ObjectHideFlags: 0\n  m_Roots:");
+    let _ = writeln!(
+        s,
+        "--- !u!1660057539 &{SCENE_ROOTS_ID}\nSceneRoots:\n  m_ObjectHideFlags: 0\n  m_Roots:"
+    );
     for r in roots {
         let _ = writeln!(s, "  - {{fileID: {r}}}");
     }
@@ -218,7 +224,9 @@ const PREFAB_FIELDS: &str = "  m_ObjectHideFlags: 0
 ";
 
 fn game_object(id: i64, name: &str, tag: &str, components: &[i64]) -> String {
-    let mut s = format!("--- !u!1 &{id}\nGameObject:\n{PREFAB_FIELDS}  serializedVersion: 6\n  m_Component:\n");
+    let mut s = format!(
+        "--- !u!1 &{id}\nGameObject:\n{PREFAB_FIELDS}  serializedVersion: 6\n  m_Component:\n"
+    );
     for c in components {
         let _ = writeln!(s, "  - component: {{fileID: {c}}}");
     }
@@ -612,7 +620,10 @@ mod tests {
         assert!((q * Vec3::Z - Vec3::X).length() < 1e-6);
         // A pure X tilt of 40° matches the corpus camera's quaternion.
         let q = Xform::at(0.0, 0.0, 0.0).euler(40.0, 0.0, 0.0).rotation();
-        assert!((q.x - 0.3420201).abs() < 1e-6 && (q.w - 0.9396927).abs() < 1e-6, "{q}");
+        assert!(
+            (q.x - 0.3420201).abs() < 1e-6 && (q.w - 0.9396927).abs() < 1e-6,
+            "{q}"
+        );
         assert_eq!((q.y, q.z), (0.0, 0.0));
     }
 
