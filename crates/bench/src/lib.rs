@@ -6,6 +6,7 @@
 //! [`run::run`] does the work; [`report::markdown`] renders it; the `kdbench` binary is
 //! a thin command line over both.
 
+pub mod accuracy;
 pub mod brute;
 #[cfg(feature = "embree")]
 pub mod embree;

@@ -1,0 +1,251 @@
+//! The soups the accuracy sweep renders: Unity scenes converted on the fly, a real mesh
+//! on a mirror floor built in code, and a tiny scene for tests.
+
+use anyhow::{bail, Context, Result};
+use formats::{
+    Ambient, AmbientMode, Camera, ClearFlags, Environment, Light, LightKind, Material, Object,
+    Projection, Shadows, Soup,
+};
+use glam::Vec3;
+use std::path::Path;
+
+/// A named soup to sweep.
+pub struct Scene {
+    pub name: String,
+    pub soup: Soup,
+}
+
+/// Convert a Unity scene with the workspace's converter.
+pub fn unity_scene(name: &str, path: &Path) -> Result<Scene> {
+    let soup = unity::convert(path, &unity::Options::default())
+        .with_context(|| format!("{}: cannot convert the scene", path.display()))?;
+    if soup.triangles.is_empty() {
+        bail!("{}: the converted scene has no triangles", path.display());
+    }
+    Ok(Scene {
+        name: name.into(),
+        soup,
+    })
+}
+
+fn quad(soup: &mut Soup, corners: [Vec3; 4], material: u32, object: u32) {
+    let n = (corners[1] - corners[0])
+        .cross(corners[2] - corners[0])
+        .normalize();
+    for t in [[0, 1, 2], [0, 2, 3]] {
+        soup.triangles.push(t.map(|i| corners[i]));
+        soup.normals.push([n; 3]);
+        soup.tri_material.push(material);
+        soup.tri_object.push(object);
+    }
+}
+
+fn floor(soup: &mut Soup, half: f32, material: u32, object: u32) {
+    // Counter-clockwise seen from above (+Y), so the face normal points up.
+    quad(
+        soup,
+        [
+            Vec3::new(-half, 0.0, -half),
+            Vec3::new(-half, 0.0, half),
+            Vec3::new(half, 0.0, half),
+            Vec3::new(half, 0.0, -half),
+        ],
+        material,
+        object,
+    );
+}
+
+fn material(name: &str, color: Vec3, metallic: f32, smoothness: f32) -> Material {
+    Material {
+        name: name.into(),
+        source: "accuracy".into(),
+        color,
+        metallic,
+        smoothness,
+        reflectivity: None,
+        emission: Vec3::ZERO,
+    }
+}
+
+fn point_light(name: &str, position: Vec3, intensity: f32, radius: f32) -> Light {
+    Light {
+        name: name.into(),
+        kind: LightKind::Point,
+        position,
+        direction: Vec3::NEG_Y,
+        color: Vec3::ONE,
+        intensity,
+        range: 30.0,
+        shadows: Shadows::Soft,
+        shadow_radius: radius,
+    }
+}
+
+fn environment(background: Vec3, ambient: Vec3) -> Environment {
+    Environment {
+        clear: ClearFlags::SolidColor,
+        background,
+        ambient: Ambient {
+            mode: AmbientMode::Flat,
+            sky: ambient,
+            equator: ambient,
+            ground: ambient,
+        },
+    }
+}
+
+fn look(position: Vec3, target: Vec3, fov_y: f32) -> Camera {
+    let forward = (target - position).normalize();
+    let right = forward.cross(Vec3::Y).normalize();
+    Camera {
+        name: "accuracy camera".into(),
+        position,
+        forward,
+        up: right.cross(forward),
+        projection: Projection::Perspective { fov_y },
+        near: 0.1,
+    }
+}
+
+/// An OBJ mesh scaled to 1 m tall, standing on a 6 m mirror floor, lit by a soft point
+/// light and a hard directional light: mirror bounces, soft and hard shadows on real
+/// geometry.
+pub fn mesh_on_mirror(path: &Path) -> Result<Scene> {
+    #[allow(clippy::needless_update)]
+    let opts = tobj::LoadOptions {
+        triangulate: true,
+        single_index: false,
+        ignore_points: true,
+        ignore_lines: true,
+        ..Default::default()
+    };
+    let (models, _) =
+        tobj::load_obj(path, &opts).with_context(|| format!("{}: cannot load", path.display()))?;
+    let mut tris = vec![];
+    for m in &models {
+        let p = &m.mesh.positions;
+        let v = |i: u32| -> Option<Vec3> {
+            let i = i as usize * 3;
+            p.get(i..i + 3).map(|c| Vec3::new(c[0], c[1], c[2]))
+        };
+        for f in m.mesh.indices.chunks_exact(3) {
+            if let (Some(a), Some(b), Some(c)) = (v(f[0]), v(f[1]), v(f[2])) {
+                if a.is_finite() && b.is_finite() && c.is_finite() {
+                    tris.push([a, b, c]);
+                }
+            }
+        }
+    }
+    if tris.is_empty() {
+        bail!("{}: no triangles", path.display());
+    }
+    let [lo, hi] = crate::scenes::bounds(&tris);
+    let size = hi - lo;
+    let scale = 1.0 / size.y.max(1e-6);
+    let centre = Vec3::new((lo.x + hi.x) / 2.0, lo.y, (lo.z + hi.z) / 2.0);
+    let mut soup = Soup::empty();
+    soup.materials = vec![
+        material("mirror floor", Vec3::splat(0.8), 1.0, 0.75),
+        material("mesh", Vec3::new(0.9, 0.55, 0.3), 0.0, 0.5),
+    ];
+    soup.objects = vec![
+        Object {
+            name: "floor".into(),
+            source: "accuracy".into(),
+        },
+        Object {
+            name: "mesh".into(),
+            source: path.display().to_string(),
+        },
+    ];
+    floor(&mut soup, 3.0, 0, 0);
+    for t in &tris {
+        let t = t.map(|v| (v - centre) * scale);
+        let n = (t[1] - t[0]).cross(t[2] - t[0]);
+        if n.length_squared() == 0.0 || !n.is_finite() {
+            soup.dropped_degenerate += 1;
+            continue;
+        }
+        soup.triangles.push(t);
+        soup.normals.push([n.normalize(); 3]);
+        soup.tri_material.push(1);
+        soup.tri_object.push(1);
+    }
+    soup.lights = vec![
+        point_light("soft key", Vec3::new(1.5, 2.5, -1.5), 6.0, 0.4),
+        Light {
+            name: "hard sun".into(),
+            kind: LightKind::Directional,
+            position: Vec3::ZERO,
+            direction: Vec3::new(0.4, -1.0, 0.6).normalize(),
+            color: Vec3::new(1.0, 0.95, 0.85),
+            intensity: 0.6,
+            range: 0.0,
+            shadows: Shadows::Hard,
+            shadow_radius: 0.0,
+        },
+    ];
+    soup.camera = look(Vec3::new(-1.2, 1.3, -2.6), Vec3::new(0.0, 0.45, 0.0), 45.0);
+    soup.environment = environment(Vec3::new(0.25, 0.35, 0.55), Vec3::splat(0.05));
+    soup.seal();
+    soup.validate()
+        .map_err(|e| anyhow::anyhow!("{}: built an invalid soup: {e}", path.display()))?;
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "mesh".into());
+    Ok(Scene {
+        name: format!("{stem}-on-mirror"),
+        soup,
+    })
+}
+
+/// A tiny scene for tests: a mirror floor, a diffuse box-less wall and a floating
+/// triangle casting a soft shadow from a point light.
+pub fn tiny() -> Scene {
+    let mut soup = Soup::empty();
+    soup.materials = vec![
+        material("mirror", Vec3::splat(0.7), 1.0, 0.8),
+        material("red", Vec3::new(0.8, 0.2, 0.2), 0.0, 0.5),
+    ];
+    soup.objects = vec![
+        Object {
+            name: "floor".into(),
+            source: "tiny".into(),
+        },
+        Object {
+            name: "blocker".into(),
+            source: "tiny".into(),
+        },
+    ];
+    floor(&mut soup, 2.0, 0, 0);
+    // A wall facing the camera (−Z), behind the blocker.
+    quad(
+        &mut soup,
+        [
+            Vec3::new(-2.0, 0.0, 1.0),
+            Vec3::new(-2.0, 2.0, 1.0),
+            Vec3::new(2.0, 2.0, 1.0),
+            Vec3::new(2.0, 0.0, 1.0),
+        ],
+        1,
+        1,
+    );
+    let t = [
+        Vec3::new(-0.5, 0.5, 0.0),
+        Vec3::new(0.0, 1.2, 0.0),
+        Vec3::new(0.5, 0.5, 0.0),
+    ];
+    soup.triangles.push(t);
+    soup.normals.push([Vec3::NEG_Z; 3]);
+    soup.tri_material.push(1);
+    soup.tri_object.push(1);
+    soup.lights = vec![point_light("key", Vec3::new(0.3, 2.0, -1.5), 4.0, 0.5)];
+    soup.camera = look(Vec3::new(0.0, 1.0, -3.0), Vec3::new(0.0, 0.6, 0.5), 50.0);
+    soup.environment = environment(Vec3::new(0.2, 0.3, 0.5), Vec3::splat(0.05));
+    soup.seal();
+    Scene {
+        name: "tiny".into(),
+        soup,
+    }
+}

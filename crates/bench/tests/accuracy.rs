@@ -1,0 +1,73 @@
+//! The accuracy report generator on a tiny scene: the reference against itself has zero
+//! error, and the error against the reference shrinks as spp grows.
+
+use bench::accuracy::{compare, scenes, sweep, Config};
+use formats::BuildParams;
+use kdtree::Accel;
+use render::RenderOptions;
+
+fn tiny_config() -> Config {
+    Config {
+        width: 32,
+        height: 24,
+        runs: 1,
+        reference_spp: 256,
+        threads: Some(1),
+        ..Config::default()
+    }
+}
+
+#[test]
+fn reference_against_itself_has_zero_error() {
+    let scene = scenes::tiny();
+    scene.soup.validate().expect("the tiny soup is valid");
+    let cfg = Config {
+        reference_spp: 16,
+        ..tiny_config()
+    };
+    let accel = Accel::build(&scene.soup.triangles, &BuildParams::default());
+    let (a, rays, _) = sweep::reference(&scene, &accel, &cfg).unwrap();
+    assert_eq!(rays.camera, 32 * 24 * 16);
+    // Rendered twice: the renderer is deterministic per seed, so the images are equal.
+    let (b, _, _) = sweep::reference(&scene, &accel, &cfg).unwrap();
+    let e = compare(&a, &b, 32, 24);
+    assert_eq!(e.rmse, 0.0);
+    assert_eq!(e.rel_mse, 0.0);
+    assert!((e.ssim - 1.0).abs() < 1e-12, "ssim {}", e.ssim);
+    // The scene is not black: the comparison is over real pixel values.
+    assert!(
+        a.iter().any(|c| c.x > 0.05),
+        "the tiny scene rendered black"
+    );
+}
+
+#[test]
+fn error_shrinks_as_spp_grows() {
+    let scene = scenes::tiny();
+    let cfg = tiny_config();
+    let accel = Accel::build(&scene.soup.triangles, &BuildParams::default());
+    let (reference, _, _) = sweep::reference(&scene, &accel, &cfg).unwrap();
+    let base = sweep::defaults(&cfg);
+    let errors: Vec<_> = [1, 4, 16, 64]
+        .iter()
+        .map(|&spp| {
+            let o = RenderOptions {
+                spp,
+                ..base.clone()
+            };
+            let (img, rays, _) = sweep::render_once(&scene, &accel, &o).unwrap();
+            assert_eq!(rays.camera, 32 * 24 * spp as u64);
+            compare(&img, &reference, 32, 24)
+        })
+        .collect();
+    for w in errors.windows(2) {
+        assert!(
+            w[1].rmse < w[0].rmse,
+            "rmse did not shrink: {:?}",
+            errors.iter().map(|e| e.rmse).collect::<Vec<_>>()
+        );
+        assert!(w[1].rel_mse < w[0].rel_mse);
+        assert!(w[1].ssim >= w[0].ssim - 1e-9);
+    }
+    assert!(errors[0].rmse > 0.0);
+}
