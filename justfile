@@ -58,4 +58,8 @@ gallery: build
 
 # Tracer and build benchmarks against brute force and a median-split tree (add `--features embree` via EMBREE=1).
 bench: (scene "scenes/baseline/Assets/Scenes/Baseline.unity" "baseline")
-    cargo run --release --quiet -p bench {{ if env_var_or_default("EMBREE", "") == "1" { "--features embree" } else { "" } }} --bin kdbench -- --baseline out/baseline.soup --out reports/bench.md
+    cargo run --release --quiet -p bench {{ if env_var_or_default("EMBREE", "") == "1" { "--features embree" } else { "" } }} --bin kdbench -- --baseline out/baseline.soup --meshes ../shared/corpus/meshes --out reports/bench.md
+
+# What accuracy costs in time: sweep spp, depth, soft-shadow samples and tree settings against a reference.
+accuracy:
+    cargo run --release --quiet -p bench --bin accuracy

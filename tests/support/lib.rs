@@ -62,9 +62,8 @@ pub struct Run {
 impl Run {
     /// Parse stdout as the single JSON object a `--json` run prints.
     pub fn json(&self) -> serde_json::Value {
-        serde_json::from_str(self.stdout.trim()).unwrap_or_else(|e| {
-            panic!("stdout is not one JSON object ({e}):\n{}", self.stdout)
-        })
+        serde_json::from_str(self.stdout.trim())
+            .unwrap_or_else(|e| panic!("stdout is not one JSON object ({e}):\n{}", self.stdout))
     }
 }
 

@@ -1,4 +1,4 @@
-//! kdbench: build and traversal benchmarks, written as a markdown table.
+//! robustbench: build and traversal benchmarks, written as a markdown table.
 //!
 //! Per scene: SAH build time (1 and 2 threads), triangles/s, SAH cost, bytes/triangle;
 //! Mrays/s of primary, shadow and random rays for the SAH tree, a median-split tree and
@@ -18,7 +18,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 #[derive(Parser, Debug)]
-#[command(name = "kdbench")]
+#[command(name = "robustbench")]
 struct Cli {
     /// Markdown report to write (default: stdout).
     #[arg(short, long)]
@@ -132,7 +132,7 @@ fn pool(n: usize) -> rayon::ThreadPool {
 }
 
 fn bench_scene(name: &str, tris: &[[Vec3; 3]], cli: &Cli, params: &BuildParams, out: &mut String) {
-    eprintln!("kdbench: {name}: {} triangles", tris.len());
+    eprintln!("robustbench: {name}: {} triangles", tris.len());
     let hash = formats::soup::geometry_hash(tris);
     let kd1 = pool(1).install(|| kdtree::build(tris, params, hash));
     let kd2 = pool(2).install(|| kdtree::build(tris, params, hash));
@@ -207,7 +207,7 @@ fn leak_scene(
     let lw = leaks(&|r| accel.intersect(r).is_some());
     let lp = leaks(&|r| accel.intersect_plain(r).is_some());
     eprintln!(
-        "kdbench: leaks {name}: watertight {lw} ({wt:.2} Mrays/s), plain {lp} ({plain:.2} Mrays/s)"
+        "robustbench: leaks {name}: watertight {lw} ({wt:.2} Mrays/s), plain {lp} ({plain:.2} Mrays/s)"
     );
     writeln!(
         out,
@@ -224,7 +224,7 @@ fn run(cli: Cli) -> Result<()> {
     }
     let want = |name: &str| cli.only.as_ref().is_none_or(|o| name.contains(o.as_str()));
     let mut out = String::new();
-    writeln!(out, "## k-d tree build and traversal (kdbench)\n").unwrap();
+    writeln!(out, "## k-d tree build and traversal (robustbench)\n").unwrap();
     writeln!(out, "Build parameters: {params:?}. Mrays/s columns: SAH 1 thread / SAH 2 threads / median-split 1 thread / brute force 1 thread (on a sample).\n").unwrap();
     writeln!(out, "| scene | triangles | build 1T s | build 2T s | speedup | Mtris/s (2T) | SAH cost | median SAH cost | bytes/tri | primary | shadow | random |").unwrap();
     writeln!(out, "|---|---|---|---|---|---|---|---|---|---|---|---|").unwrap();
@@ -263,7 +263,7 @@ fn run(cli: Cli) -> Result<()> {
         }
     } else {
         eprintln!(
-            "kdbench: SKIPPED real meshes because {} is absent",
+            "robustbench: SKIPPED real meshes because {} is absent",
             meshes.display()
         );
     }
@@ -337,7 +337,7 @@ fn run(cli: Cli) -> Result<()> {
 fn main() {
     let cli = Cli::parse();
     if let Err(e) = run(cli) {
-        eprintln!("kdbench: {e:#}");
+        eprintln!("robustbench: {e:#}");
         std::process::exit(1);
     }
 }
