@@ -71,3 +71,37 @@ fn error_shrinks_as_spp_grows() {
     }
     assert!(errors[0].rmse > 0.0);
 }
+
+#[test]
+fn bias_is_measured_against_the_sweeps_most_accurate_setting() {
+    let scene = scenes::tiny();
+    let cfg = Config {
+        reference_spp: 16,
+        spp: vec![1],
+        depth: vec![0, 1, 8],
+        cutoff: vec![0.5, 0.0],
+        soft: vec![1, 64],
+        ..tiny_config()
+    };
+    let r = sweep::measure(&scene, &cfg, &|_| {}).unwrap();
+    let bias = |knob: &str, value: &str| {
+        r.points
+            .iter()
+            .find(|p| p.knob == knob && p.value == value)
+            .and_then(|p| p.bias)
+            .unwrap_or_else(|| panic!("no bias for {knob} = {value}"))
+    };
+    // The most accurate setting of each sweep is its own anchor: same options, same seed.
+    assert_eq!(bias("depth", "8"), 0.0);
+    assert_eq!(bias("cutoff", "0"), 0.0);
+    assert_eq!(bias("soft", "64"), 0.0);
+    // The floor is a mirror: without reflections it shows no reflection of the wall; one
+    // soft-shadow sample is noisier than 64.
+    assert!(bias("depth", "0") > bias("depth", "1"), "{:?}", r.points);
+    assert!(bias("depth", "0") > 0.01);
+    assert!(bias("soft", "1") > 0.0);
+    assert!(r.points.iter().filter(|p| p.knob == "spp").all(|p| p.bias.is_none()));
+    let md = bench::accuracy::report::markdown(&[r], &cfg, "test", &[]);
+    assert!(md.contains("## Recommended defaults"), "{md}");
+    assert!(md.contains("- mirror depth: "), "{md}");
+}

@@ -43,7 +43,10 @@ pub fn markdown(results: &[SceneResult], cfg: &Config, command: &str, notes: &[S
          another seed). Each knob is swept alone from the renderer's defaults (spp {}, depth \
          {}, cut-off {}, soft samples {}). RMSE and relMSE (mean (a−r)²/(r²+0.01)) are on the \
          linear HDR colour; 1−SSIM is on the luma of the 8-bit sRGB preview, 8×8 windows \
-         stepped by 4. Rows in **bold** are the defaults.\n",
+         stepped by 4. The bias column (mirror depth, cut-off, soft samples) is the RMSE \
+         against the sweep's own most accurate setting rendered with the same seed, so the \
+         noise they share cancels; the cut-off is swept at depth {}, where it, not the depth \
+         bound, ends the paths. Rows in **bold** are the defaults.\n",
         cfg.width,
         cfg.height,
         cfg.runs,
@@ -53,7 +56,8 @@ pub fn markdown(results: &[SceneResult], cfg: &Config, command: &str, notes: &[S
         d.spp,
         d.depth,
         d.cutoff,
-        d.soft_samples
+        d.soft_samples,
+        cfg.reference_depth
     );
     let _ = writeln!(s, "![error against time](accuracy.svg)\n");
     for n in notes {
@@ -73,13 +77,13 @@ pub fn markdown(results: &[SceneResult], cfg: &Config, command: &str, notes: &[S
         );
         let _ = writeln!(
             s,
-            "| knob | value | time (s) | rays | RMSE | relMSE | 1−SSIM | build (s) |\n|---|---|---:|---:|---:|---:|---:|---:|"
+            "| knob | value | time (s) | rays | RMSE | relMSE | 1−SSIM | bias | build (s) |\n|---|---|---:|---:|---:|---:|---:|---:|---:|"
         );
         for p in &r.points {
             let b = if p.is_default { "**" } else { "" };
             let _ = writeln!(
                 s,
-                "| {b}{}{b} | {b}{}{b} | {:.4} | {} | {:.5} | {:.5} | {:.5} | {} |",
+                "| {b}{}{b} | {b}{}{b} | {:.4} | {} | {:.5} | {:.5} | {:.5} | {} | {} |",
                 p.knob,
                 p.value,
                 p.seconds,
@@ -87,6 +91,7 @@ pub fn markdown(results: &[SceneResult], cfg: &Config, command: &str, notes: &[S
                 p.errors.rmse,
                 p.errors.rel_mse,
                 p.errors.dssim(),
+                p.bias.map(|b| format!("{b:.5}")).unwrap_or_default(),
                 p.build_seconds
                     .map(|b| format!("{b:.4}"))
                     .unwrap_or_default()
@@ -104,17 +109,32 @@ pub fn markdown(results: &[SceneResult], cfg: &Config, command: &str, notes: &[S
             (i.robust_seconds / i.plain_seconds.max(1e-12) - 1.0) * 100.0,
             i.disagreements
         );
+        let noise = noise_floor(r);
         let _ = writeln!(
             s,
-            "Where each sweep flattens (first value within 5 % of its best RMSE):\n"
+            "Where each sweep stops paying (spp: first value within 5 % of the best RMSE; the \
+             others: first value whose bias is at most {:.0} % of the default's noise, RMSE \
+             {noise:.5}):\n",
+            BIAS_FRACTION * 100.0
         );
-        for (knob, what) in KNOBS.iter().take(4) {
+        if let (Some(p), Some(last)) = (plateau(&sweep(r, "spp"), 0.05), sweep(r, "spp").last()) {
+            let _ = writeln!(
+                s,
+                "- samples per pixel: {} (RMSE {:.5} at {:.4} s; the most accurate point, {}, is {:.5} at {:.4} s)",
+                p.value, p.errors.rmse, p.seconds, last.value, last.errors.rmse, last.seconds
+            );
+        }
+        for (knob, what) in KNOBS.iter().skip(1).take(3) {
             let pts = sweep(r, knob);
-            if let (Some(p), Some(last)) = (plateau(&pts, 0.05), pts.last()) {
+            if let Some(i) = unbiased(&pts, noise) {
+                let p = pts[i];
                 let _ = writeln!(
                     s,
-                    "- {what}: {} (RMSE {:.5} at {:.4} s; the most accurate point, {}, is {:.5} at {:.4} s)",
-                    p.value, p.errors.rmse, p.seconds, last.value, last.errors.rmse, last.seconds
+                    "- {what}: {} (bias {:.5}, {} rays, {:.4} s)",
+                    p.value,
+                    p.bias.unwrap_or(0.0),
+                    p.rays.total(),
+                    p.seconds
                 );
             }
         }
@@ -124,29 +144,62 @@ pub fn markdown(results: &[SceneResult], cfg: &Config, command: &str, notes: &[S
     s
 }
 
-/// Per knob, the most demanding plateau across scenes: the cheapest setting that is
-/// within 5 % of the best error on every scene measured.
+/// A bias below this fraction of the default image's noise cannot be seen under it.
+const BIAS_FRACTION: f64 = 0.1;
+
+/// The default render's RMSE against the reference: its 1-spp noise.
+fn noise_floor(r: &SceneResult) -> f64 {
+    r.points
+        .iter()
+        .find(|p| p.knob == "spp" && p.is_default)
+        .map_or(0.0, |p| p.errors.rmse)
+}
+
+/// Index of the first point (sweeps run from cheapest to most accurate) whose bias is at
+/// most [`BIAS_FRACTION`] of `noise`.
+pub fn unbiased(points: &[&Point], noise: f64) -> Option<usize> {
+    points
+        .iter()
+        .position(|p| p.bias.is_some_and(|b| b <= BIAS_FRACTION * noise))
+}
+
+/// Per bias knob, the most demanding setting across scenes: the cheapest whose bias hides
+/// under the noise on every scene measured. A knob that changes neither rays nor pixels
+/// on any scene has no evidence either way, so its default stays.
 fn recommend(s: &mut String, results: &[SceneResult]) {
-    let _ = writeln!(
-        s,
-        "## Recommended defaults
-"
-    );
+    let _ = writeln!(s, "## Recommended defaults\n");
     for (knob, what) in KNOBS.iter().skip(1).take(3) {
-        let mut need: Option<(usize, String)> = None;
-        for r in results {
+        let idle = results.iter().all(|r| {
             let pts = sweep(r, knob);
-            if let Some(p) = plateau(&pts, 0.05) {
-                let i = pts.iter().position(|q| std::ptr::eq(*q, p)).unwrap_or(0);
-                if need.as_ref().is_none_or(|(j, _)| i > *j) {
-                    need = Some((i, p.value.clone()));
-                }
-            }
-        }
-        if let Some((_, v)) = need {
+            pts.iter().all(|p| {
+                p.bias == Some(0.0) && p.rays.total() == pts[0].rays.total()
+            })
+        });
+        let default = results
+            .iter()
+            .flat_map(|r| sweep(r, knob))
+            .find(|p| p.is_default)
+            .map(|p| p.value.clone());
+        if idle {
             let _ = writeln!(
                 s,
-                "- {what}: {v} (the cheapest setting within 5 % of the best RMSE on every scene)"
+                "- {what}: keep {} (no setting changed the rays or the pixels on these scenes)",
+                default.unwrap_or_default()
+            );
+            continue;
+        }
+        let need = results
+            .iter()
+            .filter_map(|r| unbiased(&sweep(r, knob), noise_floor(r)).map(|i| (i, r)))
+            .max_by_key(|(i, _)| *i);
+        if let Some((i, r)) = need {
+            let _ = writeln!(
+                s,
+                "- {what}: {} (the cheapest setting whose bias is under {:.0} % of the 1-spp \
+                 noise on every scene; {} decides)",
+                sweep(r, knob)[i].value,
+                BIAS_FRACTION * 100.0,
+                r.scene
             );
         }
     }

@@ -84,6 +84,10 @@ pub struct Point {
     pub seconds: f64,
     pub rays: RayCounts,
     pub errors: Errors,
+    /// For the bias knobs (depth, cut-off, soft samples): RMSE against the sweep's most
+    /// accurate setting rendered with the same seed, so the 1-spp noise they share cancels
+    /// and only what the knob changes is left.
+    pub bias: Option<f64>,
     /// Tree build time, for the `tree` knob only.
     pub build_seconds: Option<f64>,
 }
@@ -193,10 +197,12 @@ pub fn measure(scene: &Scene, cfg: &Config, log: &dyn Fn(&str)) -> Result<SceneR
                      is_default: bool,
                      accel: &Accel,
                      opts: &RenderOptions,
-                     build_seconds: Option<f64>|
+                     build_seconds: Option<f64>,
+                     anchor: Option<&[Vec3]>|
      -> Result<()> {
         let (img, rays, seconds) = timed(scene, accel, opts, cfg.runs)?;
         let errors = compare(&img, &reference, w, h);
+        let bias = anchor.map(|a| compare(&img, a, w, h).rmse);
         log(&format!(
             "{}: {knob} = {value}: {seconds:.3} s, rmse {:.4}, 1-ssim {:.4}",
             scene.name,
@@ -211,6 +217,7 @@ pub fn measure(scene: &Scene, cfg: &Config, log: &dyn Fn(&str)) -> Result<SceneR
             seconds,
             rays,
             errors,
+            bias,
             build_seconds,
         });
         Ok(())
@@ -220,62 +227,50 @@ pub fn measure(scene: &Scene, cfg: &Config, log: &dyn Fn(&str)) -> Result<SceneR
             spp,
             ..base.clone()
         };
-        point("spp", spp.to_string(), spp == base.spp, &accel, &o, None)?;
+        point("spp", spp.to_string(), spp == base.spp, &accel, &o, None, None)?;
     }
+    // The bias knobs are compared with their own most accurate setting at the same seed.
+    // The cut-off is swept at the reference depth: at depth 2 the depth bound ends every
+    // path before any weight falls below the cut-off, so it could not show its effect.
+    let depth_opts = |depth| RenderOptions {
+        depth,
+        ..base.clone()
+    };
+    let cutoff_opts = |cutoff| RenderOptions {
+        cutoff,
+        depth: cfg.reference_depth,
+        ..base.clone()
+    };
+    let soft_opts = |soft_samples| RenderOptions {
+        soft_samples,
+        ..base.clone()
+    };
+    let anchor = |o: RenderOptions| render_once(scene, &accel, &o).map(|r| r.0);
+    let a = anchor(depth_opts(cfg.reference_depth))?;
     for &depth in &cfg.depth {
-        let o = RenderOptions {
-            depth,
-            ..base.clone()
-        };
-        point(
-            "depth",
-            depth.to_string(),
-            depth == base.depth,
-            &accel,
-            &o,
-            None,
-        )?;
+        let o = depth_opts(depth);
+        let d = depth == base.depth;
+        point("depth", depth.to_string(), d, &accel, &o, None, Some(&a))?;
     }
+    let a = anchor(cutoff_opts(0.0))?;
     for &cutoff in &cfg.cutoff {
-        let o = RenderOptions {
-            cutoff,
-            ..base.clone()
-        };
-        point(
-            "cutoff",
-            cutoff.to_string(),
-            cutoff == base.cutoff,
-            &accel,
-            &o,
-            None,
-        )?;
+        let o = cutoff_opts(cutoff);
+        let d = cutoff == base.cutoff;
+        point("cutoff", cutoff.to_string(), d, &accel, &o, None, Some(&a))?;
     }
+    let a = anchor(soft_opts(cfg.reference_soft))?;
     for &soft in &cfg.soft {
-        let o = RenderOptions {
-            soft_samples: soft,
-            ..base.clone()
-        };
-        point(
-            "soft",
-            soft.to_string(),
-            soft == base.soft_samples,
-            &accel,
-            &o,
-            None,
-        )?;
+        let o = soft_opts(soft);
+        let d = soft == base.soft_samples;
+        point("soft", soft.to_string(), d, &accel, &o, None, Some(&a))?;
     }
-    point("tree", "SAH".into(), true, &accel, &base, Some(sah_build))?;
+    let b = Some(sah_build);
+    point("tree", "SAH".into(), true, &accel, &base, b, None)?;
     let (mkd, median_build) = median_tree(scene);
     let maccel = Accel::new(&scene.soup, &mkd)
         .with_context(|| format!("scene {}: median tree does not fit", scene.name))?;
-    point(
-        "tree",
-        "median".into(),
-        false,
-        &maccel,
-        &base,
-        Some(median_build),
-    )?;
+    let b = Some(median_build);
+    point("tree", "median".into(), false, &maccel, &base, b, None)?;
     let intersector = intersectors(scene, &accel, cfg)?;
     log(&format!(
         "{}: robust {:.3} s, plain {:.3} s, {} of {} rays disagree",
