@@ -59,10 +59,16 @@ pub enum AccelError {
 /// A soup's triangles plus a compiled tree, ready for ray queries. Send + Sync: share one
 /// across threads by reference.
 pub struct Accel {
-    /// Triangle vertices in soup order (36 bytes each), indexed by the leaves' lists.
+    /// Triangle vertices (36 bytes each) in the order the leaves first list them, so a
+    /// ray walking neighbouring leaves reads neighbouring memory.
     tris: Vec<[[f32; 3]; 3]>,
+    /// Soup index of each entry of `tris`: hits and the tie rule speak soup indices.
+    soup_index: Vec<u32>,
     nodes: Vec<KdNode>,
+    /// The leaves' lists, as indices into `tris`.
     leaf_tris: Vec<u32>,
+    /// Triangles of the input (the denominator of bytes per triangle).
+    input_triangles: usize,
     bounds: Aabb,
 }
 
@@ -124,13 +130,34 @@ impl Accel {
                 max,
             });
         }
+        // Renumber triangles by first appearance in the leaves (depth-first order).
+        let mut slot = vec![u32::MAX; triangles.len()];
+        let mut soup_index = Vec::with_capacity(triangles.len());
+        let leaf_tris = kd
+            .leaf_tris
+            .iter()
+            .map(|&p| {
+                let s = &mut slot[p as usize];
+                if *s == u32::MAX {
+                    *s = soup_index.len() as u32;
+                    soup_index.push(p);
+                }
+                *s
+            })
+            .collect();
+        let tris = soup_index
+            .iter()
+            .map(|&p| {
+                let t = &triangles[p as usize];
+                [t[0].to_array(), t[1].to_array(), t[2].to_array()]
+            })
+            .collect();
         Ok(Accel {
-            tris: triangles
-                .iter()
-                .map(|t| [t[0].to_array(), t[1].to_array(), t[2].to_array()])
-                .collect(),
+            tris,
+            soup_index,
             nodes: kd.nodes.clone(),
-            leaf_tris: kd.leaf_tris.clone(),
+            leaf_tris,
+            input_triangles: triangles.len(),
             bounds: Aabb {
                 lo: kd.bounds[0].to_array(),
                 hi: kd.bounds[1].to_array(),
@@ -141,6 +168,7 @@ impl Accel {
     fn tree(&self) -> traverse::Tree<'_> {
         traverse::Tree {
             tris: &self.tris,
+            soup_index: &self.soup_index,
             nodes: &self.nodes,
             leaf_tris: &self.leaf_tris,
             bounds: &self.bounds,
@@ -169,16 +197,26 @@ impl Accel {
         self.nodes.len() * std::mem::size_of::<KdNode>()
             + self.leaf_tris.len() * 4
             + self.tris.len() * std::mem::size_of::<[[f32; 3]; 3]>()
+            + self.soup_index.len() * 4
     }
 
     /// [`Accel::memory_bytes`] per input triangle.
     pub fn bytes_per_triangle(&self) -> f64 {
-        self.memory_bytes() as f64 / self.tris.len().max(1) as f64
+        self.memory_bytes() as f64 / self.input_triangles.max(1) as f64
     }
 
+    /// Triangles the tree holds (soup triangles with non-finite vertices are left out).
     pub fn triangle_count(&self) -> usize {
         self.tris.len()
     }
+}
+
+/// Bytes an [`Accel`] holds for `kd`'s queries: 8 per node, 4 per leaf entry, 36 of
+/// vertices and 4 of soup index per triangle.
+pub fn query_bytes(kd: &KdFile) -> usize {
+    kd.nodes.len() * std::mem::size_of::<KdNode>()
+        + kd.leaf_tris.len() * 4
+        + kd.stats.triangles as usize * (std::mem::size_of::<[[f32; 3]; 3]>() + 4)
 }
 
 /// Brute-force queries: every triangle, the same watertight test and tie rule as the tree.

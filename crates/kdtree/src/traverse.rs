@@ -40,6 +40,7 @@ fn pad_down(t: f32) -> f32 {
 
 pub(crate) struct Tree<'a> {
     pub tris: &'a [[[f32; 3]; 3]],
+    pub soup_index: &'a [u32],
     pub nodes: &'a [KdNode],
     pub leaf_tris: &'a [u32],
     pub bounds: &'a Aabb,
@@ -219,9 +220,16 @@ impl Tree<'_> {
     #[inline(always)]
     fn tri(&self, p: u32) -> &[[f32; 3]; 3] {
         debug_assert!((p as usize) < self.tris.len());
-        // SAFETY: `KdFile::validate` proves every leaf entry < stats.triangles, and
-        // `Accel::assemble` checks stats.triangles == tris.len().
+        // SAFETY: `Accel::assemble` renumbers every leaf entry to the position where it
+        // pushed that triangle into `tris`, so each entry is < tris.len().
         unsafe { self.tris.get_unchecked(p as usize) }
+    }
+
+    #[inline(always)]
+    fn soup_index(&self, p: u32) -> u32 {
+        debug_assert!((p as usize) < self.soup_index.len());
+        // SAFETY: as for `tri`: `soup_index` has one entry per element of `tris`.
+        unsafe { *self.soup_index.get_unchecked(p as usize) }
     }
 
     /// Closest hit in [tmin, tmax]; ties in t go to the lower triangle index (so the
@@ -259,11 +267,12 @@ impl Tree<'_> {
             }
             for &p in self.leaf(node) {
                 if let Some(h) = test::<ROBUST>(&s, ray, self.tri(p), best_t) {
-                    if h.t < best_t || p < best.prim {
+                    let prim = self.soup_index(p);
+                    if h.t < best_t || prim < best.prim {
                         best_t = h.t;
                         best = Hit {
                             t: h.t,
-                            prim: p,
+                            prim,
                             u: h.u,
                             v: h.v,
                         };

@@ -93,8 +93,7 @@ fn params(cli: &Cli) -> Result<BuildParams> {
 /// Bytes a query structure holds per input triangle: 8-byte nodes, 4-byte leaf
 /// references and 36 bytes of vertices per triangle (see `Accel::memory_bytes`).
 fn bytes_per_triangle(kd: &KdFile) -> f64 {
-    let bytes = kd.nodes.len() * 8 + kd.leaf_tris.len() * 4 + kd.stats.triangles as usize * 36;
-    bytes as f64 / kd.stats.triangles.max(1) as f64
+    kdtree::query_bytes(kd) as f64 / kd.stats.triangles.max(1) as f64
 }
 
 fn print_stats(path: &Path, json: bool) -> Result<()> {
