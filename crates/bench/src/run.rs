@@ -385,7 +385,7 @@ impl Bench<'_> {
                 sah_cost: Some(tree.stats.sah_cost),
                 nodes: Some(tree.nodes.len() as u64),
                 refs_per_triangle: Some(tree.leaf_tris.len() as f64 / n.max(1) as f64),
-                bytes_per_triangle: Some(kd_bytes(&tree, n) as f64 / n.max(1) as f64),
+                bytes_per_triangle: Some(kdtree::query_bytes(&tree) as f64 / n.max(1) as f64),
             });
             kd = Some(tree);
         }
@@ -527,11 +527,6 @@ fn subset_indices(len: usize, n: usize) -> Vec<usize> {
     (0..len).step_by(stride).take(n).collect()
 }
 
-/// Bytes the k-d tree holds for queries: 8-byte nodes, 4-byte leaf references and the
-/// triangles' 36 bytes each (what `Accel` keeps).
-fn kd_bytes(kd: &formats::KdFile, triangles: usize) -> usize {
-    kd.nodes.len() * 8 + kd.leaf_tris.len() * 4 + triangles * 36
-}
 
 fn run_scene(
     cfg: &Config,

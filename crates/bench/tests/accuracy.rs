@@ -100,7 +100,11 @@ fn bias_is_measured_against_the_sweeps_most_accurate_setting() {
     assert!(bias("depth", "0") > bias("depth", "1"), "{:?}", r.points);
     assert!(bias("depth", "0") > 0.01);
     assert!(bias("soft", "1") > 0.0);
-    assert!(r.points.iter().filter(|p| p.knob == "spp").all(|p| p.bias.is_none()));
+    assert!(r
+        .points
+        .iter()
+        .filter(|p| p.knob == "spp")
+        .all(|p| p.bias.is_none()));
     let md = bench::accuracy::report::markdown(&[r], &cfg, "test", &[]);
     assert!(md.contains("## Recommended defaults"), "{md}");
     assert!(md.contains("- mirror depth: "), "{md}");

@@ -171,9 +171,8 @@ fn recommend(s: &mut String, results: &[SceneResult]) {
     for (knob, what) in KNOBS.iter().skip(1).take(3) {
         let idle = results.iter().all(|r| {
             let pts = sweep(r, knob);
-            pts.iter().all(|p| {
-                p.bias == Some(0.0) && p.rays.total() == pts[0].rays.total()
-            })
+            pts.iter()
+                .all(|p| p.bias == Some(0.0) && p.rays.total() == pts[0].rays.total())
         });
         let default = results
             .iter()

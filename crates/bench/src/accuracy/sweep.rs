@@ -227,7 +227,15 @@ pub fn measure(scene: &Scene, cfg: &Config, log: &dyn Fn(&str)) -> Result<SceneR
             spp,
             ..base.clone()
         };
-        point("spp", spp.to_string(), spp == base.spp, &accel, &o, None, None)?;
+        point(
+            "spp",
+            spp.to_string(),
+            spp == base.spp,
+            &accel,
+            &o,
+            None,
+            None,
+        )?;
     }
     // The bias knobs are compared with their own most accurate setting at the same seed.
     // The cut-off is swept at the reference depth: at depth 2 the depth bound ends every
