@@ -527,7 +527,6 @@ fn subset_indices(len: usize, n: usize) -> Vec<usize> {
     (0..len).step_by(stride).take(n).collect()
 }
 
-
 fn run_scene(
     cfg: &Config,
     scene: &Scene,

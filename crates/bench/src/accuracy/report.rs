@@ -113,9 +113,10 @@ pub fn markdown(results: &[SceneResult], cfg: &Config, command: &str, notes: &[S
         let _ = writeln!(
             s,
             "Where each sweep stops paying (spp: first value within 5 % of the best RMSE; the \
-             others: first value whose bias is at most {:.0} % of the default's noise, RMSE \
-             {noise:.5}):\n",
-            BIAS_FRACTION * 100.0
+             others: first value whose bias adds at most {:.0} % to the default's 1-spp error \
+             of {noise:.5}, i.e. bias ≤ {noise_cap:.5}):\n",
+            MAX_ADDED_ERROR * 100.0,
+            noise_cap = bias_fraction() * noise
         );
         if let (Some(p), Some(last)) = (plateau(&sweep(r, "spp"), 0.05), sweep(r, "spp").last()) {
             let _ = writeln!(
@@ -144,8 +145,15 @@ pub fn markdown(results: &[SceneResult], cfg: &Config, command: &str, notes: &[S
     s
 }
 
-/// A bias below this fraction of the default image's noise cannot be seen under it.
-const BIAS_FRACTION: f64 = 0.1;
+/// A knob's residual bias b and the image's noise n add in quadrature, so b adds
+/// √(1 + (b/n)²) − 1 to the total error: at most 1 % when b ≤ 0.142·n. A setting that
+/// changes the error by less than 1 % is not worth time.
+const MAX_ADDED_ERROR: f64 = 0.01;
+
+/// The largest bias, as a fraction of the noise, that adds at most [`MAX_ADDED_ERROR`].
+fn bias_fraction() -> f64 {
+    ((1.0 + MAX_ADDED_ERROR).powi(2) - 1.0).sqrt()
+}
 
 /// The default render's RMSE against the reference: its 1-spp noise.
 fn noise_floor(r: &SceneResult) -> f64 {
@@ -156,11 +164,11 @@ fn noise_floor(r: &SceneResult) -> f64 {
 }
 
 /// Index of the first point (sweeps run from cheapest to most accurate) whose bias is at
-/// most [`BIAS_FRACTION`] of `noise`.
+/// most [`bias_fraction`] of `noise`.
 pub fn unbiased(points: &[&Point], noise: f64) -> Option<usize> {
     points
         .iter()
-        .position(|p| p.bias.is_some_and(|b| b <= BIAS_FRACTION * noise))
+        .position(|p| p.bias.is_some_and(|b| b <= bias_fraction() * noise))
 }
 
 /// Per bias knob, the most demanding setting across scenes: the cheapest whose bias hides
@@ -194,10 +202,10 @@ fn recommend(s: &mut String, results: &[SceneResult]) {
         if let Some((i, r)) = need {
             let _ = writeln!(
                 s,
-                "- {what}: {} (the cheapest setting whose bias is under {:.0} % of the 1-spp \
-                 noise on every scene; {} decides)",
+                "- {what}: {} (the cheapest setting whose bias adds at most {:.0} % to the 1-spp \
+                 error on every scene; {} decides)",
                 sweep(r, knob)[i].value,
-                BIAS_FRACTION * 100.0,
+                MAX_ADDED_ERROR * 100.0,
                 r.scene
             );
         }

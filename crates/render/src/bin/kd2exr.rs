@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! kd2exr scene.soup scene.kd -o image.exr [--preview image.png] [--width 1024] [--height 768]
-//!        [--depth 2] [--spp 1] [--seed 0] [--threads N] [--json] [--half]
+//!        [--depth 4] [--spp 1] [--seed 0] [--threads N] [--json] [--half]
 //!        [--aov depth,normal,albedo,object] [--exposure 0] [--crop x0,y0,x1,y1]
 //!        [--soft-samples 16] [--cutoff 0.004]
 //! kd2exr merge a.exr b.exr … -o full.exr
@@ -57,18 +57,18 @@ struct RenderArgs {
     /// Also write an 8-bit sRGB PNG preview.
     #[arg(long)]
     preview: Option<PathBuf>,
-    #[arg(long, default_value_t = 1024)]
+    #[arg(long, default_value_t = RenderOptions::default().width)]
     width: u32,
-    #[arg(long, default_value_t = 768)]
+    #[arg(long, default_value_t = RenderOptions::default().height)]
     height: u32,
     /// Maximum mirror bounces.
-    #[arg(long, default_value_t = 2)]
+    #[arg(long, default_value_t = RenderOptions::default().depth)]
     depth: u32,
     /// Samples per pixel (stratified, box filter).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = RenderOptions::default().spp)]
     spp: u32,
     /// Seed of the per-pixel random numbers.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = RenderOptions::default().seed)]
     seed: u64,
     /// Worker threads (default: one per core).
     #[arg(long)]
@@ -89,10 +89,10 @@ struct RenderArgs {
     #[arg(long, value_name = "x0,y0,x1,y1", value_parser = Window::parse)]
     crop: Option<Window>,
     /// Shadow rays per soft-shadow light per shading point.
-    #[arg(long, default_value_t = 16)]
+    #[arg(long, default_value_t = RenderOptions::default().soft_samples)]
     soft_samples: u32,
     /// Stop reflection rays when the path weight falls below this.
-    #[arg(long, default_value_t = 0.004)]
+    #[arg(long, default_value_t = RenderOptions::default().cutoff)]
     cutoff: f32,
 }
 
