@@ -3,11 +3,12 @@ use std::path::PathBuf;
 /// Everything that can go wrong reading or writing an artifact. Each variant names the file.
 #[derive(Debug, thiserror::Error)]
 pub enum FormatError {
-    #[error("{path}: {source}")]
+    /// The OS error is part of the message and deliberately not a `source`, so that
+    /// `{:#}` chains print it once.
+    #[error("{path}: {error}")]
     Io {
         path: PathBuf,
-        #[source]
-        source: std::io::Error,
+        error: std::io::Error,
     },
     #[error("{path}: not a {expected} file (magic bytes are {found:?})")]
     Magic {
@@ -34,7 +35,7 @@ impl FormatError {
     pub(crate) fn io(path: &std::path::Path, source: std::io::Error) -> Self {
         FormatError::Io {
             path: path.to_path_buf(),
-            source,
+            error: source,
         }
     }
 }

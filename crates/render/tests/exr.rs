@@ -143,7 +143,7 @@ fn aov_channels_read_back_with_their_names_and_values() {
     let ours = ExrImage::read(&path).unwrap();
     assert_eq!(ours.value("Z", bx, by), Some(9.0));
     assert_eq!(ours.attributes[&format!("{ATTR_PREFIX}spp")], "4");
-    assert_eq!(ours.attributes[&format!("{ATTR_PREFIX}depth")], "2");
+    assert_eq!(ours.attributes[&format!("{ATTR_PREFIX}depth")], "4");
     assert_eq!(
         ours.attributes[&format!("{ATTR_PREFIX}geometryHash")],
         formats::hex(&soup.geometry_hash)

@@ -1,0 +1,90 @@
+//! Build-parameter experiments:
+//! `cargo run --release -p bench --example kdtune -- KT KI BONUS MAX_DEPTH LEAF_SIZE FILE…`
+//! builds each soup or OBJ with those parameters and prints build time, primary and shadow
+//! Mrays/s (best of 15, 1 thread) and the tree's statistics. Only ratios within one run mean
+//! anything on a noisy machine.
+
+use anyhow::{bail, Context, Result};
+use bench::{rays, scenes};
+use formats::BuildParams;
+use kdtree::Accel;
+use std::path::Path;
+use std::time::Instant;
+
+fn main() {
+    if let Err(e) = run() {
+        eprintln!("kdtune: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+fn best_of<T>(runs: usize, mut f: impl FnMut() -> T) -> (f64, T) {
+    let mut best = f64::MAX;
+    let mut out = f();
+    for _ in 0..runs {
+        let t = Instant::now();
+        out = f();
+        best = best.min(t.elapsed().as_secs_f64());
+    }
+    (best, out)
+}
+
+fn run() -> Result<()> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.len() < 6 {
+        bail!("usage: kdtune KT KI BONUS MAX_DEPTH LEAF_SIZE FILE…");
+    }
+    let num = |i: usize| -> Result<f32> {
+        args[i]
+            .parse()
+            .with_context(|| format!("argument {}: {:?} is not a number", i + 1, args[i]))
+    };
+    let p = BuildParams {
+        traversal_cost: num(0)?,
+        intersect_cost: num(1)?,
+        empty_bonus: num(2)?,
+        max_depth: num(3)? as u32,
+        leaf_size: num(4)? as u32,
+    };
+    for path in &args[5..] {
+        let path = Path::new(path);
+        let s = if path.extension().is_some_and(|e| e == "soup") {
+            scenes::load_soup(path)?
+        } else {
+            scenes::load_obj(path)?
+        };
+        let tris = &s.triangles;
+        let t = Instant::now();
+        let kd = kdtree::build(tris, &p, formats::soup::geometry_hash(tris));
+        let build = t.elapsed().as_secs_f64();
+        let a = Accel::from_triangles(tris, &kd)?;
+        let b = scenes::bounds(tris);
+        let prim = rays::primary(&s.view.unwrap_or(rays::framing(b)), 512);
+        let (tp, hits) = best_of(15, || {
+            prim.iter()
+                .map(|r| a.intersect(r).map(|h| (h.prim, h.u, h.v)))
+                .collect::<Vec<_>>()
+        });
+        let sh = rays::shadow(tris, &hits, rays::light_above(b), b);
+        let (ts, occluded) = best_of(15, || sh.iter().filter(|r| a.occluded(r)).count());
+        let st = &kd.stats;
+        println!(
+            "{}: {} triangles, build {:.1} ms, primary {:.3} Mrays/s, shadow {:.3} Mrays/s \
+             ({occluded} occluded), nodes {}, leaves {}, max leaf {}, depth {}, refs/tri {:.2}, \
+             SAH {:.1}, bytes/tri {:.1}",
+            s.name,
+            tris.len(),
+            build * 1e3,
+            prim.len() as f64 / tp / 1e6,
+            sh.len() as f64 / ts / 1e6,
+            st.nodes,
+            st.leaves,
+            st.max_leaf_triangles,
+            st.max_depth,
+            st.references as f64 / st.triangles.max(1) as f64,
+            st.sah_cost,
+            a.bytes_per_triangle()
+        );
+    }
+    Ok(())
+}
