@@ -77,7 +77,10 @@ fn renders_merges_and_reports() {
     assert_eq!(json["width"], 40);
     assert_eq!(json["height"], 30);
     assert_eq!(json["spp"], 1);
-    assert_eq!(json["depth"], 4, "the default mirror depth (reports/accuracy.md)");
+    assert_eq!(
+        json["depth"], 4,
+        "the default mirror depth (reports/accuracy.md)"
+    );
     assert!(json["seconds"].as_f64().unwrap() >= 0.0);
     assert_eq!(json["rays"]["camera"], 1200);
     assert_eq!(json["rays"]["reflection"], 0);

@@ -10,14 +10,15 @@ use crate::unity::{
 use std::collections::BTreeMap;
 
 /// A project under construction: its materials by name, and the objects of its one scene.
-struct Builder {
+/// Public so that end-to-end tests can write small Unity projects of their own.
+pub struct Builder {
     project: Project,
     mats: BTreeMap<&'static str, String>,
     objects: Vec<Object>,
 }
 
 impl Builder {
-    fn new(name: &str, looks: &[MatDesc]) -> Self {
+    pub fn new(name: &str, looks: &[MatDesc]) -> Self {
         let mut project = Project::new(name);
         let mut mats = BTreeMap::new();
         for m in looks {
@@ -34,7 +35,7 @@ impl Builder {
         }
     }
 
-    fn camera(&mut self, xform: Xform, desc: CameraDesc) -> &mut Self {
+    pub fn camera(&mut self, xform: Xform, desc: CameraDesc) -> &mut Self {
         self.objects.push(Object {
             name: "Main Camera".into(),
             xform,
@@ -43,7 +44,7 @@ impl Builder {
         self
     }
 
-    fn light(&mut self, name: &str, xform: Xform, desc: LightDesc) -> &mut Self {
+    pub fn light(&mut self, name: &str, xform: Xform, desc: LightDesc) -> &mut Self {
         self.objects.push(Object {
             name: name.into(),
             xform,
@@ -52,7 +53,7 @@ impl Builder {
         self
     }
 
-    fn mesh(&mut self, name: &str, builtin: i64, look: &str, xform: Xform) -> &mut Self {
+    pub fn mesh(&mut self, name: &str, builtin: i64, look: &str, xform: Xform) -> &mut Self {
         let guid = self.mats[look].clone();
         self.objects.push(Object {
             name: name.into(),
@@ -65,7 +66,8 @@ impl Builder {
         self
     }
 
-    fn finish(mut self, scene_name: &str, ambient: Ambient) -> Project {
+    /// Write the scene to `Assets/Scenes/<scene_name>.unity` and complete the project.
+    pub fn finish(mut self, scene_name: &str, ambient: Ambient) -> Project {
         let path = format!("Assets/Scenes/{scene_name}.unity");
         let key = format!("{}/{scene_name}", self.project.name);
         let scene = SceneDesc {
