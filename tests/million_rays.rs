@@ -1,0 +1,105 @@
+//! Issue 4's check at full size: `raycast` on a file of a million random rays against the
+//! baseline scene gives exactly the brute-force hits (same triangle and t, or the same
+//! miss). Brute force tests all 41,833 triangles per ray, about 4·10¹⁰ tests: ~10 minutes
+//! on 2 cores, so it is ignored by default. Run it with
+//! `cargo test --release --test million_rays -- --ignored`.
+
+use formats::rays::{self, RayRecord};
+use glam::Vec3;
+use kdtree::{brute, Ray};
+use rayon::prelude::*;
+use unitrace::run_ok;
+
+#[test]
+#[ignore = "about 10 minutes on 2 cores; run on demand"]
+fn raycast_a_million_random_rays_against_the_baseline_equals_brute_force() {
+    let dir = tempfile::tempdir().unwrap();
+    let soup_path = dir.path().join("baseline.soup");
+    let kd_path = dir.path().join("baseline.kd");
+    run_ok(
+        "unity2soup",
+        [
+            "scenes/baseline/Assets/Scenes/Baseline.unity".as_ref(),
+            "-o".as_ref(),
+            soup_path.as_os_str(),
+        ],
+    );
+    run_ok(
+        "soup2kd",
+        [soup_path.as_os_str(), "-o".as_ref(), kd_path.as_os_str()],
+    );
+    let soup = formats::Soup::read(&soup_path).unwrap();
+    assert_eq!(soup.triangles.len(), 41_833);
+    let (lo, hi) = soup.triangles.iter().flatten().fold(
+        (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    );
+    // Origins uniform in the bounds, directions uniform on the sphere (SplitMix64).
+    let mut state = 0x5eed_u64;
+    let mut unit = move || {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
+    };
+    let input: Vec<RayRecord> = (0..1_000_000)
+        .map(|_| {
+            let origin = lo + (hi - lo) * Vec3::new(unit(), unit(), unit());
+            let z = 2.0 * unit() - 1.0;
+            let phi = std::f32::consts::TAU * unit();
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            RayRecord {
+                origin,
+                tmin: 0.0,
+                dir: Vec3::new(r * phi.cos(), r * phi.sin(), z),
+                tmax: f32::INFINITY,
+            }
+        })
+        .collect();
+    let rays_path = dir.path().join("random.rays");
+    let hits_path = dir.path().join("random.hits");
+    rays::write_rays(&rays_path, &input).unwrap();
+    let v = run_ok(
+        "raycast",
+        [
+            soup_path.as_os_str(),
+            kd_path.as_os_str(),
+            rays_path.as_os_str(),
+            "-o".as_ref(),
+            hits_path.as_os_str(),
+            "--json".as_ref(),
+        ],
+    )
+    .json();
+    assert_eq!(v["rays"], 1_000_000);
+    let hits = rays::read_hits(&hits_path).unwrap();
+    let differ: Vec<usize> = (0..input.len())
+        .into_par_iter()
+        .filter(|&i| {
+            let r = &input[i];
+            let want =
+                brute::intersect(&soup.triangles, &Ray::new(r.origin, r.dir, r.tmin, r.tmax));
+            let h = hits[i];
+            match want {
+                Some(w) => (h.prim, h.t) != (w.prim, w.t),
+                None => !h.is_miss(),
+            }
+        })
+        .collect();
+    let n_hits = hits.iter().filter(|h| !h.is_miss()).count();
+    eprintln!(
+        "1,000,000 rays, {n_hits} hits, {} differ from brute force",
+        differ.len()
+    );
+    assert!(
+        n_hits > 100_000,
+        "the rays must meet the scene: {n_hits} hits"
+    );
+    assert!(
+        differ.is_empty(),
+        "rays that differ: {:?}",
+        &differ[..differ.len().min(20)]
+    );
+    assert_eq!(v["hits"], n_hits);
+}
