@@ -115,14 +115,14 @@ fn setup<const ROBUST: bool>(ray: &Ray, b: &Aabb) -> Option<Setup> {
 }
 
 #[inline(always)]
-fn test<const ROBUST: bool>(
+fn test<const ROBUST: bool, const KZ: usize>(
     s: &Setup,
     ray: &Ray,
     tri: &[[f32; 3]; 3],
     tmax: f32,
 ) -> Option<RawHit> {
     if ROBUST {
-        triangle::intersect(&s.pre, tri, ray.tmin, tmax)
+        triangle::intersect_along::<KZ>(&s.pre, tri, ray.tmin, tmax)
     } else {
         triangle::intersect_moller(ray.origin, ray.dir, tri, ray.tmin, tmax)
     }
@@ -237,6 +237,21 @@ impl Tree<'_> {
     #[inline(always)]
     pub fn closest<const ROBUST: bool>(&self, ray: &Ray) -> Option<Hit> {
         let s = setup::<ROBUST>(ray, self.bounds)?;
+        // One instantiation per dominant axis: the triangle test's permutation is then a
+        // constant (see `triangle::intersect_along`).
+        match s.pre.kz {
+            0 => self.closest_along::<ROBUST, 0>(ray, &s),
+            1 => self.closest_along::<ROBUST, 1>(ray, &s),
+            _ => self.closest_along::<ROBUST, 2>(ray, &s),
+        }
+    }
+
+    #[inline(always)]
+    fn closest_along<const ROBUST: bool, const KZ: usize>(
+        &self,
+        ray: &Ray,
+        s: &Setup,
+    ) -> Option<Hit> {
         let mut best = Hit::MISS;
         let mut best_t = ray.tmax;
         let mut stack = [(0u32, 0f32, 0f32); STACK];
@@ -245,7 +260,7 @@ impl Tree<'_> {
         loop {
             let node = self.node(node_i);
             if !node.is_leaf() {
-                match step::<ROBUST>(&s, node_i, node, t0, t1) {
+                match step::<ROBUST>(s, node_i, node, t0, t1) {
                     Step::One(c) => node_i = c,
                     Step::Two {
                         first,
@@ -266,7 +281,7 @@ impl Tree<'_> {
                 continue;
             }
             for &p in self.leaf(node) {
-                if let Some(h) = test::<ROBUST>(&s, ray, self.tri(p), best_t) {
+                if let Some(h) = test::<ROBUST, KZ>(s, ray, self.tri(p), best_t) {
                     let prim = self.soup_index(p);
                     if h.t < best_t || prim < best.prim {
                         best_t = h.t;
@@ -300,13 +315,22 @@ impl Tree<'_> {
         let Some(s) = setup::<ROBUST>(ray, self.bounds) else {
             return false;
         };
+        match s.pre.kz {
+            0 => self.any_along::<ROBUST, 0>(ray, &s),
+            1 => self.any_along::<ROBUST, 1>(ray, &s),
+            _ => self.any_along::<ROBUST, 2>(ray, &s),
+        }
+    }
+
+    #[inline(always)]
+    fn any_along<const ROBUST: bool, const KZ: usize>(&self, ray: &Ray, s: &Setup) -> bool {
         let mut stack = [(0u32, 0f32, 0f32); STACK];
         let mut sp = 0;
         let (mut node_i, mut t0, mut t1) = (0u32, s.t0, s.t1);
         loop {
             let node = self.node(node_i);
             if !node.is_leaf() {
-                match step::<ROBUST>(&s, node_i, node, t0, t1) {
+                match step::<ROBUST>(s, node_i, node, t0, t1) {
                     Step::One(c) => node_i = c,
                     Step::Two {
                         first,
@@ -327,7 +351,7 @@ impl Tree<'_> {
                 continue;
             }
             for &p in self.leaf(node) {
-                if test::<ROBUST>(&s, ray, self.tri(p), ray.tmax).is_some() {
+                if test::<ROBUST, KZ>(s, ray, self.tri(p), ray.tmax).is_some() {
                     return true;
                 }
             }

@@ -15,8 +15,8 @@ use glam::Vec3;
 #[derive(Clone, Copy, Debug)]
 pub struct RayPre {
     pub origin: [f32; 3],
-    pub kx: usize,
-    pub ky: usize,
+    /// The dominant axis of the direction; x and y of the sheared frame are the next
+    /// two axes in cyclic order.
     pub kz: usize,
     pub sx: f32,
     pub sy: f32,
@@ -42,16 +42,12 @@ impl RayPre {
         if d[kz] == 0.0 {
             return None;
         }
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        // Swap to keep the triangle's winding (the sign of the determinant) meaningful.
-        if d[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
+        // Woop et al. swap x and y for a negative direction to keep the winding's sign;
+        // the test here is two-sided, and the swap would only negate all three edge
+        // functions, the determinant and the t numerator, which cancel.
+        let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
         Some(RayPre {
             origin: origin.to_array(),
-            kx,
-            ky,
             kz,
             sx: d[kx] / d[kz],
             sy: d[ky] / d[kz],
@@ -72,20 +68,39 @@ pub struct RawHit {
 /// (tmax may be +inf). Returns t and the barycentrics (u weights v1, v weights v2).
 #[inline(always)]
 pub fn intersect(r: &RayPre, tri: &[[f32; 3]; 3], tmin: f32, tmax: f32) -> Option<RawHit> {
+    match r.kz {
+        0 => intersect_along::<0>(r, tri, tmin, tmax),
+        1 => intersect_along::<1>(r, tri, tmin, tmax),
+        _ => intersect_along::<2>(r, tri, tmin, tmax),
+    }
+}
+
+/// [`intersect`] for a ray whose dominant axis is `KZ` (`r.kz == KZ`). The permutation is
+/// a constant here, so the vertices are read straight from memory; the traversal is
+/// instantiated once per dominant axis to call this.
+///
+#[inline(always)]
+pub fn intersect_along<const KZ: usize>(
+    r: &RayPre,
+    tri: &[[f32; 3]; 3],
+    tmin: f32,
+    tmax: f32,
+) -> Option<RawHit> {
+    debug_assert_eq!(r.kz, KZ);
+    let kx = (KZ + 1) % 3;
+    let ky = (KZ + 2) % 3;
+    let (sx, sy) = (r.sx, r.sy);
     let o = r.origin;
-    // Length-4 arrays indexed with `k & 3`: the compiler sees every index in bounds, so
-    // the permutation costs no bounds checks (kx, ky, kz are always < 3).
-    let rel = |p: &[f32; 3]| [p[0] - o[0], p[1] - o[1], p[2] - o[2], 0.0];
-    let (kx, ky, kz) = (r.kx & 3, r.ky & 3, r.kz & 3);
+    let rel = |p: &[f32; 3]| [p[kx] - o[kx], p[ky] - o[ky], p[KZ] - o[KZ]];
     let a = rel(&tri[0]);
     let b = rel(&tri[1]);
     let c = rel(&tri[2]);
-    let ax = a[kx] - r.sx * a[kz];
-    let ay = a[ky] - r.sy * a[kz];
-    let bx = b[kx] - r.sx * b[kz];
-    let by = b[ky] - r.sy * b[kz];
-    let cx = c[kx] - r.sx * c[kz];
-    let cy = c[ky] - r.sy * c[kz];
+    let ax = a[0] - sx * a[2];
+    let ay = a[1] - sy * a[2];
+    let bx = b[0] - sx * b[2];
+    let by = b[1] - sy * b[2];
+    let cx = c[0] - sx * c[2];
+    let cy = c[1] - sy * c[2];
     let mut u = cx * by - cy * bx;
     let mut v = ax * cy - ay * cx;
     let mut w = bx * ay - by * ax;
@@ -105,9 +120,9 @@ pub fn intersect(r: &RayPre, tri: &[[f32; 3]; 3], tmin: f32, tmax: f32) -> Optio
     if det == 0.0 || det.is_nan() {
         return None;
     }
-    let az = r.sz * a[kz];
-    let bz = r.sz * b[kz];
-    let cz = r.sz * c[kz];
+    let az = r.sz * a[2];
+    let bz = r.sz * b[2];
+    let cz = r.sz * c[2];
     let tt = u * az + v * bz + w * cz;
     // Two-sided: compare against |det|-scaled bounds instead of dividing.
     let (tt, adet) = if det < 0.0 { (-tt, -det) } else { (tt, det) };
