@@ -63,3 +63,7 @@ bench: (scene "scenes/baseline/Assets/Scenes/Baseline.unity" "baseline")
 # What accuracy costs in time: sweep spp, depth, soft-shadow samples and tree settings against a reference.
 accuracy:
     cargo run --release --quiet -p bench --bin accuracy
+
+# Render speed-up from 1 to 2 threads on the baseline (interleaved pairs, one process); `just threads --width 320 --height 240`.
+threads *ARGS:
+    cargo run --release --quiet -p bench --bin threads -- {{ARGS}}
