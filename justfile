@@ -64,6 +64,11 @@ bench: (scene "scenes/baseline/Assets/Scenes/Baseline.unity" "baseline")
 accuracy:
     cargo run --release --quiet -p bench --bin accuracy
 
+# Scale test: the baseline's props on a SIDE×SIDE grid (16: 10.7 million triangles), converted, compiled and rendered to out/large.exr/.png.
+large SIDE="16": build
+    {{bin}}/scenegen out --large {{SIDE}}
+    just scene out/large/Assets/Scenes/Large.unity large
+
 # Render speed-up from 1 to 2 threads on the baseline (interleaved pairs, one process); `just threads --width 320 --height 240`.
 threads *ARGS:
     cargo run --release --quiet -p bench --bin threads -- {{ARGS}}

@@ -187,3 +187,35 @@ fn unity_scene_through_the_three_binaries_gives_the_known_pixels() {
     let (ux, uz) = unity_floor_point(19, 80);
     assert_close(rgb(img.at(19, 80)), lit(ux, uz), 0.01, "floor at (19, 80)");
 }
+
+/// The scale-test project (`scenegen --large`) at side 2: four copies of the baseline's
+/// props on one floor under a sun. Side 16 (10.7 million triangles) is the same code; its
+/// timings are in docs/PERFORMANCE.md.
+#[test]
+fn large_scene_converts_to_side_squared_copies_of_the_baseline_props() {
+    let dir = tempfile::tempdir().unwrap();
+    scenegen::baseline::large(2)
+        .write(dir.path())
+        .expect("write the large project");
+    let scene = dir
+        .path()
+        .join("large")
+        .join(scenegen::baseline::LARGE_SCENE_PATH);
+    let soup = dir.path().join("large.soup");
+    let s = run_ok(
+        "unity2soup",
+        [
+            scene.as_os_str(),
+            "-o".as_ref(),
+            soup.as_os_str(),
+            "--json".as_ref(),
+        ],
+    )
+    .json();
+    // The baseline minus its 12-triangle floor, four times, plus the stretched floor.
+    let props = scenegen::baseline::TRIANGLES - 12;
+    assert_eq!(s["triangles"], 4 * props + 12, "{s}");
+    assert_eq!(s["objects"], 1 + 4 * 8, "{s}");
+    assert_eq!(s["lights"], 1, "{s}");
+    assert_eq!(s["warnings"].as_array().map(Vec::len), Some(0), "{s}");
+}

@@ -4,7 +4,9 @@
 
 use crate::material::{write_material, MatDesc};
 use crate::project::Project;
-use crate::unity::{self, Ambient, Body, CameraDesc, LightDesc, MeshRef, Object, SceneDesc, Xform};
+use crate::unity::{
+    self, Ambient, Body, CameraDesc, LightDesc, LightType, MeshRef, Object, SceneDesc, Xform,
+};
 use crate::{ids, meta, models};
 
 pub const NAME: &str = "baseline";
@@ -32,7 +34,24 @@ fn looks() -> Vec<MatDesc> {
 }
 
 pub fn project() -> Project {
-    let mut p = Project::new(NAME);
+    build(NAME, 1)
+}
+
+/// The scale test: the baseline's props (everything but the floor) repeated on a
+/// `side`×`side` grid 16 m apart, 41,821·side² + 12 triangles (side 16: 10.7 million), on
+/// one floor, lit by a sun with hard shadows, seen from above at an angle. Not bundled:
+/// `scenegen --large SIDE DIR` writes it.
+pub fn large(side: usize) -> Project {
+    build(LARGE, side.max(1))
+}
+
+pub const LARGE: &str = "large";
+pub const LARGE_SCENE_PATH: &str = "Assets/Scenes/Large.unity";
+/// Grid spacing of the large scene's copies.
+const SPACING: f32 = 16.0;
+
+fn build(name: &str, side: usize) -> Project {
+    let mut p = Project::new(name);
     let mut mat_guid = std::collections::BTreeMap::new();
     for m in looks() {
         let path = format!("Assets/Materials/{}.mat", m.name);
@@ -75,7 +94,7 @@ pub fn project() -> Project {
         xform,
         body: Body::Light(LightDesc::point(color, intensity, 40.0)),
     };
-    let objects = vec![
+    let mut objects = vec![
         Object {
             name: "Main Camera".into(),
             xform: Xform::at(0.0, 4.2, -11.0).euler(13.0, 0.0, 0.0),
@@ -149,16 +168,70 @@ pub fn project() -> Project {
             Xform::at(6.5, 0.0, 7.5).euler(3.0, 40.0, -4.0).uniform(1.4),
         ),
     ];
+    let (path, key) = if side == 1 {
+        (SCENE_PATH, "baseline/Baseline")
+    } else {
+        objects = grid(objects, side);
+        (LARGE_SCENE_PATH, "large/Large")
+    };
     let scene = SceneDesc {
         ambient: Ambient::Flat([0.0, 0.0, 0.0]),
         objects,
     };
-    p.add_asset(
-        SCENE_PATH,
-        unity::write_scene("baseline/Baseline", &scene),
-        meta::scene,
-    );
+    p.add_asset(path, unity::write_scene(key, &scene), meta::scene);
     p.finish()
+}
+
+/// The baseline's objects turned into the large scene: props copied over the grid, the
+/// floor stretched under it, the camera raised to see it, the point lights (range 40 m)
+/// replaced by a sun.
+fn grid(baseline: Vec<Object>, side: usize) -> Vec<Object> {
+    let width = SPACING * side as f32;
+    let centre = |i: usize| (i as f32 - (side as f32 - 1.0) / 2.0) * SPACING;
+    let mut out = vec![];
+    let mut props = vec![];
+    for o in baseline {
+        match &o.body {
+            Body::Camera(_) => out.push(Object {
+                xform: Xform::at(0.0, 0.35 * width, -0.75 * width).euler(30.0, 0.0, 0.0),
+                ..o
+            }),
+            Body::Light(_) => {}
+            _ if o.name == "Floor" => out.push(Object {
+                xform: Xform::at(0.0, -0.1, 2.0).scale(width + 8.0, 0.2, width + 8.0),
+                ..o
+            }),
+            _ => props.push(o),
+        }
+    }
+    out.push(Object {
+        name: "Sun".into(),
+        xform: Xform::at(0.0, 10.0, 0.0).euler(50.0, -30.0, 0.0),
+        body: Body::Light(LightDesc {
+            kind: LightType::Directional,
+            ..LightDesc::point([1.0, 0.97, 0.92], 1.2, 0.0)
+        }),
+    });
+    for i in 0..side {
+        for j in 0..side {
+            for o in &props {
+                let Body::Mesh { mesh, materials } = &o.body else {
+                    continue;
+                };
+                let mut xform = o.xform;
+                xform.position += glam::Vec3::new(centre(i), 0.0, centre(j));
+                out.push(Object {
+                    name: format!("{} [{i},{j}]", o.name),
+                    xform,
+                    body: Body::Mesh {
+                        mesh: mesh.clone(),
+                        materials: materials.clone(),
+                    },
+                });
+            }
+        }
+    }
+    out
 }
 
 #[cfg(test)]

@@ -1,4 +1,5 @@
-//! `scenegen [SCENES_DIR] [--only NAME]`: (re)write the bundled Unity projects.
+//! `scenegen [SCENES_DIR] [--only NAME]`: (re)write the bundled Unity projects;
+//! `scenegen DIR --large SIDE`: write the scale-test project instead.
 
 use anyhow::{bail, Context, Result};
 use clap::Parser;
@@ -13,6 +14,10 @@ struct Args {
     /// Only this project (e.g. `baseline`, `spot`).
     #[arg(long)]
     only: Option<String>,
+    /// Write only the scale-test project `large`: the baseline's props on a SIDE×SIDE
+    /// grid (41,821·SIDE² + 12 triangles; 16 gives 10.7 million).
+    #[arg(long, value_name = "SIDE", conflicts_with = "only")]
+    large: Option<usize>,
 }
 
 fn main() {
@@ -24,10 +29,13 @@ fn main() {
 
 fn run() -> Result<()> {
     let args = Args::parse();
-    let projects: Vec<_> = scenegen::all_projects()
-        .into_iter()
-        .filter(|p| args.only.as_deref().is_none_or(|o| o == p.name))
-        .collect();
+    let projects: Vec<_> = match args.large {
+        Some(side) => vec![scenegen::baseline::large(side)],
+        None => scenegen::all_projects()
+            .into_iter()
+            .filter(|p| args.only.as_deref().is_none_or(|o| o == p.name))
+            .collect(),
+    };
     if projects.is_empty() {
         bail!("no project named {:?}", args.only.unwrap_or_default());
     }

@@ -52,6 +52,7 @@ impl Xform {
     }
 }
 
+#[derive(Clone)]
 pub enum MeshRef {
     /// A built-in primitive's fileID (`CUBE`, `SPHERE`, …).
     Builtin(i64),
