@@ -225,6 +225,23 @@ impl Tree<'_> {
         unsafe { self.tris.get_unchecked(p as usize) }
     }
 
+    /// The watertight test on a group of 1–4 leaf entries (short groups repeat their last
+    /// entry, which cannot change an answer); returns the entries lane by lane.
+    #[inline(always)]
+    fn test4<const KZ: usize>(
+        &self,
+        s: &Setup,
+        ray: &Ray,
+        group: &[u32],
+        tmax: f32,
+    ) -> ([u32; 4], [Option<RawHit>; 4]) {
+        let last = group[group.len() - 1];
+        let lanes: [u32; 4] = std::array::from_fn(|l| *group.get(l).unwrap_or(&last));
+        let tris = lanes.map(|p| self.tri(p));
+        let hits = triangle::intersect4_along::<KZ>(&s.pre, tris, ray.tmin, tmax);
+        (lanes, hits)
+    }
+
     #[inline(always)]
     fn soup_index(&self, p: u32) -> u32 {
         debug_assert!((p as usize) < self.soup_index.len());
@@ -280,17 +297,20 @@ impl Tree<'_> {
                 }
                 continue;
             }
-            for &p in self.leaf(node) {
-                if let Some(h) = test::<ROBUST, KZ>(s, ray, self.tri(p), best_t) {
-                    let prim = self.soup_index(p);
-                    if h.t < best_t || prim < best.prim {
-                        best_t = h.t;
-                        best = Hit {
-                            t: h.t,
-                            prim,
-                            u: h.u,
-                            v: h.v,
-                        };
+            let leaf = self.leaf(node);
+            if ROBUST && leaf.len() >= 2 {
+                for group in leaf.chunks(4) {
+                    let (lanes, hits) = self.test4::<KZ>(s, ray, group, best_t);
+                    for (p, h) in lanes.into_iter().zip(hits) {
+                        if let Some(h) = h {
+                            keep_closer(&mut best, &mut best_t, self.soup_index(p), h);
+                        }
+                    }
+                }
+            } else {
+                for &p in leaf {
+                    if let Some(h) = test::<ROBUST, KZ>(s, ray, self.tri(p), best_t) {
+                        keep_closer(&mut best, &mut best_t, self.soup_index(p), h);
                     }
                 }
             }
@@ -350,9 +370,19 @@ impl Tree<'_> {
                 }
                 continue;
             }
-            for &p in self.leaf(node) {
-                if test::<ROBUST, KZ>(s, ray, self.tri(p), ray.tmax).is_some() {
-                    return true;
+            let leaf = self.leaf(node);
+            if ROBUST && leaf.len() >= 2 {
+                for group in leaf.chunks(4) {
+                    let (_, hits) = self.test4::<KZ>(s, ray, group, ray.tmax);
+                    if hits.iter().any(Option::is_some) {
+                        return true;
+                    }
+                }
+            } else {
+                for &p in leaf {
+                    if test::<ROBUST, KZ>(s, ray, self.tri(p), ray.tmax).is_some() {
+                        return true;
+                    }
                 }
             }
             if sp == 0 {
@@ -361,6 +391,22 @@ impl Tree<'_> {
             sp -= 1;
             (node_i, t0, t1) = stack[sp];
         }
+    }
+}
+
+/// Take hit `h` on triangle `prim` if it is closer than the best so far, or as close with
+/// a lower index. `h.t <= best_t` matters for four-wide groups: their lanes were tested
+/// against the bound at the group's start, which an earlier lane may have lowered.
+#[inline(always)]
+fn keep_closer(best: &mut Hit, best_t: &mut f32, prim: u32, h: RawHit) {
+    if h.t <= *best_t && (h.t < *best_t || prim < best.prim) {
+        *best_t = h.t;
+        *best = Hit {
+            t: h.t,
+            prim,
+            u: h.u,
+            v: h.v,
+        };
     }
 }
 

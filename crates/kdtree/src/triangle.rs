@@ -142,6 +142,87 @@ pub fn intersect_along<const KZ: usize>(
     })
 }
 
+/// [`intersect_along`] for four triangles at once: the translation, shear and edge
+/// functions run lane by lane on `[f32; 4]` (which the compiler turns into SIMD), the
+/// rest only for lanes whose edge functions agree in sign. Each lane's arithmetic is the
+/// scalar test's, in the same order, so each lane's answer has the same bits as
+/// `intersect_along` on that triangle; a group with an edge function exactly zero is
+/// handed to the scalar test whole, for its f64 decision.
+#[inline(always)]
+pub fn intersect4_along<const KZ: usize>(
+    r: &RayPre,
+    tri: [&[[f32; 3]; 3]; 4],
+    tmin: f32,
+    tmax: f32,
+) -> [Option<RawHit>; 4] {
+    debug_assert_eq!(r.kz, KZ);
+    let kx = (KZ + 1) % 3;
+    let ky = (KZ + 2) % 3;
+    let (sx, sy, o) = (r.sx, r.sy, r.origin);
+    let lanes = |f: &dyn Fn(&[[f32; 3]; 3]) -> f32| -> [f32; 4] {
+        [f(tri[0]), f(tri[1]), f(tri[2]), f(tri[3])]
+    };
+    // Vertex v's coordinate k relative to the origin.
+    let az = lanes(&|t| t[0][KZ] - o[KZ]);
+    let bz = lanes(&|t| t[1][KZ] - o[KZ]);
+    let cz = lanes(&|t| t[2][KZ] - o[KZ]);
+    let mut ax = lanes(&|t| t[0][kx] - o[kx]);
+    let mut ay = lanes(&|t| t[0][ky] - o[ky]);
+    let mut bx = lanes(&|t| t[1][kx] - o[kx]);
+    let mut by = lanes(&|t| t[1][ky] - o[ky]);
+    let mut cx = lanes(&|t| t[2][kx] - o[kx]);
+    let mut cy = lanes(&|t| t[2][ky] - o[ky]);
+    let (mut u, mut v, mut w) = ([0f32; 4], [0f32; 4], [0f32; 4]);
+    let mut zero = false;
+    let mut outside = [false; 4];
+    for l in 0..4 {
+        ax[l] -= sx * az[l];
+        ay[l] -= sy * az[l];
+        bx[l] -= sx * bz[l];
+        by[l] -= sy * bz[l];
+        cx[l] -= sx * cz[l];
+        cy[l] -= sy * cz[l];
+        u[l] = cx[l] * by[l] - cy[l] * bx[l];
+        v[l] = ax[l] * cy[l] - ay[l] * cx[l];
+        w[l] = bx[l] * ay[l] - by[l] * ax[l];
+        zero |= (u[l] == 0.0) | (v[l] == 0.0) | (w[l] == 0.0);
+        outside[l] = ((u[l] < 0.0) | (v[l] < 0.0) | (w[l] < 0.0))
+            & ((u[l] > 0.0) | (v[l] > 0.0) | (w[l] > 0.0));
+    }
+    if zero {
+        return std::array::from_fn(|l| intersect_along::<KZ>(r, tri[l], tmin, tmax));
+    }
+    let mut out = [None; 4];
+    if outside == [true; 4] {
+        return out;
+    }
+    for l in 0..4 {
+        if outside[l] {
+            continue;
+        }
+        let det = u[l] + v[l] + w[l];
+        if det == 0.0 || det.is_nan() {
+            continue;
+        }
+        let tt = u[l] * (r.sz * az[l]) + v[l] * (r.sz * bz[l]) + w[l] * (r.sz * cz[l]);
+        let (tt, adet) = if det < 0.0 { (-tt, -det) } else { (tt, det) };
+        if !(tt >= tmin * adet && tt <= tmax * adet) {
+            continue;
+        }
+        let inv = 1.0 / det;
+        let t = tt / adet;
+        if !(t >= tmin && t <= tmax) {
+            continue;
+        }
+        out[l] = Some(RawHit {
+            t,
+            u: v[l] * inv,
+            v: w[l] * inv,
+        });
+    }
+    out
+}
+
 /// Plain Möller–Trumbore (1997), kept only to measure what watertightness costs: it leaks
 /// rays through shared edges and rejects hits with an absolute determinant epsilon.
 #[inline(always)]
@@ -216,6 +297,62 @@ mod tests {
             let r = RayPre::new(Vec3::new(p[0], p[1], -1.0), Vec3::Z).unwrap();
             assert!(intersect(&r, &tri(), 0.0, 10.0).is_some(), "{p:?}");
         }
+    }
+
+    /// Random groups of four triangles and rays, a third of them snapped to a coarse grid
+    /// with axis-aligned rays so that edge functions are exactly zero (the f64 path):
+    /// every lane answers with exactly the scalar test's bits.
+    #[test]
+    fn four_wide_matches_the_scalar_test_bit_for_bit() {
+        let mut state = 7u64;
+        let mut unit = move || {
+            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 23) as f32 - 1.0
+        };
+        let bits = |h: Option<RawHit>| h.map(|h| (h.t.to_bits(), h.u.to_bits(), h.v.to_bits()));
+        let (mut hits, mut on_edges) = (0, 0);
+        for i in 0..30_000 {
+            let snap = i % 3 == 0;
+            let mut p = || {
+                let v = 2.0 * unit();
+                if snap {
+                    v.round()
+                } else {
+                    v
+                }
+            };
+            let tris: [[[f32; 3]; 3]; 4] =
+                std::array::from_fn(|_| std::array::from_fn(|_| [p(), p(), p()]));
+            let origin = Vec3::new(p(), p(), p() - 4.0);
+            let dir = if snap {
+                [Vec3::X, Vec3::Y, Vec3::Z, -Vec3::Z][i % 4]
+            } else {
+                Vec3::new(unit(), unit(), unit() + 1.5)
+            };
+            let Some(r) = RayPre::new(origin, dir) else {
+                continue;
+            };
+            let tmax = if i % 2 == 0 { f32::INFINITY } else { 5.0 };
+            let group = [&tris[0], &tris[1], &tris[2], &tris[3]];
+            let four = match r.kz {
+                0 => intersect4_along::<0>(&r, group, 0.0, tmax),
+                1 => intersect4_along::<1>(&r, group, 0.0, tmax),
+                _ => intersect4_along::<2>(&r, group, 0.0, tmax),
+            };
+            for l in 0..4 {
+                let one = intersect(&r, &tris[l], 0.0, tmax);
+                assert_eq!(bits(four[l]), bits(one), "group {i}, lane {l}");
+                hits += one.is_some() as u32;
+                if let Some(h) = one {
+                    on_edges += (h.u == 0.0 || h.v == 0.0 || h.u + h.v == 1.0) as u32;
+                }
+            }
+        }
+        assert!(hits > 5_000, "{hits} hits");
+        assert!(on_edges > 100, "{on_edges} hits on an edge or vertex");
     }
 
     #[test]
