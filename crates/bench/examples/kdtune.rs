@@ -1,8 +1,9 @@
 //! Build-parameter experiments:
 //! `cargo run --release -p bench --example kdtune -- KT KI BONUS MAX_DEPTH LEAF_SIZE FILE…`
-//! builds each soup or OBJ with those parameters and prints build time, primary and shadow
-//! Mrays/s (best of 15, 1 thread) and the tree's statistics. Only ratios within one run mean
-//! anything on a noisy machine.
+//! builds each soup or OBJ (or `gen:N`, kdbench's generated scene of N triangles) with
+//! those parameters and prints build time, primary and shadow Mrays/s (best of 15, 1
+//! thread) and the tree's statistics. Only ratios within one run mean anything on a noisy
+//! machine.
 
 use anyhow::{bail, Context, Result};
 use bench::{rays, scenes};
@@ -46,9 +47,14 @@ fn run() -> Result<()> {
         max_depth: num(3)? as u32,
         leaf_size: num(4)? as u32,
     };
-    for path in &args[5..] {
-        let path = Path::new(path);
-        let s = if path.extension().is_some_and(|e| e == "soup") {
+    for arg in &args[5..] {
+        let path = Path::new(arg);
+        let s = if let Some(n) = arg.strip_prefix("gen:") {
+            let n = n
+                .parse()
+                .with_context(|| format!("{arg}: not gen:TRIANGLES"))?;
+            scenes::generated(n)
+        } else if path.extension().is_some_and(|e| e == "soup") {
             scenes::load_soup(path)?
         } else {
             scenes::load_obj(path)?
