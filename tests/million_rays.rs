@@ -1,6 +1,6 @@
 //! Issue 4's check at full size: `raycast` on a file of a million random rays against the
 //! baseline scene gives exactly the brute-force hits (same triangle and t, or the same
-//! miss). Brute force tests all 41,833 triangles per ray, about 4·10¹⁰ tests: ~10 minutes
+//! miss). Brute force tests all 41,833 triangles per ray, about 4·10¹⁰ tests: about 3 minutes
 //! on 2 cores, so it is ignored by default. Run it with
 //! `cargo test --release --test million_rays -- --ignored`.
 
@@ -11,7 +11,7 @@ use rayon::prelude::*;
 use unitrace::run_ok;
 
 #[test]
-#[ignore = "about 10 minutes on 2 cores; run on demand"]
+#[ignore = "about 3 minutes on 2 cores; run on demand"]
 fn raycast_a_million_random_rays_against_the_baseline_equals_brute_force() {
     let dir = tempfile::tempdir().unwrap();
     let soup_path = dir.path().join("baseline.soup");

@@ -64,6 +64,18 @@ pub struct RawHit {
     pub v: f32,
 }
 
+/// The early out before the division: whether t = tt / adet may lie in [tmin, tmax].
+/// Padded by a few ulps so that it never refuses a t that rounds into the interval; the
+/// exact test on the divided t decides. Without the padding a hit at exactly the current
+/// best t could be refused or accepted depending on which triangle set that bound, and
+/// the tie rule (lower index wins) would depend on the order triangles are tested in.
+#[inline(always)]
+fn in_scaled_interval(tt: f32, adet: f32, tmin: f32, tmax: f32) -> bool {
+    const SLACK: f32 = 4.0 * f32::EPSILON;
+    let (lo, hi) = (tmin * adet, tmax * adet);
+    tt >= lo - lo.abs() * SLACK && tt <= hi + hi.abs() * SLACK
+}
+
 /// Watertight, two-sided test of one triangle against a ray in [tmin, tmax]
 /// (tmax may be +inf). Returns t and the barycentrics (u weights v1, v weights v2).
 #[inline(always)]
@@ -126,7 +138,7 @@ pub fn intersect_along<const KZ: usize>(
     let tt = u * az + v * bz + w * cz;
     // Two-sided: compare against |det|-scaled bounds instead of dividing.
     let (tt, adet) = if det < 0.0 { (-tt, -det) } else { (tt, det) };
-    if !(tt >= tmin * adet && tt <= tmax * adet) {
+    if !in_scaled_interval(tt, adet, tmin, tmax) {
         return None;
     }
     let inv = 1.0 / det;
@@ -206,7 +218,7 @@ pub fn intersect4_along<const KZ: usize>(
         }
         let tt = u[l] * (r.sz * az[l]) + v[l] * (r.sz * bz[l]) + w[l] * (r.sz * cz[l]);
         let (tt, adet) = if det < 0.0 { (-tt, -det) } else { (tt, det) };
-        if !(tt >= tmin * adet && tt <= tmax * adet) {
+        if !in_scaled_interval(tt, adet, tmin, tmax) {
             continue;
         }
         let inv = 1.0 / det;
@@ -353,6 +365,35 @@ mod tests {
         }
         assert!(hits > 5_000, "{hits} hits");
         assert!(on_edges > 100, "{on_edges} hits on an edge or vertex");
+    }
+
+    /// Two overlapping coplanar triangles of the baseline scene (soup triangles 8880 and
+    /// 12361, the floor under a pig's foot) hit at the same t by a random ray of
+    /// tests/million_rays.rs: each must be accepted with the other's t as the bound, or the
+    /// tie rule (lower index wins) depends on which one a traversal tests first. Before the
+    /// padded early out, 8880 was refused against 12361's t.
+    #[test]
+    fn a_tie_is_accepted_whichever_triangle_set_the_bound() {
+        let a = [
+            [-3.5761795, 0.95, 1.0735804],
+            [-3.4942644, 0.95, 1.0162227],
+            [-3.628097, 0.95, 0.82509005],
+        ];
+        let b = [
+            [-3.6585164, 0.95, 0.8812674],
+            [-3.4806204, 0.95, 0.948536],
+            [-3.5683844, 0.95, 1.0099889],
+        ];
+        let r = RayPre::new(
+            Vec3::new(-3.7973728, 1.1198683, 1.1239977),
+            Vec3::new(0.7221318, -0.5132683, -0.4637686),
+        )
+        .unwrap();
+        let ta = intersect(&r, &a, 0.0, f32::INFINITY).unwrap().t;
+        let tb = intersect(&r, &b, 0.0, f32::INFINITY).unwrap().t;
+        assert_eq!(ta, tb);
+        assert_eq!(intersect(&r, &a, 0.0, tb).map(|h| h.t), Some(ta));
+        assert_eq!(intersect(&r, &b, 0.0, ta).map(|h| h.t), Some(tb));
     }
 
     #[test]
