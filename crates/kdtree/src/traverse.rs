@@ -228,7 +228,7 @@ impl Tree<'_> {
     /// The watertight test on a group of 1–4 leaf entries (short groups repeat their last
     /// entry, which cannot change an answer); returns the entries lane by lane.
     #[inline(always)]
-    fn test4<const KZ: usize>(
+    fn test4<const ROBUST: bool, const KZ: usize>(
         &self,
         s: &Setup,
         ray: &Ray,
@@ -238,7 +238,11 @@ impl Tree<'_> {
         let last = group[group.len() - 1];
         let lanes: [u32; 4] = std::array::from_fn(|l| *group.get(l).unwrap_or(&last));
         let tris = lanes.map(|p| self.tri(p));
-        let hits = triangle::intersect4_along::<KZ>(&s.pre, tris, ray.tmin, tmax);
+        let hits = if ROBUST {
+            triangle::intersect4_along::<KZ>(&s.pre, tris, ray.tmin, tmax)
+        } else {
+            triangle::intersect4_moller(ray.origin, ray.dir, tris, ray.tmin, tmax)
+        };
         (lanes, hits)
     }
 
@@ -298,9 +302,9 @@ impl Tree<'_> {
                 continue;
             }
             let leaf = self.leaf(node);
-            if ROBUST && leaf.len() >= 2 {
+            if leaf.len() >= 2 {
                 for group in leaf.chunks(4) {
-                    let (lanes, hits) = self.test4::<KZ>(s, ray, group, best_t);
+                    let (lanes, hits) = self.test4::<ROBUST, KZ>(s, ray, group, best_t);
                     for (p, h) in lanes.into_iter().zip(hits) {
                         if let Some(h) = h {
                             keep_closer(&mut best, &mut best_t, self.soup_index(p), h);
@@ -371,9 +375,9 @@ impl Tree<'_> {
                 continue;
             }
             let leaf = self.leaf(node);
-            if ROBUST && leaf.len() >= 2 {
+            if leaf.len() >= 2 {
                 for group in leaf.chunks(4) {
-                    let (_, hits) = self.test4::<KZ>(s, ray, group, ray.tmax);
+                    let (_, hits) = self.test4::<ROBUST, KZ>(s, ray, group, ray.tmax);
                     if hits.iter().any(Option::is_some) {
                         return true;
                     }

@@ -272,6 +272,56 @@ pub fn intersect_moller(
     }
 }
 
+/// [`intersect_moller`] on four triangles, lane by lane (the plain path's counterpart
+/// of [`intersect4_along`], so the robustness benchmark compares like with like).
+#[inline(always)]
+pub fn intersect4_moller(
+    origin: Vec3,
+    dir: Vec3,
+    tri: [&[[f32; 3]; 3]; 4],
+    tmin: f32,
+    tmax: f32,
+) -> [Option<RawHit>; 4] {
+    let lanes = |f: &dyn Fn(&[[f32; 3]; 3]) -> f32| -> [f32; 4] {
+        [f(tri[0]), f(tri[1]), f(tri[2]), f(tri[3])]
+    };
+    let (o, d) = (origin.to_array(), dir.to_array());
+    let e1: [[f32; 4]; 3] = std::array::from_fn(|k| lanes(&|t| t[1][k] - t[0][k]));
+    let e2: [[f32; 4]; 3] = std::array::from_fn(|k| lanes(&|t| t[2][k] - t[0][k]));
+    let s: [[f32; 4]; 3] = std::array::from_fn(|k| lanes(&|t| o[k] - t[0][k]));
+    let mut out = [None; 4];
+    let mut candidate = [false; 4];
+    let (mut u, mut inv) = ([0f32; 4], [0f32; 4]);
+    for l in 0..4 {
+        // p = d × e2, det = e1 · p, u = s · p / det
+        let p = [
+            d[1] * e2[2][l] - d[2] * e2[1][l],
+            d[2] * e2[0][l] - d[0] * e2[2][l],
+            d[0] * e2[1][l] - d[1] * e2[0][l],
+        ];
+        let det = e1[0][l] * p[0] + e1[1][l] * p[1] + e1[2][l] * p[2];
+        inv[l] = 1.0 / det;
+        u[l] = (s[0][l] * p[0] + s[1][l] * p[1] + s[2][l] * p[2]) * inv[l];
+        candidate[l] = det.abs() >= 1e-8 && (0.0..=1.0).contains(&u[l]);
+    }
+    for l in 0..4 {
+        if !candidate[l] {
+            continue;
+        }
+        let q = Vec3::from([s[0][l], s[1][l], s[2][l]])
+            .cross(Vec3::from([e1[0][l], e1[1][l], e1[2][l]]));
+        let v = dir.dot(q) * inv[l];
+        if v < 0.0 || u[l] + v > 1.0 {
+            continue;
+        }
+        let t = Vec3::from([e2[0][l], e2[1][l], e2[2][l]]).dot(q) * inv[l];
+        if t >= tmin && t <= tmax {
+            out[l] = Some(RawHit { t, u: u[l], v });
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
