@@ -22,21 +22,22 @@ struct Cli {
     /// Print one JSON object on stdout instead of a summary on stderr.
     #[arg(long)]
     json: bool,
-    /// SAH cost of one traversal step.
-    #[arg(long)]
-    traversal_cost: Option<f32>,
+    /// SAH cost of one traversal step (relative to --intersect-cost; see docs/PERFORMANCE.md
+    /// for the sweep behind the default).
+    #[arg(long, default_value_t = BuildParams::default().traversal_cost)]
+    traversal_cost: f32,
     /// SAH cost of one ray/triangle test.
-    #[arg(long)]
-    intersect_cost: Option<f32>,
+    #[arg(long, default_value_t = BuildParams::default().intersect_cost)]
+    intersect_cost: f32,
     /// Fraction of the cost forgiven for splits that cut off empty space (0–1).
-    #[arg(long)]
-    empty_bonus: Option<f32>,
+    #[arg(long, default_value_t = BuildParams::default().empty_bonus)]
+    empty_bonus: f32,
     /// Depth bound (0: 8 + 1.3·log2 N; at most 60).
-    #[arg(long)]
-    max_depth: Option<u32>,
+    #[arg(long, default_value_t = BuildParams::default().max_depth)]
+    max_depth: u32,
     /// Make a leaf at or below this many triangles.
-    #[arg(long)]
-    leaf_size: Option<u32>,
+    #[arg(long, default_value_t = BuildParams::default().leaf_size)]
+    leaf_size: u32,
     /// Worker threads (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
@@ -52,22 +53,13 @@ fn usage_error(msg: &str) -> ! {
 }
 
 fn params(cli: &Cli) -> Result<BuildParams> {
-    let mut p = BuildParams::default();
-    if let Some(v) = cli.traversal_cost {
-        p.traversal_cost = v;
-    }
-    if let Some(v) = cli.intersect_cost {
-        p.intersect_cost = v;
-    }
-    if let Some(v) = cli.empty_bonus {
-        p.empty_bonus = v;
-    }
-    if let Some(v) = cli.max_depth {
-        p.max_depth = v;
-    }
-    if let Some(v) = cli.leaf_size {
-        p.leaf_size = v;
-    }
+    let p = BuildParams {
+        traversal_cost: cli.traversal_cost,
+        intersect_cost: cli.intersect_cost,
+        empty_bonus: cli.empty_bonus,
+        max_depth: cli.max_depth,
+        leaf_size: cli.leaf_size,
+    };
     if !(p.traversal_cost >= 0.0 && p.traversal_cost.is_finite()) {
         bail!("--traversal-cost must be a finite number ≥ 0");
     }
