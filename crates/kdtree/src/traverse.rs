@@ -304,7 +304,8 @@ impl Tree<'_> {
             let leaf = self.leaf(node);
             if leaf.len() >= 2 {
                 for group in leaf.chunks(4) {
-                    let (lanes, hits) = self.test4::<ROBUST, KZ>(s, ray, group, best_t);
+                    let bound = triangle::widen(best_t);
+                    let (lanes, hits) = self.test4::<ROBUST, KZ>(s, ray, group, bound);
                     for (p, h) in lanes.into_iter().zip(hits) {
                         if let Some(h) = h {
                             keep_closer(&mut best, &mut best_t, self.soup_index(p), h);
@@ -313,7 +314,9 @@ impl Tree<'_> {
                 }
             } else {
                 for &p in leaf {
-                    if let Some(h) = test::<ROBUST, KZ>(s, ray, self.tri(p), best_t) {
+                    if let Some(h) =
+                        test::<ROBUST, KZ>(s, ray, self.tri(p), triangle::widen(best_t))
+                    {
                         keep_closer(&mut best, &mut best_t, self.soup_index(p), h);
                     }
                 }
@@ -399,8 +402,9 @@ impl Tree<'_> {
 }
 
 /// Take hit `h` on triangle `prim` if it is closer than the best so far, or as close with
-/// a lower index. `h.t <= best_t` matters for four-wide groups: their lanes were tested
-/// against the bound at the group's start, which an earlier lane may have lowered.
+/// a lower index. Candidates are tested against `widen(best_t)` (see `triangle::widen`),
+/// and four-wide groups against the bound at the group's start, so `h.t <= best_t` here is
+/// the exact test.
 #[inline(always)]
 fn keep_closer(best: &mut Hit, best_t: &mut f32, prim: u32, h: RawHit) {
     if h.t <= *best_t && (h.t < *best_t || prim < best.prim) {
@@ -424,8 +428,8 @@ pub(crate) fn brute_closest(tris: &[[Vec3; 3]], ray: &Ray) -> Option<Hit> {
     let mut best_t = ray.tmax;
     for (i, t) in tris.iter().enumerate() {
         let tri = [t[0].to_array(), t[1].to_array(), t[2].to_array()];
-        if let Some(h) = triangle::intersect(&pre, &tri, ray.tmin, best_t) {
-            if h.t < best_t || (i as u32) < best.prim {
+        if let Some(h) = triangle::intersect(&pre, &tri, ray.tmin, triangle::widen(best_t)) {
+            if h.t <= best_t && (h.t < best_t || (i as u32) < best.prim) {
                 best_t = h.t;
                 best = Hit {
                     t: h.t,
