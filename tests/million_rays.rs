@@ -5,7 +5,6 @@
 //! `cargo test --release --test million_rays -- --ignored`.
 
 use formats::rays::{self, RayRecord};
-use glam::Vec3;
 use kdtree::{brute, Ray};
 use rayon::prelude::*;
 use unitrace::run_ok;
@@ -30,33 +29,17 @@ fn raycast_a_million_random_rays_against_the_baseline_equals_brute_force() {
     );
     let soup = formats::Soup::read(&soup_path).unwrap();
     assert_eq!(soup.triangles.len(), 41_833);
-    let (lo, hi) = soup.triangles.iter().flatten().fold(
-        (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
-        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-    );
-    // Origins uniform in the bounds, directions uniform on the sphere (SplitMix64).
-    let mut state = 0x5eed_u64;
-    let mut unit = move || {
-        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
-    };
-    let input: Vec<RayRecord> = (0..1_000_000)
-        .map(|_| {
-            let origin = lo + (hi - lo) * Vec3::new(unit(), unit(), unit());
-            let z = 2.0 * unit() - 1.0;
-            let phi = std::f32::consts::TAU * unit();
-            let r = (1.0 - z * z).max(0.0).sqrt();
-            RayRecord {
-                origin,
-                tmin: 0.0,
-                dir: Vec3::new(r * phi.cos(), r * phi.sin(), z),
-                tmax: f32::INFINITY,
-            }
-        })
-        .collect();
+    // Origins uniform in the bounds, directions uniform on the sphere (kdbench's random set).
+    let input: Vec<RayRecord> =
+        bench::rays::random(bench::scenes::bounds(&soup.triangles), 1_000_000, 0x5eed)
+            .into_iter()
+            .map(|r| RayRecord {
+                origin: r.origin,
+                tmin: r.tmin,
+                dir: r.dir,
+                tmax: r.tmax,
+            })
+            .collect();
     let rays_path = dir.path().join("random.rays");
     let hits_path = dir.path().join("random.hits");
     rays::write_rays(&rays_path, &input).unwrap();

@@ -87,7 +87,6 @@ pub fn intersect(r: &RayPre, tri: &[[f32; 3]; 3], tmin: f32, tmax: f32) -> Optio
 /// [`intersect`] for a ray whose dominant axis is `KZ` (`r.kz == KZ`). The permutation is
 /// a constant here, so the vertices are read straight from memory; the traversal is
 /// instantiated once per dominant axis to call this.
-///
 #[inline(always)]
 pub fn intersect_along<const KZ: usize>(
     r: &RayPre,
@@ -125,14 +124,20 @@ pub fn intersect_along<const KZ: usize>(
     if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
         return None;
     }
+    finish([u, v, w], [a[2], b[2], c[2]], r.sz, tmin, tmax)
+}
+
+/// The part of the test after the edge functions `uvw` agree in sign: the determinant,
+/// the distance from the vertices' `z` (relative to the origin, before the z shear) and
+/// the interval. Shared by the one- and four-triangle tests so they give the same bits.
+#[inline(always)]
+fn finish(uvw: [f32; 3], z: [f32; 3], sz: f32, tmin: f32, tmax: f32) -> Option<RawHit> {
+    let [u, v, w] = uvw;
     let det = u + v + w;
     if det == 0.0 || det.is_nan() {
         return None;
     }
-    let az = r.sz * a[2];
-    let bz = r.sz * b[2];
-    let cz = r.sz * c[2];
-    let tt = u * az + v * bz + w * cz;
+    let tt = u * (sz * z[0]) + v * (sz * z[1]) + w * (sz * z[2]);
     // Two-sided: compare against |det|-scaled bounds instead of dividing.
     let (tt, adet) = if det < 0.0 { (-tt, -det) } else { (tt, det) };
     if !(tt >= tmin * adet && tt <= tmax * adet) {
@@ -201,35 +206,15 @@ pub fn intersect4_along<const KZ: usize>(
     if zero {
         return std::array::from_fn(|l| intersect_along::<KZ>(r, tri[l], tmin, tmax));
     }
-    let mut out = [None; 4];
     if outside == [true; 4] {
-        return out;
+        return [None; 4];
     }
-    for l in 0..4 {
+    std::array::from_fn(|l| {
         if outside[l] {
-            continue;
+            return None;
         }
-        let det = u[l] + v[l] + w[l];
-        if det == 0.0 || det.is_nan() {
-            continue;
-        }
-        let tt = u[l] * (r.sz * az[l]) + v[l] * (r.sz * bz[l]) + w[l] * (r.sz * cz[l]);
-        let (tt, adet) = if det < 0.0 { (-tt, -det) } else { (tt, det) };
-        if !(tt >= tmin * adet && tt <= tmax * adet) {
-            continue;
-        }
-        let inv = 1.0 / det;
-        let t = tt / adet;
-        if !(t >= tmin && t <= tmax) {
-            continue;
-        }
-        out[l] = Some(RawHit {
-            t,
-            u: v[l] * inv,
-            v: w[l] * inv,
-        });
-    }
-    out
+        finish([u[l], v[l], w[l]], [az[l], bz[l], cz[l]], r.sz, tmin, tmax)
+    })
 }
 
 /// Plain Möller–Trumbore (1997), kept only to measure what watertightness costs: it leaks

@@ -34,7 +34,7 @@ fn looks() -> Vec<MatDesc> {
 }
 
 pub fn project() -> Project {
-    build(NAME, 1)
+    build(None)
 }
 
 /// The scale test: the baseline's props (everything but the floor) repeated on a
@@ -42,7 +42,7 @@ pub fn project() -> Project {
 /// one floor, lit by a sun with hard shadows, seen from above at an angle. Not bundled:
 /// `scenegen --large SIDE DIR` writes it.
 pub fn large(side: usize) -> Project {
-    build(LARGE, side.max(1))
+    build(Some(side.max(1)))
 }
 
 pub const LARGE: &str = "large";
@@ -50,8 +50,9 @@ pub const LARGE_SCENE_PATH: &str = "Assets/Scenes/Large.unity";
 /// Grid spacing of the large scene's copies.
 const SPACING: f32 = 16.0;
 
-fn build(name: &str, side: usize) -> Project {
-    let mut p = Project::new(name);
+/// The baseline, or with `Some(side)` the large scene built from it.
+fn build(large: Option<usize>) -> Project {
+    let mut p = Project::new(if large.is_some() { LARGE } else { NAME });
     let mut mat_guid = std::collections::BTreeMap::new();
     for m in looks() {
         let path = format!("Assets/Materials/{}.mat", m.name);
@@ -168,11 +169,12 @@ fn build(name: &str, side: usize) -> Project {
             Xform::at(6.5, 0.0, 7.5).euler(3.0, 40.0, -4.0).uniform(1.4),
         ),
     ];
-    let (path, key) = if side == 1 {
-        (SCENE_PATH, "baseline/Baseline")
-    } else {
-        objects = grid(objects, side);
-        (LARGE_SCENE_PATH, "large/Large")
+    let (path, key) = match large {
+        None => (SCENE_PATH, "baseline/Baseline"),
+        Some(side) => {
+            objects = grid(objects, side);
+            (LARGE_SCENE_PATH, "large/Large")
+        }
     };
     let scene = SceneDesc {
         ambient: Ambient::Flat([0.0, 0.0, 0.0]),

@@ -6,6 +6,7 @@
 //! frame assembly; loading and writing excluded), as `kd2exr --json` reports it.
 
 use anyhow::{ensure, Context, Result};
+use bench::measure::median;
 use clap::Parser;
 use formats::BuildParams;
 use kdtree::Accel;
@@ -34,16 +35,6 @@ fn main() {
     if let Err(e) = run() {
         eprintln!("threads: {e:#}");
         std::process::exit(1);
-    }
-}
-
-fn median(v: &mut [f64]) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
     }
 }
 
@@ -80,10 +71,10 @@ fn run() -> Result<()> {
         a.width,
         a.height,
         a.pairs,
-        median(&mut one),
+        median(one),
         a.threads,
-        median(&mut many),
-        median(&mut ratio),
+        median(many),
+        median(ratio),
         lo,
         hi
     );
