@@ -1,9 +1,10 @@
 //! Build-parameter experiments:
 //! `cargo run --release -p bench --example kdtune -- KT KI BONUS MAX_DEPTH LEAF_SIZE FILE…`
 //! builds each soup or OBJ (or `gen:N`, kdbench's generated scene of N triangles) with
-//! those parameters and prints build time, primary and shadow Mrays/s (best of 15, 1
-//! thread) and the tree's statistics. Only ratios within one run mean anything on a noisy
-//! machine.
+//! those parameters and prints build time (best of up to 9 builds, all threads), primary
+//! and shadow Mrays/s (best of 15, 1 thread), the tree's statistics and a digest of its
+//! nodes (equal digests, identical trees). Only ratios within one run mean anything on a
+//! noisy machine.
 
 use anyhow::{bail, Context, Result};
 use bench::{rays, scenes};
@@ -19,10 +20,12 @@ fn main() {
     }
 }
 
+/// Fastest of `runs` timed calls (at least one), and the last call's result.
 fn best_of<T>(runs: usize, mut f: impl FnMut() -> T) -> (f64, T) {
-    let mut best = f64::MAX;
+    let t = Instant::now();
     let mut out = f();
-    for _ in 0..runs {
+    let mut best = t.elapsed().as_secs_f64();
+    for _ in 1..runs {
         let t = Instant::now();
         out = f();
         best = best.min(t.elapsed().as_secs_f64());
@@ -60,9 +63,9 @@ fn run() -> Result<()> {
             scenes::load_obj(path)?
         };
         let tris = &s.triangles;
-        let t = Instant::now();
-        let kd = kdtree::build(tris, &p, formats::soup::geometry_hash(tris));
-        let build = t.elapsed().as_secs_f64();
+        let hash = formats::soup::geometry_hash(tris);
+        let builds = (3_000_000 / tris.len().max(1)).clamp(1, 9);
+        let (build, kd) = best_of(builds, || kdtree::build(tris, &p, hash));
         let a = Accel::from_triangles(tris, &kd)?;
         let b = scenes::bounds(tris);
         let prim = rays::primary(&s.view.unwrap_or(rays::framing(b)), 512);
@@ -74,10 +77,19 @@ fn run() -> Result<()> {
         let sh = rays::shadow(tris, &hits, rays::light_above(b), b);
         let (ts, occluded) = best_of(15, || sh.iter().filter(|r| a.occluded(r)).count());
         let st = &kd.stats;
+        // FNV-1a over the nodes and leaf lists: equal digests mean an identical tree.
+        let digest = kd
+            .nodes
+            .iter()
+            .flat_map(|n| [n.flags, n.data])
+            .chain(kd.leaf_tris.iter().copied())
+            .fold(0xcbf2_9ce4_8422_2325u64, |h, w| {
+                (h ^ w as u64).wrapping_mul(0x100_0000_01b3)
+            });
         println!(
             "{}: {} triangles, build {:.1} ms, primary {:.3} Mrays/s, shadow {:.3} Mrays/s \
              ({occluded} occluded), nodes {}, leaves {}, max leaf {}, depth {}, refs/tri {:.2}, \
-             SAH {:.1}, bytes/tri {:.1}",
+             SAH {:.1}, bytes/tri {:.1}, tree {digest:016x}",
             s.name,
             tris.len(),
             build * 1e3,

@@ -47,6 +47,14 @@ pub fn clipped_bounds(tri: &[Vec3; 3], cell: &Aabb) -> Option<Aabb> {
                     p[axis] <= plane
                 }
             };
+            // Most planes cut nothing: skip them (the polygon is unchanged, same bits).
+            let n_inside = poly[..n].iter().filter(|p| inside(p)).count();
+            if n_inside == n {
+                continue;
+            }
+            if n_inside == 0 {
+                return None;
+            }
             let mut m = 0;
             for i in 0..n {
                 let a = poly[i];
@@ -69,9 +77,6 @@ pub fn clipped_bounds(tri: &[Vec3; 3], cell: &Aabb) -> Option<Aabb> {
                 }
             }
             n = m;
-            if n == 0 {
-                return None;
-            }
             poly[..n].copy_from_slice(&next[..n]);
         }
     }

@@ -9,36 +9,64 @@ pub const END: u32 = 0;
 pub const PLANAR: u32 = 1;
 pub const START: u32 = 2;
 
-/// 8 bytes: a position and (local triangle index << 2 | kind).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Event {
-    pub pos: f32,
-    pub code: u32,
+/// Local triangle indices take the low 30 bits of an event.
+pub const MAX_TRIANGLES: usize = 1 << 30;
+
+/// 8 bytes, ordered as a plain integer: the position's bits mapped to an unsigned order
+/// (high 32 bits), the kind (2 bits: end < planar < start at equal positions), and the
+/// local triangle index (low 30 bits). Sorting, merging and grouping by position are
+/// then integer operations.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub struct Event(u64);
+
+/// f32 bits to an unsigned key with the same order (for non-NaN values).
+#[inline]
+pub fn ordered(pos: f32) -> u32 {
+    let b = pos.to_bits();
+    if b >> 31 == 1 {
+        !b
+    } else {
+        b | 0x8000_0000
+    }
+}
+
+#[inline]
+fn unordered(key: u32) -> f32 {
+    f32::from_bits(if key >> 31 == 1 {
+        key & 0x7fff_ffff
+    } else {
+        !key
+    })
 }
 
 impl Event {
     #[inline]
     pub fn new(pos: f32, tri: u32, kind: u32) -> Event {
+        debug_assert!((tri as usize) < MAX_TRIANGLES && kind <= START);
         // +0.0 turns −0.0 into +0.0, so equal positions sort and group together.
-        Event {
-            pos: pos + 0.0,
-            code: (tri << 2) | kind,
-        }
+        Event(((ordered(pos + 0.0) as u64) << 32) | ((kind as u64) << 30) | tri as u64)
+    }
+    /// The position's order key ([`ordered`]); equal keys are equal positions.
+    #[inline]
+    pub fn pos_key(self) -> u32 {
+        (self.0 >> 32) as u32
+    }
+    #[inline]
+    pub fn pos(self) -> f32 {
+        unordered(self.pos_key())
     }
     #[inline]
     pub fn tri(self) -> u32 {
-        self.code >> 2
+        self.0 as u32 & (MAX_TRIANGLES as u32 - 1)
     }
     #[inline]
     pub fn kind(self) -> u32 {
-        self.code & 3
+        (self.0 >> 30) as u32 & 3
     }
-    /// Sort key: position, then end < planar < start at equal positions.
+    /// The same event for another local triangle index.
     #[inline]
-    pub fn key(self) -> u64 {
-        let b = self.pos.to_bits();
-        let ordered = if b >> 31 == 1 { !b } else { b | 0x8000_0000 };
-        ((ordered as u64) << 32) | self.kind() as u64
+    pub fn with_tri(self, tri: u32) -> Event {
+        Event(self.0 & !(MAX_TRIANGLES as u64 - 1) | tri as u64)
     }
 }
 
@@ -55,34 +83,28 @@ pub fn push_events(out: &mut Vec<Event>, b: &Aabb, axis: usize, tri: u32) {
 
 pub fn sort(events: &mut [Event], parallel: bool) {
     if parallel {
-        events.par_sort_unstable_by_key(|e| e.key());
+        events.par_sort_unstable();
     } else {
-        events.sort_unstable_by_key(|e| e.key());
+        events.sort_unstable();
     }
 }
 
-/// Merge two sorted lists into one sorted list.
-pub fn merge(a: Vec<Event>, b: Vec<Event>) -> Vec<Event> {
-    if b.is_empty() {
-        return a;
-    }
-    if a.is_empty() {
-        return b;
-    }
-    let mut out = Vec::with_capacity(a.len() + b.len());
-    let (mut i, mut j) = (0, 0);
-    while i < a.len() && j < b.len() {
-        if a[i].key() <= b[j].key() {
-            out.push(a[i]);
-            i += 1;
+/// Merge the sorted `fresh` into the sorted `v`, in place: `v` grows by `fresh.len()`
+/// and is filled from the back, so no third list is allocated.
+pub fn merge_into(v: &mut Vec<Event>, fresh: &[Event]) {
+    let (mut i, mut j) = (v.len(), fresh.len());
+    v.extend_from_slice(fresh);
+    let mut k = v.len();
+    while j > 0 {
+        k -= 1;
+        if i > 0 && v[i - 1] > fresh[j - 1] {
+            v[k] = v[i - 1];
+            i -= 1;
         } else {
-            out.push(b[j]);
-            j += 1;
+            v[k] = fresh[j - 1];
+            j -= 1;
         }
     }
-    out.extend_from_slice(&a[i..]);
-    out.extend_from_slice(&b[j..]);
-    out
 }
 
 #[cfg(test)]
@@ -102,7 +124,28 @@ mod tests {
         sort(&mut v, false);
         let tris: Vec<u32> = v.iter().map(|e| e.tri()).collect();
         assert_eq!(tris, vec![5, 4, 3, 2, 1, 0]);
-        let merged = merge(vec![v[0], v[2], v[4]], vec![v[1], v[3], v[5]]);
+        let mut merged = vec![v[0], v[2], v[4]];
+        merge_into(&mut merged, &[v[1], v[3], v[5]]);
         assert_eq!(merged, v);
+        let mut all_fresh = vec![];
+        merge_into(&mut all_fresh, &v);
+        assert_eq!(all_fresh, v);
+        let mut none_fresh = v.clone();
+        merge_into(&mut none_fresh, &[]);
+        assert_eq!(none_fresh, v);
+    }
+
+    #[test]
+    fn fields_survive_the_packing() {
+        for pos in [-3.5f32, -0.0, 0.0, 1e-30, 7.25, f32::MAX, f32::NEG_INFINITY] {
+            let e = Event::new(pos, MAX_TRIANGLES as u32 - 1, PLANAR);
+            assert_eq!(e.pos(), pos + 0.0);
+            assert_eq!(e.tri(), MAX_TRIANGLES as u32 - 1);
+            assert_eq!(e.kind(), PLANAR);
+            let f = e.with_tri(5);
+            assert_eq!((f.pos(), f.tri(), f.kind()), (pos + 0.0, 5, PLANAR));
+        }
+        assert!(Event::new(-1.0, 9, START) < Event::new(-0.5, 0, END));
+        assert!(ordered(-1.0) < ordered(0.0) && ordered(0.0) < ordered(1e-45));
     }
 }

@@ -238,27 +238,22 @@ fn sweep_axis(
     let cap = e[o1] * e[o2];
     let ring = e[o1] + e[o2];
     let inv_area = 1.0 / area;
+    let (lo_key, hi_key) = (events::ordered(lo + 0.0), events::ordered(hi + 0.0));
     let (mut nl, mut nr) = (0usize, n);
     let mut best: Option<Split> = None;
     let mut i = 0;
     while i < ev.len() {
-        let p = ev[i].pos;
-        let (mut pe, mut pp, mut ps) = (0, 0, 0);
-        while i < ev.len() && ev[i].pos == p && ev[i].kind() == END {
-            pe += 1;
+        // One position at a time: count its end, planar and start events.
+        let key = ev[i].pos_key();
+        let mut count = [0usize; 3];
+        while i < ev.len() && ev[i].pos_key() == key {
+            count[ev[i].kind() as usize] += 1;
             i += 1;
         }
-        while i < ev.len() && ev[i].pos == p && ev[i].kind() == PLANAR {
-            pp += 1;
-            i += 1;
-        }
-        while i < ev.len() && ev[i].pos == p && ev[i].kind() == START {
-            ps += 1;
-            i += 1;
-        }
-        let np = pp;
+        let [pe, pp, ps] = count;
         nr -= pp + pe;
-        if p > lo && p < hi {
+        if key > lo_key && key < hi_key {
+            let p = ev[i - 1].pos();
             let dl = p as f64 - lo as f64;
             let dr = hi as f64 - p as f64;
             let pl = 2.0 * (cap + dl * ring) * inv_area;
@@ -271,8 +266,8 @@ fn sweep_axis(
                 };
                 ctx.kt + ctx.ki * lambda * (pl * l as f64 + pr * r as f64)
             };
-            let c_below = cost(nl + np, nr);
-            let c_above = cost(nl, nr + np);
+            let c_below = cost(nl + pp, nr);
+            let c_above = cost(nl, nr + pp);
             let (c, planar_below) = if c_below <= c_above {
                 (c_below, true)
             } else {
@@ -292,22 +287,26 @@ fn sweep_axis(
     best
 }
 
-const BELOW: u8 = 1;
-const ABOVE: u8 = 2;
-const BOTH: u8 = 3;
+// A triangle's place in a split: its side in the low 2 bits and, for triangles that stay
+// on one side, its local index in that child above them.
+const BELOW: u32 = 1;
+const ABOVE: u32 = 2;
+const BOTH: u32 = 3;
 
 /// Classify the triangles against the split and build both children's work, keeping each
 /// axis's events sorted.
 fn split_work(ctx: &Ctx, w: Work, s: &Split, parallel: bool) -> (Work, Work) {
     let n = w.tris.len();
-    let mut side = vec![BOTH; n];
+    let mut place = vec![BOTH; n];
+    let split_key = events::ordered(s.pos + 0.0);
     for e in &w.events[s.axis] {
         let t = e.tri() as usize;
+        let key = e.pos_key();
         match e.kind() {
-            END if e.pos <= s.pos => side[t] = BELOW,
-            START if e.pos >= s.pos => side[t] = ABOVE,
+            END if key <= split_key => place[t] = BELOW,
+            START if key >= split_key => place[t] = ABOVE,
             PLANAR => {
-                side[t] = if e.pos < s.pos || (e.pos == s.pos && s.planar_below) {
+                place[t] = if key < split_key || (key == split_key && s.planar_below) {
                     BELOW
                 } else {
                     ABOVE
@@ -317,9 +316,27 @@ fn split_work(ctx: &Ctx, w: Work, s: &Split, parallel: bool) -> (Work, Work) {
         }
     }
     let (cell_b, cell_a) = w.cell.split(s.axis, s.pos);
+    // Local indices in each child: kept triangles first in parent order, then straddlers.
+    let kept_b = place.iter().filter(|&&p| p == BELOW).count();
+    let straddlers: Vec<usize> = (0..n).filter(|&i| place[i] == BOTH).collect();
+    let kept_a = n - kept_b - straddlers.len();
+    let mut tris_b = Vec::with_capacity(kept_b + straddlers.len());
+    let mut tris_a = Vec::with_capacity(kept_a + straddlers.len());
+    for (p, &t) in place.iter_mut().zip(&w.tris) {
+        match *p {
+            BELOW => {
+                *p |= (tris_b.len() as u32) << 2;
+                tris_b.push(t);
+            }
+            ABOVE => {
+                *p |= (tris_a.len() as u32) << 2;
+                tris_a.push(t);
+            }
+            _ => {}
+        }
+    }
     // Straddling triangles: clip to each child (perfect splits). A triangle whose box
     // straddles the plane may still miss one child entirely; it then leaves that child.
-    let straddlers: Vec<usize> = (0..n).filter(|&i| side[i] == BOTH).collect();
     let clip = |&i: &usize| {
         let tri = &ctx.tris[w.tris[i] as usize];
         (
@@ -332,26 +349,8 @@ fn split_work(ctx: &Ctx, w: Work, s: &Split, parallel: bool) -> (Work, Work) {
     } else {
         straddlers.iter().map(clip).collect()
     };
-    // Local indices in each child: kept triangles first in parent order, then straddlers.
-    let mut map_b = vec![u32::MAX; n];
-    let mut map_a = vec![u32::MAX; n];
-    let mut tris_b = Vec::new();
-    let mut tris_a = Vec::new();
-    for i in 0..n {
-        match side[i] {
-            BELOW => {
-                map_b[i] = tris_b.len() as u32;
-                tris_b.push(w.tris[i]);
-            }
-            ABOVE => {
-                map_a[i] = tris_a.len() as u32;
-                tris_a.push(w.tris[i]);
-            }
-            _ => {}
-        }
-    }
-    let mut new_b = Vec::new(); // (local index in child, clipped box)
-    let mut new_a = Vec::new();
+    let mut new_b = Vec::with_capacity(straddlers.len()); // (local index in child, clipped box)
+    let mut new_a = Vec::with_capacity(straddlers.len());
     for (&i, (cb, ca)) in straddlers.iter().zip(&clipped) {
         if let Some(b) = cb {
             new_b.push((tris_b.len() as u32, *b));
@@ -363,34 +362,26 @@ fn split_work(ctx: &Ctx, w: Work, s: &Split, parallel: bool) -> (Work, Work) {
         }
     }
     let child_events = |axis: usize, ev: &Vec<Event>| -> (Vec<Event>, Vec<Event>) {
-        let mut eb = Vec::with_capacity(ev.len() / 2 + 2 * new_b.len());
-        let mut ea = Vec::with_capacity(ev.len() / 2 + 2 * new_a.len());
-        for e in ev {
-            let t = e.tri() as usize;
-            match side[t] {
-                BELOW => eb.push(Event {
-                    pos: e.pos,
-                    code: (map_b[t] << 2) | e.kind(),
-                }),
-                ABOVE => ea.push(Event {
-                    pos: e.pos,
-                    code: (map_a[t] << 2) | e.kind(),
-                }),
+        let mut eb = Vec::with_capacity(2 * tris_b.len());
+        let mut ea = Vec::with_capacity(2 * tris_a.len());
+        for &e in ev {
+            let p = place[e.tri() as usize];
+            match p & 3 {
+                BELOW => eb.push(e.with_tri(p >> 2)),
+                ABOVE => ea.push(e.with_tri(p >> 2)),
                 _ => {}
             }
         }
-        let fresh = |list: &[(u32, Aabb)]| {
-            let mut v = Vec::with_capacity(2 * list.len());
+        let mut fresh = Vec::with_capacity(2 * new_b.len().max(new_a.len()));
+        for (list, out) in [(&new_b, &mut eb), (&new_a, &mut ea)] {
+            fresh.clear();
             for (t, b) in list {
-                events::push_events(&mut v, b, axis, *t);
+                events::push_events(&mut fresh, b, axis, *t);
             }
-            events::sort(&mut v, false);
-            v
-        };
-        (
-            events::merge(eb, fresh(&new_b)),
-            events::merge(ea, fresh(&new_a)),
-        )
+            events::sort(&mut fresh, false);
+            events::merge_into(out, &fresh);
+        }
+        (eb, ea)
     };
     let Work { events: ev, .. } = w;
     let [ex, ey, ez] = ev;
