@@ -16,7 +16,7 @@ pub const MAX_TRIANGLES: usize = 1 << 30;
 /// (high 32 bits), the kind (2 bits: end < planar < start at equal positions), and the
 /// local triangle index (low 30 bits). Sorting, merging and grouping by position are
 /// then integer operations.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord)]
 pub struct Event(u64);
 
 /// f32 bits to an unsigned key with the same order (for non-NaN values).

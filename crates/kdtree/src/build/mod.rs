@@ -17,7 +17,7 @@ pub mod median;
 pub mod stats;
 
 use crate::aabb::Aabb;
-use events::{Event, END, PLANAR, START};
+use events::{Event, END, START};
 use formats::{BuildParams, KdFile, KdNode};
 use glam::Vec3;
 use rayon::prelude::*;
@@ -235,56 +235,60 @@ fn sweep_axis(
     }
     let e: [f64; 3] = std::array::from_fn(|a| cell.hi[a] as f64 - cell.lo[a] as f64);
     let (o1, o2) = ((axis + 1) % 3, (axis + 2) % 3);
+    // A child's area is 2·(cap + d·ring) for its extent d along the axis. The sweep ranks
+    // splits by (cap + dl·ring)·nl + (cap + dr·ring)·nr (times the empty-space factor) and
+    // only the winner is scaled into the SAH cost; counts are kept as f64 (exact below
+    // 2^53) so the loop has no integer conversions.
     let cap = e[o1] * e[o2];
     let ring = e[o1] + e[o2];
-    let inv_area = 1.0 / area;
+    let keep = 1.0 - ctx.bonus;
     let (lo_key, hi_key) = (events::ordered(lo + 0.0), events::ordered(hi + 0.0));
-    let (mut nl, mut nr) = (0usize, n);
-    let mut best: Option<Split> = None;
+    let (mut nl, mut nr) = (0.0f64, n as f64);
+    let mut best = f64::INFINITY;
+    let mut best_at: Option<(f32, bool)> = None;
     let mut i = 0;
     while i < ev.len() {
         // One position at a time: count its end, planar and start events.
         let key = ev[i].pos_key();
-        let mut count = [0usize; 3];
+        let mut count = [0u32; 3];
         while i < ev.len() && ev[i].pos_key() == key {
             count[ev[i].kind() as usize] += 1;
             i += 1;
         }
-        let [pe, pp, ps] = count;
+        let [pe, pp, ps] = count.map(f64::from);
         nr -= pp + pe;
         if key > lo_key && key < hi_key {
             let p = ev[i - 1].pos();
-            let dl = p as f64 - lo as f64;
-            let dr = hi as f64 - p as f64;
-            let pl = 2.0 * (cap + dl * ring) * inv_area;
-            let pr = 2.0 * (cap + dr * ring) * inv_area;
-            let cost = |l: usize, r: usize| {
-                let lambda = if l == 0 || r == 0 {
-                    1.0 - ctx.bonus
+            let wl = cap + (p as f64 - lo as f64) * ring;
+            let wr = cap + (hi as f64 - p as f64) * ring;
+            let weigh = |l: f64, r: f64| {
+                let c = wl * l + wr * r;
+                if l == 0.0 || r == 0.0 {
+                    keep * c
                 } else {
-                    1.0
-                };
-                ctx.kt + ctx.ki * lambda * (pl * l as f64 + pr * r as f64)
+                    c
+                }
             };
-            let c_below = cost(nl + pp, nr);
-            let c_above = cost(nl, nr + pp);
+            let c_below = weigh(nl + pp, nr);
+            let c_above = weigh(nl, nr + pp);
             let (c, planar_below) = if c_below <= c_above {
                 (c_below, true)
             } else {
                 (c_above, false)
             };
-            if best.is_none_or(|b| c < b.cost) {
-                best = Some(Split {
-                    cost: c,
-                    axis,
-                    pos: p,
-                    planar_below,
-                });
+            if c < best {
+                best = c;
+                best_at = Some((p, planar_below));
             }
         }
         nl += ps + pp;
     }
-    best
+    best_at.map(|(pos, planar_below)| Split {
+        cost: ctx.kt + ctx.ki * 2.0 * best / area,
+        axis,
+        pos,
+        planar_below,
+    })
 }
 
 // A triangle's place in a split: its side in the low 2 bits and, for triangles that stay
@@ -298,43 +302,56 @@ const BOTH: u32 = 3;
 fn split_work(ctx: &Ctx, w: Work, s: &Split, parallel: bool) -> (Work, Work) {
     let n = w.tris.len();
     let mut place = vec![BOTH; n];
+    // The split axis's events are sorted, so the ones before, at and after the plane are
+    // three runs; before and after are classified without branching on the kind.
+    let ev = &w.events[s.axis];
     let split_key = events::ordered(s.pos + 0.0);
-    for e in &w.events[s.axis] {
+    let at = ev.partition_point(|e| e.pos_key() < split_key);
+    let after = at + ev[at..].partition_point(|e| e.pos_key() == split_key);
+    for e in &ev[..at] {
+        // Ends and planars before the plane are below. A start before the plane comes
+        // before its own end, so its triangle is still undecided there.
+        place[e.tri() as usize] = if e.kind() == START { BOTH } else { BELOW };
+    }
+    for e in &ev[at..after] {
         let t = e.tri() as usize;
-        let key = e.pos_key();
         match e.kind() {
-            END if key <= split_key => place[t] = BELOW,
-            START if key >= split_key => place[t] = ABOVE,
-            PLANAR => {
-                place[t] = if key < split_key || (key == split_key && s.planar_below) {
-                    BELOW
-                } else {
-                    ABOVE
-                }
-            }
-            _ => {}
+            END => place[t] = BELOW,
+            START => place[t] = ABOVE,
+            _ => place[t] = if s.planar_below { BELOW } else { ABOVE },
         }
+    }
+    for e in &ev[after..] {
+        // Starts and planars after the plane are above; an end there keeps what its start
+        // decided.
+        let t = e.tri() as usize;
+        place[t] = if e.kind() == END { place[t] } else { ABOVE };
     }
     let (cell_b, cell_a) = w.cell.split(s.axis, s.pos);
     // Local indices in each child: kept triangles first in parent order, then straddlers.
+    // Branch-free as well: each triangle is written to both lists and to the straddlers,
+    // and only the one its side names advances.
     let kept_b = place.iter().filter(|&&p| p == BELOW).count();
-    let straddlers: Vec<usize> = (0..n).filter(|&i| place[i] == BOTH).collect();
-    let kept_a = n - kept_b - straddlers.len();
-    let mut tris_b = Vec::with_capacity(kept_b + straddlers.len());
-    let mut tris_a = Vec::with_capacity(kept_a + straddlers.len());
-    for (p, &t) in place.iter_mut().zip(&w.tris) {
-        match *p {
-            BELOW => {
-                *p |= (tris_b.len() as u32) << 2;
-                tris_b.push(t);
-            }
-            ABOVE => {
-                *p |= (tris_a.len() as u32) << 2;
-                tris_a.push(t);
-            }
-            _ => {}
-        }
+    let n_both = place.iter().filter(|&&p| p == BOTH).count();
+    let kept_a = n - kept_b - n_both;
+    let mut tris_b = vec![0; kept_b + n_both + 1];
+    let mut tris_a = vec![0; kept_a + n_both + 1];
+    let mut straddlers = vec![0usize; n_both + 1];
+    let (mut nb, mut na, mut ns) = (0, 0, 0);
+    for (i, (p, &t)) in place.iter_mut().zip(&w.tris).enumerate() {
+        let side = *p;
+        tris_b[nb] = t;
+        tris_a[na] = t;
+        straddlers[ns] = i;
+        let index = if side == BELOW { nb } else { na };
+        *p = side | (index as u32) << 2;
+        nb += (side == BELOW) as usize;
+        na += (side == ABOVE) as usize;
+        ns += (side == BOTH) as usize;
     }
+    tris_b.truncate(nb);
+    tris_a.truncate(na);
+    straddlers.truncate(ns);
     // Straddling triangles: clip to each child (perfect splits). A triangle whose box
     // straddles the plane may still miss one child entirely; it then leaves that child.
     let clip = |&i: &usize| {
@@ -362,16 +379,22 @@ fn split_work(ctx: &Ctx, w: Work, s: &Split, parallel: bool) -> (Work, Work) {
         }
     }
     let child_events = |axis: usize, ev: &Vec<Event>| -> (Vec<Event>, Vec<Event>) {
-        let mut eb = Vec::with_capacity(2 * tris_b.len());
-        let mut ea = Vec::with_capacity(2 * tris_a.len());
+        // Branch-free partition: every event is written to both lists and kept where its
+        // side says (sides are random along the other axes, a branch would mispredict).
+        // Each list has room for its final length plus the one slot written past the end.
+        let mut eb = vec![Event::default(); 2 * tris_b.len() + 1];
+        let mut ea = vec![Event::default(); 2 * tris_a.len() + 1];
+        let (mut nb, mut na) = (0, 0);
         for &e in ev {
             let p = place[e.tri() as usize];
-            match p & 3 {
-                BELOW => eb.push(e.with_tri(p >> 2)),
-                ABOVE => ea.push(e.with_tri(p >> 2)),
-                _ => {}
-            }
+            let moved = e.with_tri(p >> 2);
+            eb[nb] = moved;
+            ea[na] = moved;
+            nb += (p & 3 == BELOW) as usize;
+            na += (p & 3 == ABOVE) as usize;
         }
+        eb.truncate(nb);
+        ea.truncate(na);
         let mut fresh = Vec::with_capacity(2 * new_b.len().max(new_a.len()));
         for (list, out) in [(&new_b, &mut eb), (&new_a, &mut ea)] {
             fresh.clear();
