@@ -105,13 +105,17 @@ pub fn build(
         max_depth: depth_bound(params, n),
     };
     let ids: Vec<u32> = (0..n as u32)
+        .into_par_iter()
         .filter(|&i| triangles[i as usize].iter().all(|v| v.is_finite()))
         .collect();
     let boxes: Vec<Aabb> = ids
-        .iter()
+        .par_iter()
         .map(|&i| Aabb::of_triangle(&triangles[i as usize]))
         .collect();
-    let cell = boxes.iter().fold(Aabb::EMPTY, |a, b| a.union(b));
+    let cell = boxes
+        .par_iter()
+        .copied()
+        .reduce(|| Aabb::EMPTY, |a, b| a.union(&b));
     let parallel = ids.len() >= PARALLEL_MIN;
     let events: Vec<Vec<Event>> = (0..3)
         .into_par_iter()
