@@ -8,8 +8,9 @@
 //! * Triangles lying in a candidate plane are tried on both sides; a split that cuts off
 //!   empty space gets the empty-space bonus; a node becomes a leaf when no split is
 //!   cheaper than intersecting all its triangles, at the depth bound, or at `leaf_size`.
-//! * Subtrees above [`PARALLEL_MIN`] triangles are built in parallel (`rayon::join`), and
-//!   the three axes' sweeps, classification and sorting run in parallel at those levels.
+//! * Subtrees above [`JOIN_MIN`] triangles are built in parallel (`rayon::join`), and
+//!   above [`PARALLEL_MIN`] the three axes' sweeps, classification and sorting run in
+//!   parallel too.
 
 pub mod clip;
 pub mod events;
@@ -25,8 +26,13 @@ use rayon::prelude::*;
 /// The traversal stack holds this many entries; the build never goes deeper.
 pub const MAX_DEPTH_LIMIT: u32 = 60;
 
-/// Nodes with at least this many triangles split their children into parallel tasks.
+/// Nodes with at least this many triangles work on their three axes in parallel.
 const PARALLEL_MIN: usize = 8192;
+
+/// Nodes with at least this many triangles build their two subtrees as parallel tasks:
+/// far below `PARALLEL_MIN`, so that uneven subtrees (a floor next to small props) still
+/// leave work for the other thread to steal.
+const JOIN_MIN: usize = 1024;
 
 /// The depth bound in force: `params.max_depth`, or 8 + 1.3·log2(N) when it is 0, never
 /// above [`MAX_DEPTH_LIMIT`].
@@ -188,7 +194,7 @@ fn build_rec(ctx: &Ctx, w: Work, depth: u32, out: &mut Subtree) {
     let (below, above) = split_work(ctx, w, &split, parallel);
     let at = out.nodes.len();
     out.nodes.push(KdNode::leaf(0, 0)); // placeholder, set once `above` has an index
-    if parallel {
+    if n >= JOIN_MIN {
         let (b, a) = rayon::join(
             || build_sub(ctx, below, depth + 1),
             || build_sub(ctx, above, depth + 1),
