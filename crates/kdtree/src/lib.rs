@@ -23,6 +23,7 @@ use aabb::Aabb;
 use formats::{BuildParams, KdFile, KdNode, Soup};
 use glam::Vec3;
 
+pub use build::events::MAX_TRIANGLES;
 pub use build::median::build_median;
 pub use build::{build, depth_bound};
 pub use formats::Hit;

@@ -168,6 +168,14 @@ fn run(cli: Cli) -> Result<()> {
     let params = params(&cli)?;
     let start = Instant::now();
     let soup = Soup::read(soup_path)?;
+    if soup.triangles.len() >= kdtree::MAX_TRIANGLES {
+        bail!(
+            "{}: {} triangles; a tree holds fewer than {} (30-bit indices in nodes and build events)",
+            soup_path.display(),
+            soup.triangles.len(),
+            kdtree::MAX_TRIANGLES
+        );
+    }
     let (path, cache) = match (&cli.output, &cli.cache) {
         (Some(out), _) => (out.clone(), "none"),
         (None, Some(dir)) => {

@@ -92,7 +92,8 @@ impl Subtree {
     }
 }
 
-/// Build a tree over `triangles` (soup order). Non-finite triangles are left out (the
+/// Build a tree over `triangles` (soup order), fewer than [`events::MAX_TRIANGLES`]
+/// (callers check; `soup2kd` refuses larger soups). Non-finite triangles are left out (the
 /// soup reader refuses them anyway); every other triangle, degenerate ones included, is
 /// in the tree, so the tree answers exactly what a brute-force loop would.
 pub fn build(
