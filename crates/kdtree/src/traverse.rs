@@ -198,6 +198,59 @@ fn step<const ROBUST: bool>(s: &Setup, i: u32, node: KdNode, t0: f32, t1: f32) -
     }
 }
 
+type Stack = [(u32, f32, f32); STACK];
+
+/// One interior step: moves to the next cell (`node_i`, and `t1` when the far child waits)
+/// and pushes the far child with its interval when the ray crosses the plane.
+#[inline(always)]
+fn descend<const ROBUST: bool>(
+    s: &Setup,
+    node: KdNode,
+    node_i: &mut u32,
+    t0: f32,
+    t1: &mut f32,
+    stack: &mut Stack,
+    sp: &mut usize,
+) {
+    let a = node.axis();
+    if ROBUST && !s.parallel[a] {
+        // Branch-free: which children the interval reaches is data-dependent and would
+        // mispredict. The far child is always written and the stack only grows when both
+        // are visited; the cases and their order are `step`'s.
+        let below = *node_i + 1;
+        let above = node.above_child();
+        let tp = (node.split() - s.o[a]) * s.inv[a];
+        let first = if s.inv[a] > 0.0 { below } else { above };
+        let second = below ^ above ^ first;
+        let only_first = tp > pad_up(*t1);
+        let only_second = !only_first & (tp < pad_down(t0));
+        let both = !only_first & !only_second;
+        stack[*sp] = (second, tp, *t1);
+        *sp += usize::from(both);
+        *node_i = if only_second { second } else { first };
+        *t1 = if both { tp } else { *t1 };
+        return;
+    }
+    match step::<ROBUST>(s, *node_i, node, t0, *t1) {
+        Step::One(c) => *node_i = c,
+        Step::Two {
+            first,
+            second,
+            t_split,
+        } => {
+            stack[*sp] = (second, t_split, *t1);
+            *sp += 1;
+            *node_i = first;
+            *t1 = t_split;
+        }
+        Step::Both => {
+            stack[*sp] = (node.above_child(), t0, *t1);
+            *sp += 1;
+            *node_i += 1;
+        }
+    }
+}
+
 impl Tree<'_> {
     #[inline(always)]
     fn node(&self, i: u32) -> KdNode {
@@ -275,30 +328,13 @@ impl Tree<'_> {
     ) -> Option<Hit> {
         let mut best = Hit::MISS;
         let mut best_t = ray.tmax;
-        let mut stack = [(0u32, 0f32, 0f32); STACK];
+        let mut stack: Stack = [(0, 0.0, 0.0); STACK];
         let mut sp = 0;
         let (mut node_i, mut t0, mut t1) = (0u32, s.t0, s.t1);
         loop {
             let node = self.node(node_i);
             if !node.is_leaf() {
-                match step::<ROBUST>(s, node_i, node, t0, t1) {
-                    Step::One(c) => node_i = c,
-                    Step::Two {
-                        first,
-                        second,
-                        t_split,
-                    } => {
-                        stack[sp] = (second, t_split, t1);
-                        sp += 1;
-                        node_i = first;
-                        t1 = t_split;
-                    }
-                    Step::Both => {
-                        stack[sp] = (node.above_child(), t0, t1);
-                        sp += 1;
-                        node_i += 1;
-                    }
-                }
+                descend::<ROBUST>(s, node, &mut node_i, t0, &mut t1, &mut stack, &mut sp);
                 continue;
             }
             let leaf = self.leaf(node);
@@ -351,30 +387,13 @@ impl Tree<'_> {
 
     #[inline(always)]
     fn any_along<const ROBUST: bool, const KZ: usize>(&self, ray: &Ray, s: &Setup) -> bool {
-        let mut stack = [(0u32, 0f32, 0f32); STACK];
+        let mut stack: Stack = [(0, 0.0, 0.0); STACK];
         let mut sp = 0;
         let (mut node_i, mut t0, mut t1) = (0u32, s.t0, s.t1);
         loop {
             let node = self.node(node_i);
             if !node.is_leaf() {
-                match step::<ROBUST>(s, node_i, node, t0, t1) {
-                    Step::One(c) => node_i = c,
-                    Step::Two {
-                        first,
-                        second,
-                        t_split,
-                    } => {
-                        stack[sp] = (second, t_split, t1);
-                        sp += 1;
-                        node_i = first;
-                        t1 = t_split;
-                    }
-                    Step::Both => {
-                        stack[sp] = (node.above_child(), t0, t1);
-                        sp += 1;
-                        node_i += 1;
-                    }
-                }
+                descend::<ROBUST>(s, node, &mut node_i, t0, &mut t1, &mut stack, &mut sp);
                 continue;
             }
             let leaf = self.leaf(node);
