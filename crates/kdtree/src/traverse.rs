@@ -204,6 +204,7 @@ type Stack = [(u32, f32, f32); STACK];
 /// and pushes the far child with its interval when the ray crosses the plane.
 #[inline(always)]
 fn descend<const ROBUST: bool>(
+    nodes: &[KdNode],
     s: &Setup,
     node: KdNode,
     node_i: &mut u32,
@@ -222,6 +223,14 @@ fn descend<const ROBUST: bool>(
         let tp = (node.split() - s.o[a]) * s.inv[a];
         let first = if s.inv[a] > 0.0 { below } else { above };
         let second = below ^ above ^ first;
+        #[cfg(target_arch = "x86_64")]
+        {
+            use core::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+            // SAFETY: a prefetch never faults and reads nothing; SSE is part of x86_64.
+            unsafe {
+                _mm_prefetch::<_MM_HINT_T0>(nodes.as_ptr().wrapping_add(second as usize).cast())
+            };
+        }
         let only_first = tp > pad_up(*t1);
         let only_second = !only_first & (tp < pad_down(t0));
         let both = !only_first & !only_second;
@@ -334,7 +343,7 @@ impl Tree<'_> {
         loop {
             let node = self.node(node_i);
             if !node.is_leaf() {
-                descend::<ROBUST>(s, node, &mut node_i, t0, &mut t1, &mut stack, &mut sp);
+                descend::<ROBUST>(self.nodes, s, node, &mut node_i, t0, &mut t1, &mut stack, &mut sp);
                 continue;
             }
             let leaf = self.leaf(node);
@@ -393,7 +402,7 @@ impl Tree<'_> {
         loop {
             let node = self.node(node_i);
             if !node.is_leaf() {
-                descend::<ROBUST>(s, node, &mut node_i, t0, &mut t1, &mut stack, &mut sp);
+                descend::<ROBUST>(self.nodes, s, node, &mut node_i, t0, &mut t1, &mut stack, &mut sp);
                 continue;
             }
             let leaf = self.leaf(node);
