@@ -1,8 +1,8 @@
 //! Build-parameter experiments:
 //! `cargo run --release -p bench --example kdtune -- KT KI BONUS MAX_DEPTH LEAF_SIZE FILE…`
 //! builds each soup or OBJ (or `gen:N`, kdbench's generated scene of N triangles) with
-//! those parameters and prints build time (best of up to 9 builds, all threads), primary
-//! and shadow Mrays/s (best of 15, 1 thread), the tree's statistics and a digest of its
+//! those parameters and prints build time (best of up to 9 builds, all threads), primary,
+//! shadow and random-ray Mrays/s (best of 15, 1 thread), the tree's statistics and a digest of its
 //! nodes (equal digests, identical trees). Only ratios within one run mean anything on a
 //! noisy machine.
 
@@ -76,6 +76,8 @@ fn run() -> Result<()> {
         });
         let sh = rays::shadow(tris, &hits, rays::light_above(b), b);
         let (ts, occluded) = best_of(15, || sh.iter().filter(|r| a.occluded(r)).count());
+        let random = rays::random(b, 1 << 16, 7);
+        let (tr, _) = best_of(15, || random.iter().filter_map(|r| a.intersect(r)).count());
         let st = &kd.stats;
         // FNV-1a over the nodes and leaf lists: equal digests mean an identical tree.
         let digest = kd
@@ -88,13 +90,14 @@ fn run() -> Result<()> {
             });
         println!(
             "{}: {} triangles, build {:.1} ms, primary {:.3} Mrays/s, shadow {:.3} Mrays/s \
-             ({occluded} occluded), nodes {}, leaves {}, max leaf {}, depth {}, refs/tri {:.2}, \
+             ({occluded} occluded), random {:.3} Mrays/s, nodes {}, leaves {}, max leaf {}, depth {}, refs/tri {:.2}, \
              SAH {:.1}, bytes/tri {:.1}, tree {digest:016x}",
             s.name,
             tris.len(),
             build * 1e3,
             prim.len() as f64 / tp / 1e6,
             sh.len() as f64 / ts / 1e6,
+            random.len() as f64 / tr / 1e6,
             st.nodes,
             st.leaves,
             st.max_leaf_triangles,

@@ -248,8 +248,8 @@ fn sweep_axis(
     let (o1, o2) = ((axis + 1) % 3, (axis + 2) % 3);
     // A child's area is 2·(cap + d·ring) for its extent d along the axis. The sweep ranks
     // splits by (cap + dl·ring)·nl + (cap + dr·ring)·nr (times the empty-space factor) and
-    // only the winner is scaled into the SAH cost; counts are kept as f64 (exact below
-    // 2^53) so the loop has no integer conversions.
+    // only the winner is scaled into the SAH cost; nl and nr are f64 (exact below 2^53),
+    // so each position converts its three counts once.
     let cap = e[o1] * e[o2];
     let ring = e[o1] + e[o2];
     let keep = 1.0 - ctx.bonus;
