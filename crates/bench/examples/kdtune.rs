@@ -2,9 +2,9 @@
 //! `cargo run --release -p bench --example kdtune -- KT KI BONUS MAX_DEPTH LEAF_SIZE FILE…`
 //! builds each soup or OBJ (or `gen:N`, kdbench's generated scene of N triangles) with
 //! those parameters and prints build time (best of up to 9 builds, all threads), primary,
-//! shadow and random-ray Mrays/s (best of 15, 1 thread), the tree's statistics and a digest of its
-//! nodes (equal digests, identical trees). Only ratios within one run mean anything on a
-//! noisy machine.
+//! shadow and random-ray Mrays/s (best of 15, 1 thread), the tree's statistics and a
+//! digest of its nodes (equal digests, identical trees). Only ratios within one run mean
+//! anything on a noisy machine.
 
 use anyhow::{bail, Context, Result};
 use bench::{rays, scenes};
@@ -90,8 +90,8 @@ fn run() -> Result<()> {
             });
         println!(
             "{}: {} triangles, build {:.1} ms, primary {:.3} Mrays/s, shadow {:.3} Mrays/s \
-             ({occluded} occluded), random {:.3} Mrays/s, nodes {}, leaves {}, max leaf {}, depth {}, refs/tri {:.2}, \
-             SAH {:.1}, bytes/tri {:.1}, tree {digest:016x}",
+             ({occluded} occluded), random {:.3} Mrays/s, nodes {}, leaves {}, max leaf {}, \
+             depth {}, refs/tri {:.2}, SAH {:.1}, bytes/tri {:.1}, tree {digest:016x}",
             s.name,
             tris.len(),
             build * 1e3,

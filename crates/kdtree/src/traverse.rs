@@ -24,18 +24,16 @@ use glam::Vec3;
 /// Entries of the traversal stack (≥ the build's depth bound, which is at most 60).
 pub const STACK: usize = 64;
 
-/// Relative padding of cell intervals: a few ulps of the plane-distance computation
-/// ((s − o)·(1/d) rounds three times).
-const PAD: f32 = 4.0 * f32::EPSILON;
-
+/// Cell intervals are padded by [`triangle::PAD`]: a few ulps of the plane-distance
+/// computation ((s − o)·(1/d) rounds three times). Up is `triangle::widen`'s padding.
 #[inline(always)]
 fn pad_up(t: f32) -> f32 {
-    t + t.abs() * PAD
+    triangle::widen(t)
 }
 
 #[inline(always)]
 fn pad_down(t: f32) -> f32 {
-    t - t.abs() * PAD
+    t - t.abs() * triangle::PAD
 }
 
 pub(crate) struct Tree<'a> {
@@ -485,15 +483,7 @@ pub(crate) fn brute_closest(tris: &[[Vec3; 3]], ray: &Ray) -> Option<Hit> {
     for (i, t) in tris.iter().enumerate() {
         let tri = [t[0].to_array(), t[1].to_array(), t[2].to_array()];
         if let Some(h) = triangle::intersect(&pre, &tri, ray.tmin, triangle::widen(best_t)) {
-            if h.t <= best_t && (h.t < best_t || (i as u32) < best.prim) {
-                best_t = h.t;
-                best = Hit {
-                    t: h.t,
-                    prim: i as u32,
-                    u: h.u,
-                    v: h.v,
-                };
-            }
+            keep_closer(&mut best, &mut best_t, i as u32, h);
         }
     }
     (!best.is_miss()).then_some(best)

@@ -70,8 +70,11 @@ pub struct RawHit {
 /// exactly, so a tie goes by index whatever order the triangles are tested in.
 #[inline(always)]
 pub fn widen(t: f32) -> f32 {
-    t + t.abs() * (4.0 * f32::EPSILON)
+    t + t.abs() * PAD
 }
+
+/// A few ulps, relative: `widen`'s margin, and the traversal's padding of cell intervals.
+pub const PAD: f32 = 4.0 * f32::EPSILON;
 
 /// Watertight, two-sided test of one triangle against a ray in [tmin, tmax]
 /// (tmax may be +inf). Returns t and the barycentrics (u weights v1, v weights v2).

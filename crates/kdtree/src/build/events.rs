@@ -19,10 +19,11 @@ pub const MAX_TRIANGLES: usize = 1 << 30;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord)]
 pub struct Event(u64);
 
-/// f32 bits to an unsigned key with the same order (for non-NaN values).
+/// f32 bits to an unsigned key with the same order (for non-NaN values); −0.0 maps to
+/// +0.0's key, so equal positions sort and group together.
 #[inline]
 pub fn ordered(pos: f32) -> u32 {
-    let b = pos.to_bits();
+    let b = (pos + 0.0).to_bits();
     if b >> 31 == 1 {
         !b
     } else {
@@ -43,8 +44,7 @@ impl Event {
     #[inline]
     pub fn new(pos: f32, tri: u32, kind: u32) -> Event {
         debug_assert!((tri as usize) < MAX_TRIANGLES && kind <= START);
-        // +0.0 turns −0.0 into +0.0, so equal positions sort and group together.
-        Event(((ordered(pos + 0.0) as u64) << 32) | ((kind as u64) << 30) | tri as u64)
+        Event(((ordered(pos) as u64) << 32) | ((kind as u64) << 30) | tri as u64)
     }
     /// The position's order key ([`ordered`]); equal keys are equal positions.
     #[inline]

@@ -253,7 +253,7 @@ fn sweep_axis(
     let cap = e[o1] * e[o2];
     let ring = e[o1] + e[o2];
     let keep = 1.0 - ctx.bonus;
-    let (lo_key, hi_key) = (events::ordered(lo + 0.0), events::ordered(hi + 0.0));
+    let (lo_key, hi_key) = (events::ordered(lo), events::ordered(hi));
     let (mut nl, mut nr) = (0.0f64, n as f64);
     let mut best = f64::INFINITY;
     let mut best_at: Option<(f32, bool)> = None;
@@ -316,7 +316,7 @@ fn split_work(ctx: &Ctx, w: Work, s: &Split, parallel: bool) -> (Work, Work) {
     // The split axis's events are sorted, so the ones before, at and after the plane are
     // three runs; before and after are classified without branching on the kind.
     let ev = &w.events[s.axis];
-    let split_key = events::ordered(s.pos + 0.0);
+    let split_key = events::ordered(s.pos);
     let at = ev.partition_point(|e| e.pos_key() < split_key);
     let after = at + ev[at..].partition_point(|e| e.pos_key() == split_key);
     for e in &ev[..at] {
