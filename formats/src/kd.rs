@@ -12,17 +12,18 @@ pub const VERSION: u32 = 1;
 /// SAH build parameters. They change the tree, so they are part of the cache key.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct BuildParams {
-    /// Cost of one traversal step, relative to `intersect_cost`. Default 4 (with 1.5 per
+    /// Cost of one traversal step, relative to `intersect_cost`. Default 5 (with 1.5 per
     /// triangle): our node steps, each a dependent load and an unpredictable branch, cost
-    /// more than a triangle test; against 1 it cuts references from 2.2–3.7 to 2.1–2.4
-    /// per triangle, bringing every measured scene under 64 bytes per triangle and the
-    /// build 1.2–1.7× faster for −7 % to +3 % ray speed (docs/PERFORMANCE.md).
+    /// more than a (four-wide) triangle test. Swept with the empty bonus over eleven
+    /// scenes: fewer, fuller leaves keep every scene under 58 bytes per triangle and the
+    /// build fast, and rays got faster, not slower (docs/PERFORMANCE.md).
     pub traversal_cost: f32,
     /// Cost of one ray/triangle test.
     pub intersect_cost: f32,
     /// Fraction of the SAH cost forgiven when a split cuts off empty space (0–1): the cost
-    /// is multiplied by 1 − empty_bonus. Default 0.5, as pbrt-v3 (Wald & Havran's λ = 0.8
-    /// is 0.2 here); 0.8 made cuts of empty slivers win over real splits.
+    /// is multiplied by 1 − empty_bonus. Default 0.1 (Wald & Havran's λ = 0.8 is 0.2 here,
+    /// pbrt-v3's 0.5): a larger bonus cuts empty slivers off thin surface cells, each a
+    /// step every ray through them pays (docs/PERFORMANCE.md has the sweep).
     pub empty_bonus: f32,
     /// Depth bound; 0 means the default 8 + 1.3·log2(N).
     pub max_depth: u32,
@@ -33,9 +34,9 @@ pub struct BuildParams {
 impl Default for BuildParams {
     fn default() -> Self {
         BuildParams {
-            traversal_cost: 4.0,
+            traversal_cost: 5.0,
             intersect_cost: 1.5,
-            empty_bonus: 0.5,
+            empty_bonus: 0.1,
             max_depth: 0,
             leaf_size: 1,
         }
