@@ -1,10 +1,11 @@
 //! Front-to-back k-d tree traversal with a fixed-size stack.
 //!
 //! Robustness rules (DESIGN §7, docs/ROBUSTNESS.md):
-//! * A direction component that is ±0 (or so small that its reciprocal overflows) never
-//!   enters a product with an infinity: the ray is parallel to that axis's planes, and the
-//!   side of a split is decided from the origin alone; a ray lying *in* a split plane
-//!   visits both children over its whole interval.
+//! * A direction component that is ±0 (or so small that its reciprocal overflows) makes
+//!   the ray parallel to that axis's planes: the box test decides from the origin alone,
+//!   and at a split the plane distance (split − o)·(±∞) is ±∞ on the origin's side, so
+//!   that child alone is visited; a ray lying *in* a split plane (0·∞ = NaN) visits both
+//!   children over its whole interval.
 //! * Which child comes first is decided by the direction's sign alone (the child the ray
 //!   comes from, then the one it goes to), so an origin on a split plane is handled by the
 //!   same code as every other origin.
@@ -50,7 +51,6 @@ struct Setup {
     pre: RayPre,
     o: [f32; 3],
     inv: [f32; 3],
-    parallel: [bool; 3],
     t0: f32,
     t1: f32,
 }
@@ -107,7 +107,6 @@ fn setup<const ROBUST: bool>(ray: &Ray, b: &Aabb) -> Option<Setup> {
         pre,
         o,
         inv,
-        parallel,
         t0,
         t1,
     })
@@ -130,31 +129,48 @@ fn test<const ROBUST: bool, const KZ: usize>(
 /// Children of interior node `i` to visit, in order, with their intervals.
 enum Step {
     One(u32),
+    /// Both children: `first` over [t0, min(t_split, t1)], `second` over
+    /// [max(t_split, t0), t1] (see [`near_end`] and [`far_start`]).
     Two {
         first: u32,
         second: u32,
         t_split: f32,
     },
-    /// Ray in the split plane: both children over the whole interval.
-    Both,
 }
 
+/// End of the first child's interval. A NaN `t_split` (a ray in the split plane, below)
+/// gives the whole interval; `t_split` beyond `t1` (within the padding) gives `t1`.
+#[inline(always)]
+fn near_end(t_split: f32, t1: f32) -> f32 {
+    if t_split <= t1 {
+        t_split
+    } else {
+        t1
+    }
+}
+
+/// Start of the second child's interval; NaN gives `t0`, as in [`near_end`].
+#[inline(always)]
+fn far_start(t_split: f32, t0: f32) -> f32 {
+    if t_split >= t0 {
+        t_split
+    } else {
+        t0
+    }
+}
+
+/// The robust path needs no case for rays parallel to the split plane (a direction
+/// component of ±0, or one whose reciprocal overflowed): `inv` is then ±∞ with the
+/// direction's sign, so the plane distance is ±∞ on the side the origin is on and picks
+/// that child alone by the same comparisons as every other ray, and a ray lying in the
+/// plane gets 0·∞ = NaN, which no comparison accepts: both children, over the whole
+/// interval ([`near_end`], [`far_start`]).
 #[inline(always)]
 fn step<const ROBUST: bool>(s: &Setup, i: u32, node: KdNode, t0: f32, t1: f32) -> Step {
     let a = node.axis();
     let below = i + 1;
     let above = node.above_child();
-    let diff = node.split() - s.o[a];
-    if ROBUST && s.parallel[a] {
-        return if diff > 0.0 {
-            Step::One(below)
-        } else if diff < 0.0 {
-            Step::One(above)
-        } else {
-            Step::Both
-        };
-    }
-    let tp = diff * s.inv[a];
+    let tp = (node.split() - s.o[a]) * s.inv[a];
     if ROBUST {
         // The ray comes from the side opposite its direction and goes to the other.
         let (first, second) = if s.inv[a] > 0.0 {
@@ -242,15 +258,10 @@ fn take_step<const ROBUST: bool>(
             second,
             t_split,
         } => {
-            stack[*sp] = MaybeUninit::new((second, t_split, *t1));
+            stack[*sp] = MaybeUninit::new((second, far_start(t_split, t0), *t1));
             *sp += 1;
             *node_i = first;
-            *t1 = t_split;
-        }
-        Step::Both => {
-            stack[*sp] = MaybeUninit::new((node.above_child(), t0, *t1));
-            *sp += 1;
-            *node_i += 1;
+            *t1 = near_end(t_split, *t1);
         }
     }
 }
@@ -272,10 +283,10 @@ fn take_step_branch_free<const ROBUST: bool>(
     stack: &mut Stack,
     sp: &mut usize,
 ) {
-    let a = node.axis();
-    if !ROBUST || s.parallel[a] {
+    if !ROBUST {
         return take_step::<ROBUST>(s, node, node_i, t0, t1, stack, sp);
     }
+    let a = node.axis();
     let below = *node_i + 1;
     let above = node.above_child();
     let tp = (node.split() - s.o[a]) * s.inv[a];
@@ -290,10 +301,10 @@ fn take_step_branch_free<const ROBUST: bool>(
     let only_first = tp > pad_up(*t1);
     let only_second = !only_first & (tp < pad_down(t0));
     let both = !only_first & !only_second;
-    stack[*sp] = MaybeUninit::new((second, tp, *t1));
+    stack[*sp] = MaybeUninit::new((second, far_start(tp, t0), *t1));
     *sp += usize::from(both);
     *node_i = if only_second { second } else { first };
-    *t1 = if both { tp } else { *t1 };
+    *t1 = if both { near_end(tp, *t1) } else { *t1 };
 }
 
 impl Tree<'_> {
