@@ -413,17 +413,18 @@ impl Tree<'_> {
                     }
                 }
             }
-            // Next cell, skipping those that start beyond the closest hit.
-            loop {
-                if sp == 0 {
-                    return (!best.is_miss()).then_some(best);
-                }
-                sp -= 1;
-                (node_i, t0, t1) = pop(&stack, sp);
-                let enter = if ROBUST { pad_down(t0) } else { t0 };
-                if best_t >= enter {
-                    break;
-                }
+            // Next cell. The stack is front to back (each entry starts no earlier than the
+            // one above it: a push is the far side of the current cell, which lies before
+            // every cell already waiting), so a hit closer than the next cell's entry is
+            // closer than all of them.
+            if sp == 0 {
+                return (!best.is_miss()).then_some(best);
+            }
+            sp -= 1;
+            (node_i, t0, t1) = pop(&stack, sp);
+            let enter = if ROBUST { pad_down(t0) } else { t0 };
+            if best_t < enter {
+                return Some(best);
             }
         }
     }
