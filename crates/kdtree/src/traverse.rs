@@ -418,15 +418,16 @@ impl Tree<'_> {
             // every cell already waiting), so a hit closer than the next cell's entry is
             // closer than all of them.
             if sp == 0 {
-                return (!best.is_miss()).then_some(best);
+                break;
             }
             sp -= 1;
             (node_i, t0, t1) = pop(&stack, sp);
             let enter = if ROBUST { pad_down(t0) } else { t0 };
             if best_t < enter {
-                return Some(best);
+                break;
             }
         }
+        (!best.is_miss()).then_some(best)
     }
 
     /// Whether any triangle is hit in [tmin, tmax]; stops at the first one found.
