@@ -13,6 +13,7 @@ pub mod graph;
 pub mod material;
 pub mod mesh;
 pub mod meta;
+pub mod model;
 pub mod obj;
 pub mod objexport;
 pub mod primitives;
