@@ -7,8 +7,10 @@
 //! groups dropped, sub-meshes per material inside a group) is what the scene's fileIDs
 //! and material slots refer to, and it is simpler to follow exactly here.
 
+use crate::material::linear_rgb;
 use crate::mesh::{smooth_normals, triangulate, Mesh};
-use glam::Vec3;
+use crate::model::{Model, ModelMaterial, ModelMesh, ModelNode};
+use glam::{Quat, Vec3};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -51,6 +53,58 @@ pub struct ObjModel {
 impl ObjModel {
     pub fn triangle_count(&self) -> usize {
         self.groups.iter().map(|g| g.mesh.triangle_count()).sum()
+    }
+
+    /// The hierarchy Unity imports: a root node named after the file, one child per
+    /// group at the identity holding the group's mesh (named after the group), and the
+    /// `.mtl` colours as the model's own materials (`Kd` is sRGB, like Unity's colours).
+    pub fn to_model(&self) -> Model {
+        let stem = self
+            .path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let node = |name: &str, parent, mesh| ModelNode {
+            name: name.to_string(),
+            parent,
+            translation: Vec3::ZERO,
+            rotation: Quat::IDENTITY,
+            scale: Vec3::ONE,
+            mesh,
+        };
+        let mut nodes = vec![node(&stem, None, None)];
+        nodes.extend(
+            self.groups
+                .iter()
+                .enumerate()
+                .map(|(i, g)| node(&g.name, Some(0), Some(i))),
+        );
+        let meshes = self
+            .groups
+            .iter()
+            .map(|g| ModelMesh {
+                name: g.name.clone(),
+                mesh: g.mesh.clone(),
+                materials: g.materials.clone(),
+                skin: None,
+            })
+            .collect();
+        let mut materials: Vec<ModelMaterial> = self
+            .mtl_colors
+            .iter()
+            .map(|(name, &color)| ModelMaterial {
+                name: name.clone(),
+                color: linear_rgb(color.extend(1.0)),
+                texture: None,
+            })
+            .collect();
+        materials.sort_by(|a, b| a.name.cmp(&b.name));
+        Model {
+            nodes,
+            meshes,
+            materials,
+            warnings: self.warnings.clone(),
+        }
     }
 }
 

@@ -472,7 +472,9 @@ fn unresolved_mesh_falls_back_to_the_object_name() {
     let soup = convert(&root.join("Assets/s.unity"));
     assert_eq!(soup.triangles.len(), 3);
     assert!(
-        soup.warnings.iter().any(|w| w.contains("seed's fallback")),
+        soup.warnings
+            .iter()
+            .any(|w| w.contains("found by the object's name")),
         "{:?}",
         soup.warnings
     );
