@@ -210,13 +210,14 @@ impl ModelMeta {
     /// sharing a name get distinct ids.
     pub fn ids_nth(&self, class: u32, name: &str, path: &str, n: (usize, usize)) -> Vec<i64> {
         let mut out = Vec::new();
-        for (id, n) in &self.recycle {
-            if n == name && (*id / 100000) as u32 == class {
+        for (id, entry) in &self.recycle {
+            // Legacy ids are classID·100000 + 2k.
+            if entry == name && (*id / 100000) as u32 == class {
                 out.push(*id);
             }
         }
-        for (c, id, n) in &self.internal {
-            if *c == class && n == name {
+        for (c, id, entry) in &self.internal {
+            if *c == class && entry == name {
                 out.push(*id);
             }
         }
@@ -317,13 +318,13 @@ mod tests {
         let m = ModelMeta::parse(text);
         assert_eq!(m.global_scale, 0.007);
         assert!(!m.generation2);
-        assert_eq!(m.ids(43, "Bunny", "Bunny")[0], 4300002);
+        assert_eq!(m.ids(docs::MESH, "Bunny", "Bunny")[0], 4300002);
         assert_eq!(
-            m.ids(4, "//RootNode", "//RootNode/root/Transform")[0],
+            m.ids(docs::TRANSFORM, "//RootNode", "//RootNode/root/Transform")[0],
             400000
         );
         let g2 = ModelMeta::parse("ModelImporter:\n  internalIDToNameTable:\n  - first:\n      43: 777\n    second: Foo\n  meshes:\n    fileIdsGeneration: 2\n");
         assert!(g2.generation2);
-        assert_eq!(g2.ids(43, "Foo", "Foo")[0], 777);
+        assert_eq!(g2.ids(docs::MESH, "Foo", "Foo")[0], 777);
     }
 }
