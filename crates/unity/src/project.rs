@@ -165,14 +165,13 @@ impl Project {
                 let Some(p) = self.resolve(guid) else {
                     continue;
                 };
-                match ext(p).as_str() {
-                    "prefab" => {
-                        if let Ok(t) = std::fs::read_to_string(p) {
-                            texts.push(t);
-                        }
+                if ext(p) != "prefab" {
+                    // Whatever is not a model is refused at once, without a read.
+                    models.push(p.clone());
+                } else if let Ok(bytes) = self.file(p).as_ref() {
+                    if let Ok(t) = std::str::from_utf8(bytes) {
+                        texts.push(t.to_string());
                     }
-                    _ if model_format(p).is_some() => models.push(p.clone()),
-                    _ => {}
                 }
             }
         }
@@ -188,23 +187,18 @@ impl Project {
         }
     }
 
-    /// The one place a model file's format picks its reader.
+    /// The one place a model file's format picks its reader. Every model is scaled by
+    /// its importer's `globalScale`.
     fn load_model(&self, path: &Path) -> Result<ModelAsset, ModelError> {
-        let Some(format) = model_format(path) else {
-            return Err(ModelError::Unsupported(ext(path)));
+        let mut model = match ext(path).as_str() {
+            "obj" => obj::load_in(path, &self.root)
+                .map_err(|e| self.read_error(path, &e))?
+                .to_model(),
+            other => return Err(ModelError::Unsupported(other.to_string())),
         };
         let meta = ModelMeta::read(path);
-        let model = match format {
-            ModelFormat::Obj => self.load_obj(path, &meta)?,
-        };
-        Ok(ModelAsset { model, meta })
-    }
-
-    fn load_obj(&self, path: &Path, meta: &ModelMeta) -> Result<Model, ModelError> {
-        let obj = obj::load_in(path, &self.root).map_err(|e| self.read_error(path, &e))?;
-        let mut model = obj.to_model();
         model.scale(meta.global_scale);
-        Ok(model)
+        Ok(ModelAsset { model, meta })
     }
 
     /// A reader's error, naming the file relative to the project as every other message
@@ -214,18 +208,6 @@ impl Project {
             e.to_string()
                 .replace(&path.display().to_string(), &self.rel(path)),
         )
-    }
-}
-
-/// The model formats with a reader.
-enum ModelFormat {
-    Obj,
-}
-
-fn model_format(path: &Path) -> Option<ModelFormat> {
-    match ext(path).as_str() {
-        "obj" => Some(ModelFormat::Obj),
-        _ => None,
     }
 }
 
