@@ -313,6 +313,18 @@ mod tests {
     }
 
     #[test]
+    fn objects_sharing_a_name_count_up_in_the_hashes() {
+        let meta = ModelMeta::parse("ModelImporter:\n  meshes:\n    fileIdsGeneration: 2\n");
+        let mut c = IdCounter::default();
+        let first = c.ids(&meta, docs::MESH, "Wheel", "Wheel");
+        let second = c.ids(&meta, docs::MESH, "Wheel", "Wheel");
+        let other = c.ids(&meta, docs::GAME_OBJECT, "Wheel", "//RootNode/root/Wheel");
+        assert_eq!(first, vec![hash_id("Type:Mesh->Wheel0"); 2]);
+        assert_eq!(second, vec![hash_id("Type:Mesh->Wheel1"); 2]);
+        assert_eq!(other[1], hash_id("Type:GameObject->//RootNode/root/Wheel0"));
+    }
+
+    #[test]
     fn legacy_table_and_settings() {
         let text = "fileFormatVersion: 2\nguid: 19cde6fd65027fb4c9c6814597f47199\nModelImporter:\n  serializedVersion: 23\n  fileIDToRecycleName:\n    100000: //RootNode\n    100002: Bunny\n    400000: //RootNode\n    400002: Bunny\n    4300000: default\n    4300002: Bunny\n  meshes:\n    globalScale: 0.007\n";
         let m = ModelMeta::parse(text);

@@ -422,6 +422,26 @@ mod tests {
     }
 
     #[test]
+    fn imports_as_a_root_named_after_the_file_with_one_child_per_group() {
+        let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\ng A\nf 1 2 3\ng B\nusemtl red\nf 1 3 2\n";
+        let m = parse(text, Path::new("dir/chair.obj")).unwrap().to_model();
+        let names: Vec<_> = m.nodes.iter().map(|n| n.name.as_str()).collect();
+        assert_eq!(names, ["chair", "A", "B"]);
+        assert_eq!(m.nodes[0].parent, None);
+        assert!(m.nodes[1..]
+            .iter()
+            .all(|n| n.parent == Some(0) && n.translation == Vec3::ZERO));
+        assert_eq!((m.nodes[1].mesh, m.nodes[2].mesh), (Some(0), Some(1)));
+        assert_eq!(m.meshes[1].name, "B");
+        assert_eq!(m.meshes[1].materials, ["red"]);
+        assert_eq!(
+            Model::material_name(&m.meshes[0].materials[0]),
+            "defaultMat"
+        );
+        assert_eq!(m.node_path(2), "//RootNode/root/B");
+    }
+
+    #[test]
     fn short_faces_are_counted_and_mtllib_stays_inside_the_root() {
         let dir = tempfile::tempdir().unwrap();
         let root = dir.path().join("Proj");
