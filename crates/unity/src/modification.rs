@@ -5,14 +5,36 @@
 //! everything else is set in the body.
 
 use crate::graph::Obj;
-use crate::reference::Ref;
+use crate::reference::{fref, Ref};
 use crate::yaml::Node;
 
 /// Longest `m_Materials` or YAML array a modification may grow.
 const MAX_ARRAY: usize = 1 << 16;
 
+/// The `target` fileID of one `m_Modifications` entry.
+pub fn target(md: &Node) -> i64 {
+    fref(md.get("target")).0
+}
+
+/// Apply one `m_Modifications` entry to `obj`; a reference it holds without a GUID was
+/// written in file `file`.
+pub fn apply(obj: &mut Obj, md: &Node, file: usize) {
+    let Some(prop) = md.str_at("propertyPath") else {
+        return;
+    };
+    let value = md.str_at("value").unwrap_or("");
+    let objref = md.get("objectReference");
+    let (ref_id, _) = fref(objref);
+    let new = if value.is_empty() && (ref_id != 0 || is_ref_path(prop)) {
+        objref.cloned().unwrap_or(ref_node(0, ""))
+    } else {
+        Node::Scalar(value.to_string())
+    };
+    set(obj, prop, new, file);
+}
+
 /// Set `prop` of `obj` to `value`; a reference in `value` was written in file `file`.
-pub fn apply(obj: &mut Obj, prop: &str, value: Node, file: usize) {
+fn set(obj: &mut Obj, prop: &str, value: Node, file: usize) {
     let segs: Vec<&str> = prop.split('.').collect();
     match segs.split_first() {
         Some((&"m_Mesh", rest)) => set_ref(&mut obj.mesh, rest, &value, file),
@@ -22,12 +44,12 @@ pub fn apply(obj: &mut Obj, prop: &str, value: Node, file: usize) {
 }
 
 /// Whether an empty value at `prop` means "no reference" rather than an empty scalar.
-pub fn is_ref_path(prop: &str) -> bool {
+fn is_ref_path(prop: &str) -> bool {
     prop == "m_Mesh" || prop.starts_with("m_Materials.Array.data[")
 }
 
-/// An empty reference, as Unity writes one.
-pub fn ref_node(file_id: i64, guid: &str) -> Node {
+/// A reference node as Unity writes one.
+fn ref_node(file_id: i64, guid: &str) -> Node {
     Node::Map(vec![
         ("fileID".into(), Node::Scalar(file_id.to_string())),
         ("guid".into(), Node::Scalar(guid.to_string())),

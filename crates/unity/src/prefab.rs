@@ -3,7 +3,7 @@
 
 use crate::docs::Doc;
 use crate::graph::{is_transform, read_text, Graph, IdMap};
-use crate::modification::{self, is_ref_path, ref_node};
+use crate::modification;
 use crate::project::{ext, ModelError};
 use crate::reference::fref;
 use crate::yaml::Node;
@@ -16,22 +16,9 @@ impl Graph<'_> {
     /// arena index). References written without a GUID point into file `file`.
     pub(crate) fn apply_mods(&mut self, smap: &IdMap, mods: &[Node], file: usize) {
         for md in mods {
-            let (target, _) = fref(md.get("target"));
-            let Some(&idx) = smap.get(&target) else {
-                continue;
-            };
-            let Some(prop) = md.str_at("propertyPath") else {
-                continue;
-            };
-            let value = md.str_at("value").unwrap_or("");
-            let objref = md.get("objectReference");
-            let (ref_id, _) = fref(objref);
-            let new = if value.is_empty() && (ref_id != 0 || is_ref_path(prop)) {
-                objref.cloned().unwrap_or(ref_node(0, ""))
-            } else {
-                Node::Scalar(value.to_string())
-            };
-            modification::apply(&mut self.objs[idx], prop, new, file);
+            if let Some(&idx) = smap.get(&modification::target(md)) {
+                modification::apply(&mut self.objs[idx], md, file);
+            }
         }
     }
 
