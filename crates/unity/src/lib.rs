@@ -1,23 +1,33 @@
 //! `unity2soup`'s library: reads a text-serialized Unity scene with its project (`.meta`
-//! GUIDs, `.prefab`, `.mat`, OBJ models) and produces the world-space triangle soup of
-//! DESIGN §3–§4.
+//! GUIDs, `.prefab`, `.mat`, OBJ models) and produces the world-space, right-handed
+//! triangle soup the renderer reads.
 //!
 //! Stages: [`docs`] splits files into documents, [`yaml`] parses the bodies it needs,
 //! [`graph`] builds the object graph with prefab instances expanded, [`emit`] walks it
-//! into a [`formats::Soup`].
+//! into a [`formats::Soup`]. Every asset read goes through [`project::Project`].
 
+pub mod camera;
 pub mod docs;
 pub mod embedded;
 pub mod emit;
+pub mod environment;
 pub mod graph;
+pub mod light;
 pub mod material;
 pub mod mesh;
+pub mod mesh_source;
 pub mod meta;
 pub mod model;
+pub mod model_instance;
+pub mod modification;
 pub mod obj;
 pub mod objexport;
+pub mod prefab;
 pub mod primitives;
 pub mod project;
+pub mod reference;
+pub mod renderer;
+pub mod transform;
 pub mod yaml;
 
 use formats::Soup;
@@ -67,20 +77,11 @@ pub fn convert_report(scene: &Path, opts: &Options) -> Result<Report, ConvertErr
     };
     let project = project::Project::open(&root);
     // Refuse binary scenes before doing any work.
-    let bytes = std::fs::read(scene).map_err(|source| graph::LoadError::Io {
-        path: scene.to_path_buf(),
-        source,
-    })?;
-    if bytes.is_empty() {
-        return Err(graph::LoadError::Empty(scene.to_path_buf()).into());
-    }
-    if !docs::is_text_yaml(&bytes) {
-        return Err(graph::LoadError::Binary(scene.to_path_buf()).into());
-    }
-    project.preload_models(&String::from_utf8_lossy(&bytes));
+    let text = graph::read_text(&project, scene)?;
+    project.preload_models(&text);
     let mut g = graph::Graph::new(&project);
     g.warnings.extend(project.guids.warnings.iter().cloned());
-    g.load_scene(scene)?;
+    g.load_scene(scene, text);
     let scene_rel = project.rel(scene);
     let (mut soup, cameras) = emit::emit(&g, &scene_rel)?;
     // Model-level warnings (missing .mtl …), once per model used.
@@ -90,14 +91,11 @@ pub fn convert_report(scene: &Path, opts: &Options) -> Result<Report, ConvertErr
         .iter()
         .map(|o| o.source.split('#').next().unwrap_or(""))
     {
-        let p = project.root.join(f);
-        if project::ext(&p) == "obj" {
-            if let Ok(a) = project.model(&p).as_ref() {
-                for w in &a.obj.warnings {
-                    let w = format!("{f}: {w}");
-                    if !model_warnings.contains(&w) {
-                        model_warnings.push(w);
-                    }
+        if let Ok(a) = project.model(&project.root.join(f)).as_ref() {
+            for w in &a.model.warnings {
+                let w = format!("{f}: {w}");
+                if !model_warnings.contains(&w) {
+                    model_warnings.push(w);
                 }
             }
         }

@@ -1,8 +1,22 @@
-//! Unity materials (class 21, in `.mat` files or embedded in a scene) → soup materials.
+//! Unity materials (class 21) → soup materials, and where a renderer's material slot
+//! comes from: a `.mat` file, a Material embedded in the scene or prefab, Unity's
+//! built-in materials, or a model's own material.
 
+use crate::docs;
+use crate::emit::Emitter;
+use crate::model::Model;
+use crate::project::ModelError;
+use crate::reference::Ref;
 use crate::yaml::Node;
 use formats::Material;
 use glam::{Vec3, Vec4};
+use std::path::Path;
+
+/// The GUID of Unity's built-in extra resources (Default-Material and its kin).
+const BUILTIN_EXTRA_GUID: &str = "0000000000000000f000000000000000";
+
+/// Default-Material's fileID among the built-in extra resources.
+const DEFAULT_MATERIAL_ID: i64 = 10303;
 
 /// sRGB electro-optical transfer function, per channel; HDR values above 1 follow the
 /// same curve (Unity stores HDR colours gamma-encoded too).
@@ -118,6 +132,151 @@ pub fn convert(body: &Node, source: &str) -> (Material, Vec<String>) {
         m.source = source;
     }
     (m, notes)
+}
+
+impl Emitter<'_, '_> {
+    fn default_material(&mut self) -> u32 {
+        self.add_material("builtin:Default-Material".into(), Material::unity_default)
+    }
+
+    /// The soup index of the material under `key`, made on first use.
+    fn add_material(&mut self, key: String, make: impl FnOnce() -> Material) -> u32 {
+        if let Some(&i) = self.materials.get(&key) {
+            return i;
+        }
+        let i = self.soup.materials.len() as u32;
+        self.soup.materials.push(make());
+        self.materials.insert(key, i);
+        i
+    }
+
+    /// Unity's default material, with a warning about `what` saying why.
+    fn warn_default(&mut self, what: &str, why: String) -> u32 {
+        self.soup
+            .warnings
+            .push(format!("{what}: {why}; Unity's default material used"));
+        self.default_material()
+    }
+
+    /// A material slot's soup material index (deduplicated by source); `what` names
+    /// the object in messages.
+    pub(crate) fn material(&mut self, r: &Ref, what: &str) -> u32 {
+        let id = r.file_id;
+        if id == 0 {
+            return self.warn_default(what, "material slot is empty".into());
+        }
+        let Some(guid) = r.guid.as_deref() else {
+            return self.embedded_material(id, r.file, what);
+        };
+        if guid == BUILTIN_EXTRA_GUID {
+            if id != DEFAULT_MATERIAL_ID {
+                self.soup.warnings.push(format!(
+                    "{what}: built-in material {id} approximated by Default-Material"
+                ));
+            }
+            return self.default_material();
+        }
+        let project = self.g.project;
+        let Some(path) = project.resolve(guid).cloned() else {
+            return self.warn_default(
+                what,
+                format!("material GUID {guid} is not in the project (a package or deleted asset)"),
+            );
+        };
+        if crate::project::ext(&path) == "mat" {
+            self.mat_file(&path, what)
+        } else {
+            self.model_material(id, &path, what)
+        }
+    }
+
+    /// A Material document of file `file` (guid-less reference).
+    fn embedded_material(&mut self, id: i64, file: usize, what: &str) -> u32 {
+        let key = format!("local:{file}:{id}");
+        if let Some(&i) = self.materials.get(&key) {
+            return i;
+        }
+        let project = self.g.project;
+        let Some(f) = self.g.files.get(file) else {
+            return self.warn_default(what, format!("local material {id} not found"));
+        };
+        match f.doc(id) {
+            Some((docs::MATERIAL, body)) => {
+                let src = format!("{}#{id}", project.rel(&f.path));
+                let (m, _notes) = convert(&body, &src);
+                self.add_material(key, || m)
+            }
+            _ => {
+                let why = format!("material fileID {id} is not in {}", project.rel(&f.path));
+                self.warn_default(what, why)
+            }
+        }
+    }
+
+    /// The Material of a `.mat` file.
+    fn mat_file(&mut self, path: &Path, what: &str) -> u32 {
+        let rel = self.g.project.rel(path);
+        let key = format!("mat:{rel}");
+        if let Some(&i) = self.materials.get(&key) {
+            return i;
+        }
+        let mat = self.g.project.mat(path);
+        match mat.as_ref() {
+            Ok(Some(b)) => {
+                let (m, notes) = convert(b, &rel);
+                for n in notes {
+                    self.soup.warnings.push(format!("{rel}: {n}"));
+                }
+                self.add_material(key, || m)
+            }
+            Ok(None) => self.warn_default(what, format!("{rel} holds no Material")),
+            Err(e) => self.warn_default(what, format!("{rel}: {e}")),
+        }
+    }
+
+    /// The model's own material whose fileID is `id`.
+    fn model_material(&mut self, id: i64, path: &Path, what: &str) -> u32 {
+        let rel = self.g.project.rel(path);
+        let loaded = self.g.project.model(path);
+        let asset = match loaded.as_ref() {
+            Ok(a) => a,
+            Err(ModelError::Unsupported(ext)) => {
+                return self.warn_default(what, format!("{rel} is a .{ext}, not a material"))
+            }
+            Err(ModelError::Read(_)) => {
+                return self.warn_default(what, format!("{rel} could not be read"))
+            }
+        };
+        let name = asset
+            .material_names()
+            .find(|n| asset.material_ids(n).contains(&id));
+        let Some(name) = name else {
+            return self.warn_default(
+                what,
+                format!("material fileID {id} names no material of {rel}"),
+            );
+        };
+        let key = format!("objmat:{rel}:{name}");
+        if let Some(&i) = self.materials.get(&key) {
+            return i;
+        }
+        match asset.model.material(name) {
+            Some(own) => {
+                let mut m = Material::unity_default();
+                m.name = name.to_string();
+                m.source = format!("{rel}#{name}");
+                m.color = own.color;
+                self.add_material(key, || m)
+            }
+            // A sub-mesh without a material name: Unity's importer gives it its default
+            // material.
+            None if name == Model::UNNAMED_MATERIAL => self.default_material(),
+            None => {
+                let why = format!("{rel}: material '{name}' has no Kd in a .mtl");
+                self.warn_default(what, why)
+            }
+        }
+    }
 }
 
 #[cfg(test)]

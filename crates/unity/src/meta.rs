@@ -1,6 +1,7 @@
 //! `.meta` files: the project's GUID → asset index, and the ModelImporter settings that
-//! decide which fileID names which object inside a model (DESIGN §4).
+//! decide which fileID names which object inside a model.
 
+use crate::docs;
 use crate::yaml::{self, Node};
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
@@ -119,12 +120,12 @@ pub fn guid_of(text: &str) -> Option<String> {
 
 pub fn class_name(class: u32) -> &'static str {
     match class {
-        1 => "GameObject",
-        4 => "Transform",
-        21 => "Material",
-        23 => "MeshRenderer",
-        33 => "MeshFilter",
-        43 => "Mesh",
+        docs::GAME_OBJECT => "GameObject",
+        docs::TRANSFORM => "Transform",
+        docs::MATERIAL => "Material",
+        docs::MESH_RENDERER => "MeshRenderer",
+        docs::MESH_FILTER => "MeshFilter",
+        docs::MESH => "Mesh",
         _ => "Object",
     }
 }
@@ -201,22 +202,57 @@ impl ModelMeta {
     /// `fileIdsGeneration: 2` hash. All schemes are registered at once: they cannot
     /// collide in practice, and old projects keep legacy ids after an upgrade.
     pub fn ids(&self, class: u32, name: &str, path: &str) -> Vec<i64> {
+        self.ids_nth(class, name, path, (0, 0))
+    }
+
+    /// [`Self::ids`] of an object that is the `n.0`-th (from 0) of its class with that
+    /// name and the `n.1`-th with that path: Unity's hashes end in that count, so objects
+    /// sharing a name get distinct ids.
+    pub fn ids_nth(&self, class: u32, name: &str, path: &str, n: (usize, usize)) -> Vec<i64> {
         let mut out = Vec::new();
-        for (id, n) in &self.recycle {
-            if n == name && (*id / 100000) as u32 == class {
+        for (id, entry) in &self.recycle {
+            // Legacy ids are classID·100000 + 2k.
+            if entry == name && (*id / 100000) as u32 == class {
                 out.push(*id);
             }
         }
-        for (c, id, n) in &self.internal {
-            if *c == class && n == name {
+        for (c, id, entry) in &self.internal {
+            if *c == class && entry == name {
                 out.push(*id);
             }
         }
         let cls = class_name(class);
-        out.push(hash_id(&format!("Type:{cls}->{name}0")));
-        out.push(hash_id(&format!("Type:{cls}->{path}0")));
+        out.push(hash_id(&format!("Type:{cls}->{name}{}", n.0)));
+        out.push(hash_id(&format!("Type:{cls}->{path}{}", n.1)));
         out
     }
+}
+
+/// Counts the objects of each class and name (and path) a model has given ids so far,
+/// for [`ModelMeta::ids_nth`].
+#[derive(Default)]
+pub struct IdCounter {
+    names: HashMap<(u32, String), usize>,
+    paths: HashMap<(u32, String), usize>,
+}
+
+impl IdCounter {
+    /// Every fileID of the next object of `class` named `name` (hashed by `path` under
+    /// `fileIdsGeneration: 2`).
+    pub fn ids(&mut self, meta: &ModelMeta, class: u32, name: &str, path: &str) -> Vec<i64> {
+        let n = (
+            next(&mut self.names, class, name),
+            next(&mut self.paths, class, path),
+        );
+        meta.ids_nth(class, name, path, n)
+    }
+}
+
+/// The count so far of `key` in `seen`, counting this one.
+fn next(seen: &mut HashMap<(u32, String), usize>, class: u32, key: &str) -> usize {
+    let n = seen.entry((class, key.to_string())).or_default();
+    *n += 1;
+    *n - 1
 }
 
 /// Unity's hashed fileID: xxHash64 (seed 0) of the identifier string, as i64.
@@ -277,18 +313,30 @@ mod tests {
     }
 
     #[test]
+    fn objects_sharing_a_name_count_up_in_the_hashes() {
+        let meta = ModelMeta::parse("ModelImporter:\n  meshes:\n    fileIdsGeneration: 2\n");
+        let mut c = IdCounter::default();
+        let first = c.ids(&meta, docs::MESH, "Wheel", "Wheel");
+        let second = c.ids(&meta, docs::MESH, "Wheel", "Wheel");
+        let other = c.ids(&meta, docs::GAME_OBJECT, "Wheel", "//RootNode/root/Wheel");
+        assert_eq!(first, vec![hash_id("Type:Mesh->Wheel0"); 2]);
+        assert_eq!(second, vec![hash_id("Type:Mesh->Wheel1"); 2]);
+        assert_eq!(other[1], hash_id("Type:GameObject->//RootNode/root/Wheel0"));
+    }
+
+    #[test]
     fn legacy_table_and_settings() {
         let text = "fileFormatVersion: 2\nguid: 19cde6fd65027fb4c9c6814597f47199\nModelImporter:\n  serializedVersion: 23\n  fileIDToRecycleName:\n    100000: //RootNode\n    100002: Bunny\n    400000: //RootNode\n    400002: Bunny\n    4300000: default\n    4300002: Bunny\n  meshes:\n    globalScale: 0.007\n";
         let m = ModelMeta::parse(text);
         assert_eq!(m.global_scale, 0.007);
         assert!(!m.generation2);
-        assert_eq!(m.ids(43, "Bunny", "Bunny")[0], 4300002);
+        assert_eq!(m.ids(docs::MESH, "Bunny", "Bunny")[0], 4300002);
         assert_eq!(
-            m.ids(4, "//RootNode", "//RootNode/root/Transform")[0],
+            m.ids(docs::TRANSFORM, "//RootNode", "//RootNode/root/Transform")[0],
             400000
         );
         let g2 = ModelMeta::parse("ModelImporter:\n  internalIDToNameTable:\n  - first:\n      43: 777\n    second: Foo\n  meshes:\n    fileIdsGeneration: 2\n");
         assert!(g2.generation2);
-        assert_eq!(g2.ids(43, "Foo", "Foo")[0], 777);
+        assert_eq!(g2.ids(docs::MESH, "Foo", "Foo")[0], 777);
     }
 }

@@ -74,9 +74,31 @@ impl Model {
         self.meshes.iter().map(|m| m.mesh.triangle_count()).sum()
     }
 
+    /// Scale every node's translation and mesh (ModelImporter `globalScale`).
+    pub fn scale(&mut self, s: f32) {
+        for n in &mut self.nodes {
+            n.translation *= s;
+        }
+        for m in &mut self.meshes {
+            m.mesh = std::mem::take(&mut m.mesh).scaled(s);
+        }
+    }
+
     /// The model's own material of that name.
     pub fn material(&self, name: &str) -> Option<&ModelMaterial> {
         self.materials.iter().find(|m| m.name == name)
+    }
+
+    /// The name Unity gives the material of a sub-mesh whose file names none.
+    pub const UNNAMED_MATERIAL: &'static str = "defaultMat";
+
+    /// The name of the material Unity imports for a sub-mesh's own material name.
+    pub fn material_name(own: &str) -> &str {
+        if own.is_empty() {
+            Self::UNNAMED_MATERIAL
+        } else {
+            own
+        }
     }
 
     /// The path Unity hashes for a node under `fileIdsGeneration: 2`:

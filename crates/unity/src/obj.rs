@@ -7,8 +7,10 @@
 //! groups dropped, sub-meshes per material inside a group) is what the scene's fileIDs
 //! and material slots refer to, and it is simpler to follow exactly here.
 
+use crate::material::linear_rgb;
 use crate::mesh::{smooth_normals, triangulate, Mesh};
-use glam::Vec3;
+use crate::model::{Model, ModelMaterial, ModelMesh, ModelNode};
+use glam::{Quat, Vec3};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -51,6 +53,58 @@ pub struct ObjModel {
 impl ObjModel {
     pub fn triangle_count(&self) -> usize {
         self.groups.iter().map(|g| g.mesh.triangle_count()).sum()
+    }
+
+    /// The hierarchy Unity imports: a root node named after the file, one child per
+    /// group at the identity holding the group's mesh (named after the group), and the
+    /// `.mtl` colours as the model's own materials (`Kd` is sRGB, like Unity's colours).
+    pub fn to_model(&self) -> Model {
+        let stem = self
+            .path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let node = |name: &str, parent, mesh| ModelNode {
+            name: name.to_string(),
+            parent,
+            translation: Vec3::ZERO,
+            rotation: Quat::IDENTITY,
+            scale: Vec3::ONE,
+            mesh,
+        };
+        let mut nodes = vec![node(&stem, None, None)];
+        nodes.extend(
+            self.groups
+                .iter()
+                .enumerate()
+                .map(|(i, g)| node(&g.name, Some(0), Some(i))),
+        );
+        let meshes = self
+            .groups
+            .iter()
+            .map(|g| ModelMesh {
+                name: g.name.clone(),
+                mesh: g.mesh.clone(),
+                materials: g.materials.clone(),
+                skin: None,
+            })
+            .collect();
+        let mut materials: Vec<ModelMaterial> = self
+            .mtl_colors
+            .iter()
+            .map(|(name, &color)| ModelMaterial {
+                name: name.clone(),
+                color: linear_rgb(color.extend(1.0)),
+                texture: None,
+            })
+            .collect();
+        materials.sort_by(|a, b| a.name.cmp(&b.name));
+        Model {
+            nodes,
+            meshes,
+            materials,
+            warnings: self.warnings.clone(),
+        }
     }
 }
 
@@ -365,6 +419,26 @@ mod tests {
             .iter()
             .all(|n| (*n - Vec3::Z).length() < 1e-6));
         assert!(m.warnings.is_empty());
+    }
+
+    #[test]
+    fn imports_as_a_root_named_after_the_file_with_one_child_per_group() {
+        let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\ng A\nf 1 2 3\ng B\nusemtl red\nf 1 3 2\n";
+        let m = parse(text, Path::new("dir/chair.obj")).unwrap().to_model();
+        let names: Vec<_> = m.nodes.iter().map(|n| n.name.as_str()).collect();
+        assert_eq!(names, ["chair", "A", "B"]);
+        assert_eq!(m.nodes[0].parent, None);
+        assert!(m.nodes[1..]
+            .iter()
+            .all(|n| n.parent == Some(0) && n.translation == Vec3::ZERO));
+        assert_eq!((m.nodes[1].mesh, m.nodes[2].mesh), (Some(0), Some(1)));
+        assert_eq!(m.meshes[1].name, "B");
+        assert_eq!(m.meshes[1].materials, ["red"]);
+        assert_eq!(
+            Model::material_name(&m.meshes[0].materials[0]),
+            "defaultMat"
+        );
+        assert_eq!(m.node_path(2), "//RootNode/root/B");
     }
 
     #[test]

@@ -1,20 +1,43 @@
-//! A Unity project on disk: its root, the GUID index, and caches of the assets a scene
-//! uses (each OBJ is read once however many objects use it; OBJ files are loaded in
-//! parallel before the scene is walked).
+//! A Unity project on disk: its root, the GUID index, and every read of an asset a scene
+//! uses. Each file is read once however many objects use it (scenes and prefabs as bytes,
+//! `.mat` files as their parsed Material, models as a [`Model`]); the models a scene can
+//! reach are loaded in parallel before the scene is walked.
 
+use crate::docs;
 use crate::meta::{GuidIndex, ModelMeta};
-use crate::obj::{self, ObjModel};
+use crate::model::Model;
+use crate::obj;
+use crate::yaml::Node;
 use rayon::prelude::*;
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, OnceLock};
 
+/// An imported model with the `.meta` settings that name its objects.
 pub struct ModelAsset {
-    pub obj: ObjModel,
+    pub model: Model,
     pub meta: ModelMeta,
 }
 
-pub type ModelResult = Arc<Result<ModelAsset, String>>;
+/// Why a model asset gives no [`Model`].
+#[derive(Clone, Debug, thiserror::Error)]
+pub enum ModelError {
+    /// A model format this converter has no reader for (the lower-case extension).
+    #[error("a .{0} model, which is not converted (only OBJ models are)")]
+    Unsupported(String),
+    /// The reader refused the file (the message names it relative to the project).
+    #[error("{0}")]
+    Read(String),
+}
+
+pub type ModelResult = Arc<Result<ModelAsset, ModelError>>;
+
+/// A file's bytes, or why it could not be read.
+pub type FileResult = Arc<std::io::Result<Vec<u8>>>;
+
+/// The Material body of a `.mat` file: `Ok(None)` when it holds none, `Err` with the
+/// read error's message.
+pub type MatResult = Arc<Result<Option<Node>, String>>;
 
 pub struct Project {
     pub root: PathBuf,
@@ -23,7 +46,10 @@ pub struct Project {
     /// `Packages/manifest.json` names the High Definition Render Pipeline, whose lights
     /// are in physical units.
     pub hdrp: bool,
+    files: Mutex<HashMap<PathBuf, FileResult>>,
     models: Mutex<HashMap<PathBuf, ModelResult>>,
+    mats: Mutex<HashMap<PathBuf, MatResult>>,
+    by_name: OnceLock<HashMap<String, PathBuf>>,
 }
 
 /// The folder holding `Assets/`, walking up from `start`.
@@ -33,6 +59,18 @@ pub fn find_root(start: &Path) -> Option<PathBuf> {
         .ancestors()
         .find(|d| d.join("Assets").is_dir())
         .map(Path::to_path_buf)
+}
+
+/// A cached value of `cache` under `key`, computed by `make` on first use.
+fn cached<V: Clone>(cache: &Mutex<HashMap<PathBuf, V>>, key: &Path, make: impl FnOnce() -> V) -> V {
+    if let Some(v) = cache.lock().ok().and_then(|m| m.get(key).cloned()) {
+        return v;
+    }
+    let v = make();
+    if let Ok(mut m) = cache.lock() {
+        m.insert(key.to_path_buf(), v.clone());
+    }
+    v
 }
 
 impl Project {
@@ -56,7 +94,10 @@ impl Project {
             assets,
             guids,
             hdrp,
-            models: Mutex::new(HashMap::new()),
+            files: Mutex::default(),
+            models: Mutex::default(),
+            mats: Mutex::default(),
+            by_name: OnceLock::new(),
         }
     }
 
@@ -79,29 +120,42 @@ impl Project {
         self.guids.get(guid)
     }
 
-    /// Load an OBJ model (once).
-    pub fn model(&self, path: &Path) -> ModelResult {
-        if let Some(m) = self
-            .models
-            .lock()
-            .map(|m| m.get(path).cloned())
-            .ok()
-            .flatten()
-        {
-            return m;
-        }
-        let loaded = Arc::new(self.load_model(path));
-        if let Ok(mut m) = self.models.lock() {
-            m.insert(path.to_path_buf(), loaded.clone());
-        }
-        loaded
+    /// A scene or prefab file's bytes (read once).
+    pub fn file(&self, path: &Path) -> FileResult {
+        cached(&self.files, path, || Arc::new(std::fs::read(path)))
     }
 
-    /// Load, in parallel, every OBJ referenced by GUID from `scene_text` and from the
+    /// The Material of a `.mat` file (read and parsed once).
+    pub fn mat(&self, path: &Path) -> MatResult {
+        cached(&self.mats, path, || {
+            Arc::new(match std::fs::read_to_string(path) {
+                Ok(text) => Ok(docs::split(&text)
+                    .into_iter()
+                    .find(|d| d.class == docs::MATERIAL)
+                    .map(|d| d.parse())),
+                Err(e) => Err(e.to_string()),
+            })
+        })
+    }
+
+    /// A model (loaded once).
+    pub fn model(&self, path: &Path) -> ModelResult {
+        cached(&self.models, path, || Arc::new(self.load_model(path)))
+    }
+
+    /// The first file named `name` (ASCII case ignored) under the assets folder, in a
+    /// depth-first walk of sorted folders; the folders are walked once for all names.
+    pub fn find_by_name(&self, name: &str) -> Option<&PathBuf> {
+        self.by_name
+            .get_or_init(|| index_by_name(&self.assets))
+            .get(&name.to_ascii_lowercase())
+    }
+
+    /// Load, in parallel, every model referenced by GUID from `scene_text` and from the
     /// prefab files it reaches.
     pub fn preload_models(&self, scene_text: &str) {
         let mut seen = HashSet::new();
-        let mut objs: Vec<PathBuf> = Vec::new();
+        let mut models: Vec<PathBuf> = Vec::new();
         let mut texts = vec![scene_text.to_string()];
         while let Some(t) = texts.pop() {
             for guid in guids_in(&t) {
@@ -111,18 +165,17 @@ impl Project {
                 let Some(p) = self.resolve(guid) else {
                     continue;
                 };
-                match ext(p).as_str() {
-                    "obj" => objs.push(p.clone()),
-                    "prefab" => {
-                        if let Ok(t) = std::fs::read_to_string(p) {
-                            texts.push(t);
-                        }
+                if ext(p) != "prefab" {
+                    // Whatever is not a model is refused at once, without a read.
+                    models.push(p.clone());
+                } else if let Ok(bytes) = self.file(p).as_ref() {
+                    if let Ok(t) = std::str::from_utf8(bytes) {
+                        texts.push(t.to_string());
                     }
-                    _ => {}
                 }
             }
         }
-        let loaded: Vec<(PathBuf, ModelResult)> = objs
+        let loaded: Vec<(PathBuf, ModelResult)> = models
             .into_par_iter()
             .map(|p| {
                 let m = Arc::new(self.load_model(&p));
@@ -133,19 +186,28 @@ impl Project {
             m.extend(loaded);
         }
     }
-}
 
-impl Project {
-    fn load_model(&self, path: &Path) -> Result<ModelAsset, String> {
-        let obj = obj::load_in(path, &self.root).map_err(|e| {
-            // Name the file relative to the project, as every other message does.
+    /// The one place a model file's format picks its reader. Every model is scaled by
+    /// its importer's `globalScale`.
+    fn load_model(&self, path: &Path) -> Result<ModelAsset, ModelError> {
+        let mut model = match ext(path).as_str() {
+            "obj" => obj::load_in(path, &self.root)
+                .map_err(|e| self.read_error(path, &e))?
+                .to_model(),
+            other => return Err(ModelError::Unsupported(other.to_string())),
+        };
+        let meta = ModelMeta::read(path);
+        model.scale(meta.global_scale);
+        Ok(ModelAsset { model, meta })
+    }
+
+    /// A reader's error, naming the file relative to the project as every other message
+    /// does.
+    fn read_error(&self, path: &Path, e: &dyn std::fmt::Display) -> ModelError {
+        ModelError::Read(
             e.to_string()
-                .replace(&path.display().to_string(), &self.rel(path))
-        })?;
-        Ok(ModelAsset {
-            obj,
-            meta: ModelMeta::read(path),
-        })
+                .replace(&path.display().to_string(), &self.rel(path)),
+        )
     }
 }
 
@@ -154,6 +216,29 @@ pub fn ext(p: &Path) -> String {
     p.extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default()
+}
+
+/// Lower-case file name → first path in the walk order of [`Project::find_by_name`]. A
+/// folder that cannot be listed ends the walk: a search by name never looked past it.
+fn index_by_name(dir: &Path) -> HashMap<String, PathBuf> {
+    let mut index = HashMap::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        let Ok(rd) = std::fs::read_dir(&d) else {
+            break;
+        };
+        let mut entries: Vec<_> = rd.filter_map(Result::ok).map(|e| e.path()).collect();
+        entries.sort();
+        for p in entries {
+            if p.is_dir() {
+                stack.push(p);
+            } else if let Some(f) = p.file_name() {
+                let key = f.to_string_lossy().to_ascii_lowercase();
+                index.entry(key).or_insert(p);
+            }
+        }
+    }
+    index
 }
 
 fn guids_in(text: &str) -> impl Iterator<Item = &str> {

@@ -1,6 +1,5 @@
 //! Tiny Unity projects written into temporary folders: a few lines of YAML per object,
 //! the way Unity writes them.
-#![allow(dead_code)]
 
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
@@ -143,6 +142,12 @@ pub fn project(files: &[(&str, &str)]) -> (tempfile::TempDir, PathBuf) {
 
 pub fn convert(scene: &Path) -> formats::Soup {
     unity::convert(scene, &unity::Options::default()).unwrap()
+}
+
+/// Convert a scene that needs no other file of its project.
+pub fn convert_scene(text: &str) -> formats::Soup {
+    let (_d, root) = project(&[("Assets/s.unity", text)]);
+    convert(&root.join("Assets/s.unity"))
 }
 
 pub fn bounds(pts: impl Iterator<Item = glam::Vec3>) -> (glam::Vec3, glam::Vec3) {

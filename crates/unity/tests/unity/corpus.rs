@@ -13,6 +13,7 @@
 //! * Lights: enabled Light components of type 0–2 on active objects. Cameras: enabled
 //!   Camera components on active objects.
 
+use crate::support::bounds;
 use glam::Vec3;
 use std::path::{Path, PathBuf};
 
@@ -33,6 +34,11 @@ fn corpus() -> Option<PathBuf> {
         );
         None
     }
+}
+
+/// The soup of a corpus scene (path relative to the corpus), `None` without the corpus.
+fn corpus_soup(scene: &str) -> Option<formats::Soup> {
+    corpus().map(|root| report(&root.join(scene)).soup)
 }
 
 fn report(path: &Path) -> unity::Report {
@@ -191,21 +197,21 @@ fn object_bounds(soup: &formats::Soup, name: &str) -> (Vec3, Vec3) {
                 soup.objects.iter().map(|o| &o.name).collect::<Vec<_>>()
             )
         });
-    soup.triangles
-        .iter()
-        .zip(&soup.tri_object)
-        .filter(|(_, &o)| o as usize == idx)
-        .flat_map(|(t, _)| t.iter().copied())
-        .fold(
-            (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
-            |(lo, hi), p| (lo.min(p), hi.max(p)),
-        )
+    bounds(
+        soup.triangles
+            .iter()
+            .zip(&soup.tri_object)
+            .filter(|(_, &o)| o as usize == idx)
+            .flat_map(|(t, _)| t.iter().copied()),
+    )
 }
 
-fn assert_box(got: (Vec3, Vec3), lo: Vec3, hi: Vec3, eps: f32, what: &str) {
+/// The world box of object `name` is `lo … hi` within `eps`.
+fn assert_box(soup: &formats::Soup, name: &str, lo: Vec3, hi: Vec3, eps: f32) {
+    let got = object_bounds(soup, name);
     assert!(
         (got.0 - lo).abs().max_element() < eps && (got.1 - hi).abs().max_element() < eps,
-        "{what}: got {:?}, expected {lo} … {hi}",
+        "{name}: got {:?}, expected {lo} … {hi}",
         got
     );
 }
@@ -222,29 +228,31 @@ fn eotf(c: f32) -> f32 {
 #[test]
 #[allow(clippy::excessive_precision)] // values as computed by hand
 fn mesh_to_svg_prefab_instance_of_multi_group_obj() {
-    let Some(root) = corpus() else { return };
     // cubescene: PrefabInstance of multcoloredcube2.obj; root Transform 400012 moved to
     // (30.91, 390.74, −446.33), rotated q = (0.16436426, −0.68089753, −0.16095737,
     // −0.69530976). Group Cube_Cube.000 uses 4 vertices of the file; each was taken
     // (x, y, z) → Unity (−x, y, z) → q·v·q⁻¹ + T → soup (−x, y, z), by hand in a
     // 15-line Python script: box (−32.40334, 390.444_8, −444.35446) …
     // (−29.7201, 393.1286, −444.29826).
-    let soup =
-        report(&root.join("VidarUre__MeshToSvgConverter/Assets/Scenes/cubescene.unity")).soup;
-    let b = object_bounds(&soup, "multcoloredcube2/Cube_Cube.000");
+    let Some(soup) = corpus_soup("VidarUre__MeshToSvgConverter/Assets/Scenes/cubescene.unity")
+    else {
+        return;
+    };
     assert_box(
-        b,
+        &soup,
+        "multcoloredcube2/Cube_Cube.000",
         Vec3::new(-32.40334, 390.444_8, -444.35446),
         Vec3::new(-29.7201, 393.1286, -444.29826),
         1e-3,
-        "Cube_Cube.000",
     );
 
     // terrainscene: renderer 2300000 (group Earth_Plane.108, 2048 faces) has its material
     // overridden by the scene-embedded Material 525343101 (_Color sRGB (0.64, 0.295121,
     // 0.048366), _Glossiness 0, _Metallic 0).
-    let soup =
-        report(&root.join("VidarUre__MeshToSvgConverter/Assets/Scenes/terrainscene.unity")).soup;
+    let Some(soup) = corpus_soup("VidarUre__MeshToSvgConverter/Assets/Scenes/terrainscene.unity")
+    else {
+        return;
+    };
     let idx = soup
         .objects
         .iter()
@@ -275,7 +283,6 @@ fn mesh_to_svg_prefab_instance_of_multi_group_obj() {
 
 #[test]
 fn compute_shader_bvh_parented_scaled_obj() {
-    let Some(root) = corpus() else { return };
     // Meshs (identity) / bunny: position (1, −1.72, 0), rotation (0, 1, 0, 0) = 180°
     // about Y, scale 50, MeshFilter → bunny.obj by hashed fileID. A file vertex (x, y, z)
     // imports as (−x, y, z), turns to (x, y, −z), scales and moves to
@@ -283,40 +290,42 @@ fn compute_shader_bvh_parented_scaled_obj() {
     // File bounds: x [−0.09438042, 0.0607788], y [0.0333099, 0.18699602],
     // z [−0.06167917, 0.05871464] → soup x [−4.03894, 3.719021], y [−0.054505, 7.629801],
     // z [−2.935732, 3.0839585].
-    let soup =
-        report(&root.join("fuqunaga__ComputeShaderBVHMeshHit/Assets/Scenes/SampleScene.unity"))
-            .soup;
-    let b = object_bounds(&soup, "Meshs/bunny");
+    let Some(soup) =
+        corpus_soup("fuqunaga__ComputeShaderBVHMeshHit/Assets/Scenes/SampleScene.unity")
+    else {
+        return;
+    };
     assert_box(
-        b,
+        &soup,
+        "Meshs/bunny",
         Vec3::new(-4.03894, -0.054505, -2.935732),
         Vec3::new(3.719021, 7.629801, 3.0839585),
         1e-4,
-        "bunny",
     );
 }
 
 #[test]
 fn cube_room_capture_legacy_prefab_scene() {
-    let Some(root) = corpus() else { return };
     // wall (identity) / mesh (scale x 0.66) / inner → wall.obj 4300000 = group Mesh1, one
     // quad at z = 0 with x ∈ [−3, 3], y ∈ [0, 6]: x scales to ±1.98 (symmetric, so the
     // two x negations do not show). outter → 4300002 = Mesh2, five quads over all
     // 8 vertices: z ∈ [−0.2, 0].
-    let soup = report(&root.join("jonike__CubeRoom/Assets/Scenes/Capture.unity")).soup;
+    let Some(soup) = corpus_soup("jonike__CubeRoom/Assets/Scenes/Capture.unity") else {
+        return;
+    };
     assert_box(
-        object_bounds(&soup, "wall/mesh/inner"),
+        &soup,
+        "wall/mesh/inner",
         Vec3::new(-1.98, 0.0, 0.0),
         Vec3::new(1.98, 6.0, 0.0),
         1e-5,
-        "inner",
     );
     assert_box(
-        object_bounds(&soup, "wall/mesh/outter"),
+        &soup,
+        "wall/mesh/outter",
         Vec3::new(-1.98, 0.0, -0.2),
         Vec3::new(1.98, 6.0, 0.0),
         1e-5,
-        "outter",
     );
     // The camera is orthographic.
     assert!(matches!(
@@ -327,33 +336,34 @@ fn cube_room_capture_legacy_prefab_scene() {
 
 #[test]
 fn rigidbody_fracture_unity6_bounds() {
-    let Some(root) = corpus() else { return };
     // Unity 6 scene (SceneRoots). "Cube (4)": position (−1.5, −0.6, 1.5), unit scale →
     // Unity box [−2, −1.1, 1] … [−1, −0.1, 2] → soup x negated: [1, −1.1, 1] … [2, −0.1, 2].
     // "Sphere": (0, 3, 1.5), scale 0.3 → radius 0.15. "Cube": origin, scale (3, 0.1, 3).
-    let soup =
-        report(&root.join("Ayinzhang__Rigidbody-Fracture/Assets/Scenes/RigidbodyFracture.unity"))
-            .soup;
+    let Some(soup) =
+        corpus_soup("Ayinzhang__Rigidbody-Fracture/Assets/Scenes/RigidbodyFracture.unity")
+    else {
+        return;
+    };
     assert_box(
-        object_bounds(&soup, "Cube (4)"),
+        &soup,
+        "Cube (4)",
         Vec3::new(1.0, -1.1, 1.0),
         Vec3::new(2.0, -0.1, 2.0),
         1e-5,
-        "Cube (4)",
     );
     assert_box(
-        object_bounds(&soup, "Sphere"),
+        &soup,
+        "Sphere",
         Vec3::new(-0.15, 2.85, 1.35),
         Vec3::new(0.15, 3.15, 1.65),
         1e-5,
-        "Sphere",
     );
     assert_box(
-        object_bounds(&soup, "Cube"),
+        &soup,
+        "Cube",
         Vec3::new(-1.5, -0.05, -1.5),
         Vec3::new(1.5, 0.05, 1.5),
         1e-5,
-        "Cube",
     );
     // Camera at (0, 1, −10) with identity rotation: soup forward +Z, right = −X.
     assert_eq!(soup.camera.position, Vec3::new(0.0, 1.0, -10.0));
@@ -388,7 +398,7 @@ fn legacy_material_with_repeated_data_keys() {
     let text = std::fs::read_to_string(&p).unwrap();
     let doc = unity::docs::split(&text)
         .into_iter()
-        .find(|d| d.class == 21)
+        .find(|d| d.class == unity::docs::MATERIAL)
         .unwrap();
     let (m, _) = unity::material::convert(&doc.parse(), "mat_fence_02.mat");
     assert_eq!(m.name, "mat_fence_02");

@@ -1,10 +1,8 @@
 //! The `unity2soup` and `soup2obj` binaries: arguments, JSON summary, exit codes, and
 //! the OBJ export's layout.
 
-mod support;
-
+use crate::support::*;
 use std::process::Command;
-use support::*;
 
 fn scene() -> (tempfile::TempDir, std::path::PathBuf) {
     let mut sc = Scene::default();

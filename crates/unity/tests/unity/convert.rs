@@ -1,17 +1,59 @@
 //! unity2soup on tiny hand-written projects: coordinates, handedness, hierarchy,
 //! primitives, fileID schemes, prefab instances, visibility, lights and camera.
 
-mod support;
-
+use crate::support::*;
 use formats::{LightKind, Shadows};
 use glam::Vec3;
 use std::f32::consts::FRAC_1_SQRT_2;
-use support::*;
+use std::path::{Path, PathBuf};
 
 const OBJ_GUID: &str = "a1b2c3d4e5f60718293a4b5c6d7e8f90";
 
 /// A triangle and a quad (two triangles) in a right-handed OBJ, normals along +Z.
 const OBJ: &str = "v 1 2 3\nv 4 2 3\nv 1 5 3\nv 10 0 -1\nv 11 0 -1\nv 11 1 -1\nv 10 1 -1\nvn 0 0 1\ng default\nf 1//1 2//1 3//1\nf 4//1 5//1 6//1 7//1\n";
+
+/// Default-Material, the slot every test model object uses.
+const DEFAULT_MAT: (i64, &str) = (10303, "0000000000000000f000000000000000");
+
+/// A scene whose one GameObject `name`, at the origin, draws the `default` mesh of the
+/// model `OBJ_GUID` with Default-Material.
+fn model_scene(name: &str) -> Scene {
+    mesh_scene(name, 4300000, OBJ_GUID, &[DEFAULT_MAT])
+}
+
+/// A scene whose one GameObject `name`, at the origin, draws mesh `mesh_id` of asset
+/// `guid` with `materials`.
+fn mesh_scene(name: &str, mesh_id: i64, guid: &str, materials: &[(i64, &str)]) -> Scene {
+    let mut sc = Scene::default();
+    let (go, _) = sc.object(name, &Tf::at(0.0, 0.0, 0.0), 0, true);
+    sc.mesh(go, mesh_id, guid, materials, true);
+    sc
+}
+
+/// A project holding the OBJ text `obj` at `obj_path` (its legacy `.meta` names the one
+/// mesh `default`) and `scene_text` at `scene_path`; returns the scene's path.
+fn obj_project(
+    obj_path: &str,
+    obj: &str,
+    scene_path: &str,
+    scene_text: &str,
+) -> (tempfile::TempDir, PathBuf) {
+    let meta = legacy_meta(OBJ_GUID, &["default"]);
+    let meta_path = format!("{obj_path}.meta");
+    let (d, root) = project(&[
+        (obj_path, obj),
+        (&meta_path, &meta),
+        (scene_path, scene_text),
+    ]);
+    (d, root.join(scene_path))
+}
+
+/// The error converting `scene`, as one line.
+fn convert_error(scene: &Path) -> String {
+    unity::convert(scene, &unity::Options::default())
+        .unwrap_err()
+        .to_string()
+}
 
 fn legacy_meta(guid: &str, names: &[&str]) -> String {
     let mut s = format!("fileFormatVersion: 2\nguid: {guid}\nModelImporter:\n  serializedVersion: 23\n  fileIDToRecycleName:\n    100000: //RootNode\n    400000: //RootNode\n");
@@ -30,21 +72,9 @@ fn legacy_meta(guid: &str, names: &[&str]) -> String {
 
 #[test]
 fn obj_at_identity_keeps_its_file_coordinates_and_winding() {
-    let mut sc = Scene::default();
-    let (go, _) = sc.object("Model", &Tf::at(0.0, 0.0, 0.0), 0, true);
-    sc.mesh(
-        go,
-        4300000,
-        OBJ_GUID,
-        &[(10303, "0000000000000000f000000000000000")],
-        true,
-    );
-    let (_d, root) = project(&[
-        ("Assets/m.obj", OBJ),
-        ("Assets/m.obj.meta", &legacy_meta(OBJ_GUID, &["default"])),
-        ("Assets/s.unity", &sc.text),
-    ]);
-    let soup = convert(&root.join("Assets/s.unity"));
+    let sc = model_scene("Model");
+    let (_d, scene) = obj_project("Assets/m.obj", OBJ, "Assets/s.unity", &sc.text);
+    let soup = convert(&scene);
     let v = |x, y, z| Vec3::new(x, y, z);
     assert_eq!(
         soup.triangles,
@@ -71,8 +101,7 @@ fn object_at_unity_plus_x_is_right_of_the_camera() {
     let mut sc = Scene::default();
     sc.camera(&Tf::at(0.0, 0.0, 0.0));
     sc.primitive("Right", &Tf::at(3.0, 0.0, 10.0), 0, CUBE);
-    let (_d, root) = project(&[("Assets/s.unity", &sc.text)]);
-    let soup = convert(&root.join("Assets/s.unity"));
+    let soup = convert_scene(&sc.text);
     let cam = &soup.camera;
     assert_eq!(cam.forward, Vec3::Z);
     assert_eq!(cam.up, Vec3::Y);
@@ -127,8 +156,7 @@ fn primitives_have_unity_dimensions() {
     for (id, name, tris, lo, hi) in cases {
         let mut sc = Scene::default();
         sc.primitive(name, &Tf::at(0.0, 0.0, 0.0), 0, id);
-        let (_d, root) = project(&[("Assets/s.unity", &sc.text)]);
-        let soup = convert(&root.join("Assets/s.unity"));
+        let soup = convert_scene(&sc.text);
         if tris > 0 {
             assert_eq!(soup.triangles.len(), tris, "{name}");
         }
@@ -151,8 +179,7 @@ fn primitives_have_unity_dimensions() {
     let facing = |id: i64| {
         let mut sc = Scene::default();
         sc.primitive("P", &Tf::at(0.0, 0.0, 0.0), 0, id);
-        let (_d, root) = project(&[("Assets/s.unity", &sc.text)]);
-        let soup = convert(&root.join("Assets/s.unity"));
+        let soup = convert_scene(&sc.text);
         let t = soup.triangles[0];
         (t[1] - t[0]).cross(t[2] - t[0]).normalize()
     };
@@ -177,8 +204,7 @@ fn negative_scale_mirrors_and_keeps_faces_outward() {
         0,
         CUBE,
     );
-    let (_d, root) = project(&[("Assets/s.unity", &sc.text)]);
-    let soup = convert(&root.join("Assets/s.unity"));
+    let soup = convert_scene(&sc.text);
     for (i, (t, n)) in soup.triangles.iter().zip(&soup.normals).enumerate() {
         let g = (t[1] - t[0]).cross(t[2] - t[0]).normalize();
         assert!(
@@ -235,8 +261,7 @@ fn parented_rotated_scaled_hierarchy() {
         p2,
         CUBE,
     );
-    let (_d, root) = project(&[("Assets/s.unity", &sc.text)]);
-    let soup = convert(&root.join("Assets/s.unity"));
+    let soup = convert_scene(&sc.text);
     assert_eq!(soup.objects[0].name, "Parent/Child");
     let pts = |o: u32| {
         soup.triangles
@@ -267,8 +292,7 @@ fn inactive_parents_and_disabled_renderers_draw_nothing() {
     let (go, _) = sc.object("Disabled", &Tf::at(0.0, 0.0, 0.0), 0, true);
     sc.mesh(go, CUBE, BUILTIN, &[], false);
     sc.primitive("Shown", &Tf::at(0.0, 0.0, 0.0), 0, SPHERE);
-    let (_d, root) = project(&[("Assets/s.unity", &sc.text)]);
-    let soup = convert(&root.join("Assets/s.unity"));
+    let soup = convert_scene(&sc.text);
     assert_eq!(soup.objects.len(), 1);
     assert_eq!(soup.objects[0].name, "Shown");
 }
@@ -286,8 +310,7 @@ fn lights_convert_position_direction_colour_and_shadows() {
     sc.light(&Tf::at(0.0, 5.0, 0.0), 2, [1.0, 1.0, 1.0], 1);
     sc.light(&Tf::at(0.0, 0.0, 0.0), 1, [1.0, 1.0, 1.0], 0);
     sc.light(&Tf::at(0.0, 0.0, 0.0), 3, [1.0, 1.0, 1.0], 0);
-    let (_d, root) = project(&[("Assets/s.unity", &sc.text)]);
-    let soup = convert(&root.join("Assets/s.unity"));
+    let soup = convert_scene(&sc.text);
     assert_eq!(soup.lights.len(), 3, "the area light is skipped");
     let spot = &soup.lights[0];
     assert_eq!(
@@ -322,25 +345,28 @@ fn lights_convert_position_direction_colour_and_shadows() {
 const TWO_GROUPS: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 5 0 0\nv 6 0 0\nv 5 1 0\nmtllib two.mtl\ng A\nusemtl red\nf 1 2 3\ng B\nusemtl green\nf 4 5 6\n";
 const TWO_MTL: &str = "newmtl red\nKd 1 0 0\nnewmtl green\nKd 0 1 0\n";
 
-#[test]
-fn legacy_table_resolves_sub_meshes_by_name() {
-    let mut sc = Scene::default();
-    let (go, _) = sc.object("B", &Tf::at(0.0, 0.0, 0.0), 0, true);
-    // 4300002 is `B` in the table (4300000 is `A`).
-    sc.mesh(
-        go,
-        4300002,
-        OBJ_GUID,
-        &[(2100000, "ffffffffffffffffffffffffffffffff")],
-        true,
-    );
+/// Convert `scene_text` in a project holding two.obj, its `.mtl`, and a legacy `.meta`
+/// naming the groups A and B.
+fn convert_beside_two_groups(scene_text: &str) -> formats::Soup {
     let (_d, root) = project(&[
         ("Assets/two.obj", TWO_GROUPS),
         ("Assets/two.mtl", TWO_MTL),
         ("Assets/two.obj.meta", &legacy_meta(OBJ_GUID, &["A", "B"])),
-        ("Assets/s.unity", &sc.text),
+        ("Assets/s.unity", scene_text),
     ]);
-    let soup = convert(&root.join("Assets/s.unity"));
+    convert(&root.join("Assets/s.unity"))
+}
+
+#[test]
+fn legacy_table_resolves_sub_meshes_by_name() {
+    // 4300002 is `B` in the table (4300000 is `A`).
+    let sc = mesh_scene(
+        "B",
+        4300002,
+        OBJ_GUID,
+        &[(2100000, "ffffffffffffffffffffffffffffffff")],
+    );
+    let soup = convert_beside_two_groups(&sc.text);
     assert_eq!(soup.triangles.len(), 1);
     assert_eq!(soup.triangles[0][0], Vec3::new(5.0, 0.0, 0.0));
     assert_eq!(soup.objects[0].source, "Assets/two.obj#B");
@@ -358,15 +384,11 @@ fn gen2_meta(guid: &str) -> String {
 
 #[test]
 fn file_ids_generation_2_resolves_hashed_ids() {
-    let mut sc = Scene::default();
-    let (go, _) = sc.object("B", &Tf::at(0.0, 0.0, 0.0), 0, true);
-    let default_mat = (10303, "0000000000000000f000000000000000");
-    sc.mesh(
-        go,
+    let mut sc = mesh_scene(
+        "B",
         unity::meta::hash_id("Type:Mesh->B0"),
         OBJ_GUID,
-        &[default_mat],
-        true,
+        &[DEFAULT_MAT],
     );
     // A renderer without material slots draws nothing.
     let (go2, _) = sc.object("NoSlots", &Tf::at(0.0, 0.0, 0.0), 0, true);
@@ -441,17 +463,9 @@ fn prefab_instance_of_an_obj_model_applies_modifications() {
 #[test]
 fn model_materials_take_the_mtl_colour() {
     // A legacy MeshFilter on group A; its renderer uses the model's internal material.
-    let mut sc = Scene::default();
-    let (go, _) = sc.object("A", &Tf::at(0.0, 0.0, 0.0), 0, true);
     let mat_id = unity::meta::hash_id("Type:Material->red0");
-    sc.mesh(go, 4300000, OBJ_GUID, &[(mat_id, OBJ_GUID)], true);
-    let (_d, root) = project(&[
-        ("Assets/two.obj", TWO_GROUPS),
-        ("Assets/two.mtl", TWO_MTL),
-        ("Assets/two.obj.meta", &legacy_meta(OBJ_GUID, &["A", "B"])),
-        ("Assets/s.unity", &sc.text),
-    ]);
-    let soup = convert(&root.join("Assets/s.unity"));
+    let sc = mesh_scene("A", 4300000, OBJ_GUID, &[(mat_id, OBJ_GUID)]);
+    let soup = convert_beside_two_groups(&sc.text);
     assert_eq!(soup.materials.len(), 1);
     assert_eq!(soup.materials[0].color, Vec3::X);
     assert_eq!(soup.materials[0].source, "Assets/two.obj#red");
@@ -459,20 +473,19 @@ fn model_materials_take_the_mtl_colour() {
 
 #[test]
 fn unresolved_mesh_falls_back_to_the_object_name() {
-    let mut sc = Scene::default();
-    let (go, _) = sc.object("m", &Tf::at(0.0, 0.0, 0.0), 0, true);
-    sc.mesh(
-        go,
+    let sc = mesh_scene(
+        "m",
         4300000,
         "99999999999999999999999999999999",
-        &[(10303, "0000000000000000f000000000000000")],
-        true,
+        &[DEFAULT_MAT],
     );
     let (_d, root) = project(&[("Assets/Models/m.obj", OBJ), ("Assets/s.unity", &sc.text)]);
     let soup = convert(&root.join("Assets/s.unity"));
     assert_eq!(soup.triangles.len(), 3);
     assert!(
-        soup.warnings.iter().any(|w| w.contains("seed's fallback")),
+        soup.warnings
+            .iter()
+            .any(|w| w.contains("found by the object's name")),
         "{:?}",
         soup.warnings
     );
@@ -481,8 +494,7 @@ fn unresolved_mesh_falls_back_to_the_object_name() {
 #[test]
 fn binary_scene_is_refused() {
     let (_d, root) = project(&[("Assets/s.unity", "\0\0\u{2e}K\0\0\u{36}\u{c}\0\0\0\u{f}")]);
-    let err = unity::convert(&root.join("Assets/s.unity"), &unity::Options::default()).unwrap_err();
-    let msg = err.to_string();
+    let msg = convert_error(&root.join("Assets/s.unity"));
     assert!(
         msg.contains("binary") && msg.contains("Force Text"),
         "{msg}"
@@ -494,28 +506,16 @@ fn non_finite_transform_is_an_error_naming_the_object() {
     let mut sc = Scene::default();
     sc.primitive("Broken", &Tf::at(f32::NAN, 0.0, 0.0), 0, CUBE);
     let (_d, root) = project(&[("Assets/s.unity", &sc.text)]);
-    let err = unity::convert(&root.join("Assets/s.unity"), &unity::Options::default()).unwrap_err();
-    assert!(err.to_string().contains("'Broken'"), "{err}");
+    let err = convert_error(&root.join("Assets/s.unity"));
+    assert!(err.contains("'Broken'"), "{err}");
 }
 
 #[test]
 fn degenerate_triangles_are_dropped_and_counted() {
     let obj = "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\nf 1 1 4\n";
-    let mut sc = Scene::default();
-    let (go, _) = sc.object("D", &Tf::at(0.0, 0.0, 0.0), 0, true);
-    sc.mesh(
-        go,
-        4300000,
-        OBJ_GUID,
-        &[(10303, "0000000000000000f000000000000000")],
-        true,
-    );
-    let (_d, root) = project(&[
-        ("Assets/d.obj", obj),
-        ("Assets/d.obj.meta", &legacy_meta(OBJ_GUID, &["default"])),
-        ("Assets/s.unity", &sc.text),
-    ]);
-    let soup = convert(&root.join("Assets/s.unity"));
+    let sc = model_scene("D");
+    let (_d, scene) = obj_project("Assets/d.obj", obj, "Assets/s.unity", &sc.text);
+    let soup = convert(&scene);
     assert_eq!(soup.triangles.len(), 1);
     assert_eq!(soup.dropped_degenerate, 2);
 }
@@ -541,13 +541,7 @@ fn nested_prefabs_apply_overrides_outermost_last() {
     let outer_guid = "b0000000000000000000000000000002";
     let mut base = Scene::default();
     base.raw("--- !u!1 &100\nGameObject:\n  m_Name: Base\n  m_IsActive: 1\n--- !u!4 &400\nTransform:\n  m_GameObject: {fileID: 100}\n  m_LocalRotation: {x: 0, y: 0, z: 0, w: 1}\n  m_LocalPosition: {x: 0, y: 0, z: 0}\n  m_LocalScale: {x: 1, y: 1, z: 1}\n  m_Father: {fileID: 0}\n--- !u!1 &101\nGameObject:\n  m_Name: Box\n  m_IsActive: 1\n--- !u!4 &401\nTransform:\n  m_GameObject: {fileID: 101}\n  m_LocalRotation: {x: 0, y: 0, z: 0, w: 1}\n  m_LocalPosition: {x: 1, y: 0, z: 0}\n  m_LocalScale: {x: 1, y: 1, z: 1}\n  m_Father: {fileID: 400}\n");
-    base.mesh(
-        101,
-        CUBE,
-        BUILTIN,
-        &[(10303, "0000000000000000f000000000000000")],
-        true,
-    );
+    base.mesh(101, CUBE, BUILTIN, &[DEFAULT_MAT], true);
     // Outer.prefab: root "Outer" (Transform 410) holding an instance 900 of Base that
     // moves Box to x = 2 (the stripped 920 stands for Base's root, parented under 410).
     let mut outer = Scene::default();
@@ -587,8 +581,7 @@ fn children_of_a_missing_prefab_keep_its_placement() {
     let mut sc = Scene::default();
     sc.raw(&format!("--- !u!1001 &700\nPrefab:\n  m_Modification:\n    m_TransformParent: {{fileID: 0}}\n    m_Modifications:\n    - target: {{fileID: 400000, guid: {g}, type: 3}}\n      propertyPath: m_LocalPosition.x\n      value: 4\n      objectReference: {{fileID: 0}}\n    - target: {{fileID: 400000, guid: {g}, type: 3}}\n      propertyPath: m_LocalScale.x\n      value: 2\n      objectReference: {{fileID: 0}}\n    - target: {{fileID: 400000, guid: {g}, type: 3}}\n      propertyPath: m_LocalScale.y\n      value: 2\n      objectReference: {{fileID: 0}}\n    - target: {{fileID: 400000, guid: {g}, type: 3}}\n      propertyPath: m_LocalScale.z\n      value: 2\n      objectReference: {{fileID: 0}}\n  m_ParentPrefab: {{fileID: 100100000, guid: {g}, type: 3}}\n  m_IsPrefabParent: 0\n--- !u!4 &701 stripped\nTransform:\n  m_PrefabParentObject: {{fileID: 400000, guid: {g}, type: 3}}\n  m_PrefabInternal: {{fileID: 700}}\n"));
     sc.primitive("Child", &Tf::at(1.0, 0.0, 0.0), 701, CUBE);
-    let (_d, root) = project(&[("Assets/s.unity", &sc.text)]);
-    let soup = convert(&root.join("Assets/s.unity"));
+    let soup = convert_scene(&sc.text);
     let (lo, hi) = bounds(soup.triangles.iter().flatten().copied());
     assert!(
         close(lo, Vec3::new(-7.0, -1.0, -1.0), 1e-5) && close(hi, Vec3::new(-5.0, 1.0, 1.0), 1e-5),
@@ -603,22 +596,9 @@ fn children_of_a_missing_prefab_keep_its_placement() {
 #[test]
 fn non_finite_obj_vertex_is_an_error_naming_the_object() {
     let obj = "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n";
-    let mut sc = Scene::default();
-    let (go, _) = sc.object("Bad Mesh", &Tf::at(0.0, 0.0, 0.0), 0, true);
-    sc.mesh(
-        go,
-        4300000,
-        OBJ_GUID,
-        &[(10303, "0000000000000000f000000000000000")],
-        true,
-    );
-    let (_d, root) = project(&[
-        ("Assets/n.obj", obj),
-        ("Assets/n.obj.meta", &legacy_meta(OBJ_GUID, &["default"])),
-        ("Assets/s.unity", &sc.text),
-    ]);
-    let err = unity::convert(&root.join("Assets/s.unity"), &unity::Options::default()).unwrap_err();
-    let msg = err.to_string();
+    let sc = model_scene("Bad Mesh");
+    let (_d, scene) = obj_project("Assets/n.obj", obj, "Assets/s.unity", &sc.text);
+    let msg = convert_error(&scene);
     assert!(msg.contains("'Bad Mesh'") && msg.contains("NaN"), "{msg}");
 }
 
@@ -668,24 +648,14 @@ fn removed_components_and_game_objects_draw_nothing() {
 
 #[test]
 fn project_root_is_found_or_given() {
-    let mut sc = Scene::default();
-    let (go, _) = sc.object("Model", &Tf::at(0.0, 0.0, 0.0), 0, true);
-    sc.mesh(
-        go,
-        4300000,
-        OBJ_GUID,
-        &[(10303, "0000000000000000f000000000000000")],
-        true,
+    let sc = model_scene("Model");
+    let (d, scene) = obj_project(
+        "Assets/Deep/m.obj",
+        OBJ,
+        "Assets/Scenes/Sub/s.unity",
+        &sc.text,
     );
-    let (_d, root) = project(&[
-        ("Assets/Deep/m.obj", OBJ),
-        (
-            "Assets/Deep/m.obj.meta",
-            &legacy_meta(OBJ_GUID, &["default"]),
-        ),
-        ("Assets/Scenes/Sub/s.unity", &sc.text),
-    ]);
-    let scene = root.join("Assets/Scenes/Sub/s.unity");
+    let root = d.path().to_path_buf();
     let found = convert(&scene);
     assert_eq!(found.triangles.len(), 3);
     for given in [root.clone(), root.join("Assets")] {
@@ -701,6 +671,6 @@ fn project_root_is_found_or_given() {
     // A scene outside any project.
     let lone = tempfile::tempdir().unwrap();
     std::fs::write(lone.path().join("s.unity"), &sc.text).unwrap();
-    let err = unity::convert(&lone.path().join("s.unity"), &unity::Options::default()).unwrap_err();
-    assert!(err.to_string().contains("--assets"), "{err}");
+    let err = convert_error(&lone.path().join("s.unity"));
+    assert!(err.contains("--assets"), "{err}");
 }

@@ -1,0 +1,87 @@
+//! Camera (class 20) → the soup's camera and the environment's clear flags and
+//! background: the Game view's camera among the scene's enabled ones.
+
+use crate::emit::{flip, EmitError, Emitter};
+use crate::material::linear_rgb;
+use crate::reference::fref;
+use crate::yaml::Node;
+use formats::{Camera, ClearFlags, Projection};
+use glam::{Mat4, Vec3, Vec4Swizzles};
+
+/// The camera a body and world transform describe; `None` when its orientation is
+/// degenerate.
+pub fn convert(b: &Node, world: Mat4, name: String) -> Option<Camera> {
+    let forward = flip(world.transform_vector3(Vec3::Z)).normalize_or_zero();
+    let up0 = flip(world.transform_vector3(Vec3::Y));
+    let up = (up0 - forward * up0.dot(forward)).normalize_or_zero();
+    if forward == Vec3::ZERO || up == Vec3::ZERO {
+        return None;
+    }
+    let projection = if b.i64_at("orthographic") == Some(1) {
+        Projection::Orthographic {
+            half_height: b.f32_at("orthographic size").unwrap_or(5.0),
+        }
+    } else {
+        Projection::Perspective {
+            fov_y: b.f32_at("field of view").unwrap_or(60.0),
+        }
+    };
+    Some(Camera {
+        name,
+        position: flip(world.w_axis.xyz()),
+        forward,
+        up,
+        projection,
+        near: b.f32_at("near clip plane").unwrap_or(0.3),
+    })
+}
+
+/// What the camera clears to: the skybox (`m_ClearFlags` 1) or a solid colour.
+pub fn clear_flags(b: &Node) -> ClearFlags {
+    if b.i64_at("m_ClearFlags").unwrap_or(1) == 1 {
+        ClearFlags::Skybox
+    } else {
+        ClearFlags::SolidColor
+    }
+}
+
+impl Emitter<'_, '_> {
+    /// The soup's camera from the enabled `(GameObject, Camera)` pairs.
+    pub(crate) fn camera(&mut self, cams: &[(usize, usize)]) -> Result<(), EmitError> {
+        let (g, scene_rel) = (self.g, self.scene_rel);
+        let depth = |c: usize| g.objs[c].body.f32_at("m_Depth").unwrap_or(0.0);
+        // The Game view shows the display cameras; the highest depth draws last.
+        let display: Vec<&(usize, usize)> = cams
+            .iter()
+            .filter(|(_, c)| fref(g.objs[*c].body.get("m_TargetTexture")).0 == 0)
+            .collect();
+        let mut best: Option<&(usize, usize)> = None;
+        for c in &display {
+            if best.is_none_or(|b| depth(c.1) > depth(b.1)) {
+                best = Some(c);
+            }
+        }
+        let Some(&(go, c)) = best else {
+            self.soup.warnings.push(format!("{scene_rel}: no enabled camera renders to the display; Unity's default camera used"));
+            return Ok(());
+        };
+        if display.len() > 1 {
+            self.soup.warnings.push(format!(
+                "{scene_rel}: {} enabled cameras; using '{}' (highest depth, first in the file)",
+                display.len(),
+                self.path(go)
+            ));
+        }
+        let b = &g.objs[c].body;
+        let world = self.checked_world(go)?;
+        let Some(camera) = convert(b, world, self.path(go)) else {
+            return Err(self.non_finite(go, "camera orientation is degenerate".into()));
+        };
+        self.soup.camera = camera;
+        self.soup.environment.clear = clear_flags(b);
+        if let Some(bg) = b.get("m_BackGroundColor").and_then(Node::color) {
+            self.soup.environment.background = linear_rgb(bg);
+        }
+        Ok(())
+    }
+}
