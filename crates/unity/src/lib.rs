@@ -9,6 +9,7 @@
 pub mod docs;
 pub mod embedded;
 pub mod emit;
+pub mod fbx;
 pub mod graph;
 pub mod material;
 pub mod mesh;
