@@ -9,7 +9,7 @@
 //!
 //! * units: positions and translations (never node scales) times the import scale,
 //!   `UnitScaleFactor / 100 · globalScale` with `useFileScale: 1`, else `globalScale`;
-//! * axes: the rotation from the file's axis system to Y-up, either on the root node
+//! * axes: the rotation from the file's axis system to Unity's, either on the root node
 //!   (`bakeAxisConversion: 0`) or conjugated through every node and vertex (`1`);
 //! * handedness: X negated (positions, normals, translations; rotations as
 //!   (x, −y, −z, w)) and every triangle's winding reversed, as for OBJ.
@@ -95,7 +95,8 @@ fn load_opts(file_len: usize) -> ufbx::LoadOpts<'static> {
 struct Importer {
     /// Metres per file unit as Unity scales it.
     scale: f64,
-    /// File axes → Y-up (a signed permutation; identity for Y-up files).
+    /// File axes → Unity's before the mirror (a signed permutation; identity for Y-up
+    /// files).
     axes: DQuat,
     axes_mat: DMat3,
     /// `bakeAxisConversion: 1`.
@@ -166,7 +167,14 @@ impl Importer {
         let rows = [ax.right, ax.up, ax.front].map(axis_vec);
         let (mut axes, mut axes_mat) = (DQuat::IDENTITY, DMat3::IDENTITY);
         if let [Some(r), Some(u), Some(f)] = rows {
-            let m = DMat3::from_cols(r, u, f).transpose();
+            let mut m = DMat3::from_cols(r, u, f).transpose();
+            if m != DMat3::IDENTITY {
+                // Unity turns a converted file half a turn about Y on top: Unity-fitted
+                // colliders on 3ds Max Z-up files (bakeAxisConversion 1) put file
+                // (x, y, z) at Unity (x, z, y), where "front to +Z, then mirror X" would
+                // give (−x, z, −y).
+                m = DMat3::from_diagonal(DVec3::new(-1.0, 1.0, -1.0)) * m;
+            }
             if (m.determinant() - 1.0).abs() < 1e-6 {
                 axes_mat = m;
                 axes = DQuat::from_mat3(&m);

@@ -281,15 +281,17 @@ fn maya_style_pivots_move_into_the_node_translation() {
 
 #[test]
 fn z_up_axis_conversion_on_the_root_or_baked() {
-    // 3ds Max axes: up +Z, front −Y, right +X; UnitScaleFactor 100 (m) → ×1. File →
-    // Y-up is Rx(−90°): (x,y,z) → (x,z,−y); with the mirror, Unity = (−x,z,−y).
+    // 3ds Max axes: up +Z, front −Y, right +X; UnitScaleFactor 100 (m) → ×1. Unity puts
+    // file (x,y,z) at (x,z,y) (what its fitted colliders show on the corpus's baked Max
+    // files): before the mirror that is (−x,z,y) = Ry(180°)·Rx(−90°), quaternion
+    // (0,½√2,½√2,0), mirrored (0,−½√2,−½√2,0).
     // Two root children (no collapse): A at (1,2,3) with vertices (1,0,0) (0,1,0)
-    // (0,0,1), and an empty B. World positions either way: P·A·(t + v):
-    // (2,2,3) → (−2,3,−2); (1,3,3) → (−1,3,−3); (1,2,4) → (−1,4,−2).
-    // bakeAxisConversion 0: root rotation Rx(−90°) (mirror leaves it), A's local
-    // translation mirror(1,2,3) = (−1,2,3), vertex (1,0,0) → (−1,0,0).
-    // bakeAxisConversion 1: root rotation identity, A's translation P·A·(1,2,3) =
-    // (−1,3,−2), vertices (−1,0,0) (0,0,−1) (0,1,0).
+    // (0,0,1), and an empty B. World positions either way: (t + v) with y and z swapped:
+    // (2,2,3) → (2,3,2); (1,3,3) → (1,3,3); (1,2,4) → (1,4,2).
+    // bakeAxisConversion 0: the root carries the rotation, A's local translation is
+    // mirror(1,2,3) = (−1,2,3), vertex (1,0,0) → (−1,0,0).
+    // bakeAxisConversion 1: root rotation identity, A's translation (1,3,2), vertices
+    // (1,0,0) (0,0,1) (0,1,0).
     let g = Geometry::new(
         &[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
         &[&[0, 1, 2]],
@@ -306,14 +308,14 @@ fn z_up_axis_conversion_on_the_root_or_baked() {
         ..Default::default()
     };
     let world_want = [
-        Vec3::new(-2.0, 3.0, -2.0),
-        Vec3::new(-1.0, 3.0, -3.0),
-        Vec3::new(-1.0, 4.0, -2.0),
+        Vec3::new(2.0, 3.0, 2.0),
+        Vec3::new(1.0, 3.0, 3.0),
+        Vec3::new(1.0, 4.0, 2.0),
     ];
     let m = load(&f, "zup", &file_scale());
     assert_eq!(m.nodes.len(), 3);
     assert!(
-        close_q(m.nodes[0].rotation, Quat::from_xyzw(-H, 0.0, 0.0, H)),
+        close_q(m.nodes[0].rotation, Quat::from_xyzw(0.0, -H, -H, 0.0)),
         "{:?}",
         m.nodes[0]
     );
@@ -328,11 +330,8 @@ fn z_up_axis_conversion_on_the_root_or_baked() {
         "{:?}",
         m.nodes[0]
     );
-    assert!(close(m.nodes[1].translation, Vec3::new(-1.0, 3.0, -2.0)));
-    assert_has(
-        &m.meshes[0].mesh.positions,
-        &[Vec3::NEG_X, Vec3::NEG_Z, Vec3::Y],
-    );
+    assert!(close(m.nodes[1].translation, Vec3::new(1.0, 3.0, 2.0)));
+    assert_has(&m.meshes[0].mesh.positions, &[Vec3::X, Vec3::Z, Vec3::Y]);
     assert_has(&world_positions(&m, 1), &world_want);
 }
 

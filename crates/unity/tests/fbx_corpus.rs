@@ -1,0 +1,418 @@
+//! The FBX reader against Unity's own numbers and against corrupt input, on the real
+//! projects of `../shared/corpus/unity/` (set `UNITRACE_CORPUS` to the corpus folder when
+//! the worktree does not sit beside `shared/`).
+//!
+//! Unity's answer: a BoxCollider added in the editor to a GameObject that has a
+//! MeshFilter is fitted to the imported Mesh's local bounds (`m_Center`, `m_Size` = the
+//! AABB of its vertices, Unity space), so every such pair in a scene or prefab records
+//! where Unity put that mesh's vertices.
+
+use glam::Vec3;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use unity::docs;
+use unity::meta::{hash_id, GuidIndex, ModelMeta};
+use unity::model::Model;
+use unity::yaml::Node;
+
+fn corpus() -> Option<PathBuf> {
+    let p = std::env::var_os("UNITRACE_CORPUS")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/corpus"))
+        .join("unity");
+    if p.is_dir() {
+        Some(p)
+    } else {
+        eprintln!(
+            "SKIPPED: FBX corpus tests, because {} does not exist (the corpus lives beside the repo in ../shared, or set UNITRACE_CORPUS)",
+            p.display()
+        );
+        None
+    }
+}
+
+fn is_fbx(p: &Path) -> bool {
+    p.extension().is_some_and(|e| e.eq_ignore_ascii_case("fbx"))
+}
+
+fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(rd) = std::fs::read_dir(dir) else {
+        return;
+    };
+    let mut entries: Vec<PathBuf> = rd.filter_map(Result::ok).map(|e| e.path()).collect();
+    entries.sort();
+    for p in entries {
+        if p.is_dir() {
+            walk(&p, out);
+        } else {
+            out.push(p);
+        }
+    }
+}
+
+fn all_files(root: &Path) -> Vec<PathBuf> {
+    let mut v = Vec::new();
+    walk(root, &mut v);
+    v
+}
+
+fn load(p: &Path) -> (Model, ModelMeta) {
+    let meta = ModelMeta::read(p);
+    let m = unity::fbx::load(p, &meta).unwrap_or_else(|e| panic!("{e}"));
+    (m, meta)
+}
+
+/// Unity's fileIDs for each mesh: the legacy tables' entries of that name, else the
+/// hash of `Type:Mesh-><name><n>` (n counts earlier meshes of the same name).
+fn mesh_ids(m: &Model, meta: &ModelMeta) -> HashMap<i64, usize> {
+    let mut out = HashMap::new();
+    let mut seen: HashMap<&str, usize> = HashMap::new();
+    for (i, mesh) in m.meshes.iter().enumerate() {
+        let n = seen.entry(&mesh.name).or_default();
+        for id in meta.ids(43, &mesh.name, &mesh.name) {
+            out.entry(id).or_insert(i);
+        }
+        out.insert(hash_id(&format!("Type:Mesh->{}{}", mesh.name, *n)), i);
+        *n += 1;
+    }
+    out
+}
+
+/// Unity's GameObject fileIDs for each node (legacy names with `//RootNode` for the
+/// root, name hashes, and `fileIdsGeneration: 2` path hashes).
+fn node_ids(m: &Model, meta: &ModelMeta) -> HashMap<i64, usize> {
+    let mut out = HashMap::new();
+    let mut seen: HashMap<String, usize> = HashMap::new();
+    for i in 0..m.nodes.len() {
+        let name = if i == 0 {
+            "//RootNode".to_string()
+        } else {
+            m.nodes[i].name.clone()
+        };
+        let path = m.node_path(i);
+        for id in meta.ids(1, &name, &path) {
+            out.entry(id).or_insert(i);
+        }
+        let n = seen.entry(name.clone()).or_default();
+        out.insert(hash_id(&format!("Type:GameObject->{name}{n}")), i);
+        *n += 1;
+        let n = seen.entry(path.clone()).or_default();
+        out.insert(hash_id(&format!("Type:GameObject->{path}{n}")), i);
+        *n += 1;
+    }
+    out
+}
+
+fn aabb(points: &[Vec3]) -> (Vec3, Vec3) {
+    let lo = points.iter().fold(Vec3::splat(f32::MAX), |a, &p| a.min(p));
+    let hi = points.iter().fold(Vec3::splat(f32::MIN), |a, &p| a.max(p));
+    ((lo + hi) / 2.0, hi - lo)
+}
+
+fn file_id(n: &Node, key: &str) -> Option<(i64, Option<String>)> {
+    let r = n.get(key)?;
+    Some((r.i64_at("fileID")?, r.str_at("guid").map(str::to_string)))
+}
+
+struct Pair {
+    file: String,
+    object: i64,
+    /// BoxColliders on the same GameObject.
+    colliders: usize,
+    model: String,
+    mesh: String,
+    unity: (Vec3, Vec3),
+    ours: (Vec3, Vec3),
+}
+
+impl Pair {
+    /// Per axis, centre and size differences as a fraction of the collider's largest side.
+    fn error(&self) -> (Vec3, Vec3) {
+        let scale = self.unity.1.abs().max_element().max(1e-6);
+        (
+            (self.unity.0 - self.ours.0).abs() / scale,
+            (self.unity.1.abs() - self.ours.1).abs() / scale,
+        )
+    }
+    fn matches(&self) -> bool {
+        let (c, s) = self.error();
+        c.max_element() <= 0.01 && s.max_element() <= 0.01
+    }
+
+    /// Why a differing collider was edited by hand rather than fitted, when the pair
+    /// itself shows it: a compound collider (several boxes on one object, at most one of
+    /// them fitted), or a box dragged along one axis (the other two still fit).
+    fn edited(&self) -> Option<&'static str> {
+        if self.colliders > 1 {
+            return Some("one of several boxes on the object (a compound collider)");
+        }
+        let (c, s) = self.error();
+        let fits = (0..3).filter(|&i| c[i] <= 0.01 && s[i] <= 0.01).count();
+        (fits == 2).then_some("resized along one axis only")
+    }
+}
+
+/// Every (MeshFilter into an FBX, BoxCollider) pair on one GameObject in the corpus,
+/// and the pairs on GameObjects of FBX prefab instances whose collider was added there.
+fn collider_pairs(corpus: &Path) -> Vec<Pair> {
+    let mut pairs = Vec::new();
+    let mut models: HashMap<PathBuf, Option<(Model, ModelMeta)>> = HashMap::new();
+    let mut projects: Vec<PathBuf> = std::fs::read_dir(corpus)
+        .unwrap()
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .filter(|p| p.join("Assets").is_dir())
+        .collect();
+    projects.sort();
+    for project in projects {
+        let guids = GuidIndex::build(&project.join("Assets"));
+        for file in all_files(&project.join("Assets")) {
+            let ext = file.extension().and_then(|e| e.to_str()).unwrap_or("");
+            if ext != "unity" && ext != "prefab" {
+                continue;
+            }
+            let Ok(text) = std::fs::read_to_string(&file) else {
+                continue; // a binary scene
+            };
+            let docs = docs::split(&text);
+            // GameObject fileID → (model path, mesh fileID) from its MeshFilter, and
+            // stripped GameObject → (model path, GameObject fileID in the model).
+            let mut filters: HashMap<i64, (PathBuf, i64)> = HashMap::new();
+            let mut stripped: HashMap<i64, (PathBuf, i64)> = HashMap::new();
+            let mut boxes: Vec<(i64, Vec3, Vec3)> = Vec::new();
+            for d in &docs {
+                let body = d.parse();
+                match d.class {
+                    33 => {
+                        let (Some((go, _)), Some((mesh, Some(guid)))) =
+                            (file_id(&body, "m_GameObject"), file_id(&body, "m_Mesh"))
+                        else {
+                            continue;
+                        };
+                        if let Some(p) = guids.get(&guid).filter(|p| is_fbx(p)) {
+                            filters.insert(go, (p.clone(), mesh));
+                        }
+                    }
+                    1 if d.stripped => {
+                        let src = file_id(&body, "m_CorrespondingSourceObject")
+                            .or_else(|| file_id(&body, "m_PrefabParentObject"));
+                        if let Some((id, Some(guid))) = src {
+                            if let Some(p) = guids.get(&guid).filter(|p| is_fbx(p)) {
+                                stripped.insert(d.file_id, (p.clone(), id));
+                            }
+                        }
+                    }
+                    65 => {
+                        let (Some((go, _)), Some(c), Some(s)) = (
+                            file_id(&body, "m_GameObject"),
+                            body.get("m_Center").and_then(Node::vec3),
+                            body.get("m_Size").and_then(Node::vec3),
+                        ) else {
+                            continue;
+                        };
+                        boxes.push((go, c, s));
+                    }
+                    _ => {}
+                }
+            }
+            let mut per_object: HashMap<i64, usize> = HashMap::new();
+            for (go, _, _) in &boxes {
+                *per_object.entry(*go).or_default() += 1;
+            }
+            for (go, c, s) in boxes {
+                let (model_path, mesh_of) = if let Some((p, mesh_id)) = filters.get(&go) {
+                    (p, Err(*mesh_id))
+                } else if let Some((p, go_id)) = stripped.get(&go) {
+                    (p, Ok(*go_id))
+                } else {
+                    continue;
+                };
+                let entry = models.entry(model_path.clone()).or_insert_with(|| {
+                    let meta = ModelMeta::read(model_path);
+                    match unity::fbx::load(model_path, &meta) {
+                        Ok(m) => Some((m, meta)),
+                        Err(e) => {
+                            eprintln!("{e}");
+                            None
+                        }
+                    }
+                });
+                let Some((model, meta)) = entry else { continue };
+                let mesh = match mesh_of {
+                    Err(mesh_id) => mesh_ids(model, meta).get(&mesh_id).copied(),
+                    Ok(go_id) => node_ids(model, meta)
+                        .get(&go_id)
+                        .and_then(|&n| model.nodes[n].mesh),
+                };
+                let rel = |p: &Path| p.strip_prefix(corpus).unwrap_or(p).display().to_string();
+                let Some(mesh) = mesh else {
+                    eprintln!(
+                        "not compared: {} object {go} → {} ({mesh_of:?}): no such mesh, or a node without one",
+                        rel(&file),
+                        rel(model_path)
+                    );
+                    continue;
+                };
+                let mm = &model.meshes[mesh];
+                pairs.push(Pair {
+                    file: rel(&file),
+                    object: go,
+                    colliders: per_object[&go],
+                    model: rel(model_path),
+                    mesh: mm.name.clone(),
+                    unity: (c, s),
+                    ours: aabb(&mm.mesh.positions),
+                });
+            }
+        }
+    }
+    pairs
+}
+
+/// The file features and import settings one model exercises, as labels.
+fn model_features(path: &Path) -> Vec<String> {
+    let meta = ModelMeta::read(path);
+    let scene = ufbx::load_file(&path.to_string_lossy(), ufbx::LoadOpts::default()).unwrap();
+    let md = &scene.metadata;
+    let st = &scene.settings;
+    let mut f = vec![
+        format!(
+            "FBX {} {}",
+            md.version,
+            if md.ascii { "ASCII" } else { "binary" }
+        ),
+        format!("UnitScaleFactor {}", st.unit_meters * 100.0),
+        format!(
+            "useFileScale {:?}, globalScale {}",
+            meta.use_file_scale, meta.global_scale
+        ),
+        format!(
+            "axes {:?}/{:?}/{:?}, bakeAxisConversion {}",
+            st.axes.right, st.axes.up, st.axes.front, meta.bake_axis_conversion as u8
+        ),
+        format!(
+            "fileIDs: {}",
+            if !meta.recycle.is_empty() || !meta.internal.is_empty() {
+                "legacy table"
+            } else if meta.generation2 {
+                "fileIdsGeneration 2"
+            } else {
+                "name hash"
+            }
+        ),
+    ];
+    let prop = |n: &ufbx::Node, name: &str| {
+        ufbx::find_prop(&n.element.props, name)
+            .map(|p| p.value_vec4)
+            .is_some_and(|v| v.x != 0.0 || v.y != 0.0 || v.z != 0.0)
+    };
+    for (name, label) in [
+        ("RotationPivot", "nodes with a RotationPivot"),
+        ("PreRotation", "nodes with a PreRotation"),
+        ("GeometricTranslation", "nodes with a GeometricTranslation"),
+        ("GeometricRotation", "nodes with a GeometricRotation"),
+    ] {
+        if scene.nodes.iter().any(|n| prop(n, name)) {
+            f.push(label.to_string());
+        }
+    }
+    if scene.nodes.iter().any(|n| {
+        let s = n.local_transform.scale;
+        (s.x - 1.0).abs() > 1e-3 || (s.y - 1.0).abs() > 1e-3 || (s.z - 1.0).abs() > 1e-3
+    }) {
+        f.push("nodes with a scale".into());
+    }
+    if scene
+        .meshes
+        .iter()
+        .any(|m| m.faces.iter().any(|f| f.num_indices > 4))
+    {
+        f.push("n-gons".into());
+    }
+    f
+}
+
+/// Pairs whose collider differs from the mesh box for a reason other than the reader,
+/// by (scene or prefab file, GameObject fileID).
+const EDITED: &[(&str, i64, &str)] = &[
+    ("rockMedium_003.prefab", 1880065807507268,
+     "two prefabs of this one mesh carry different boxes (0.24×0.14×0.18 and 0.24×0.20×0.18): trimmed by hand"),
+    ("rockMedium_003 (1).prefab", 1761527945396984,
+     "two prefabs of this one mesh carry different boxes (0.24×0.14×0.18 and 0.24×0.20×0.18): trimmed by hand"),
+    ("rockPillar_004 (1).prefab", 1609845191492478,
+     "the long axis fits exactly (centre and size), the other two are 7–10 % off: trimmed by hand like this project's rockMedium_003 boxes"),
+    ("Level Objects/target.prefab", 1167547035320350,
+     "the box is 30–40 % of the mesh on every axis: fitted to a part of it by hand"),
+    ("Notebook_Pink.prefab", 3288322442485273172,
+     "the pages' box is 59–88 % of the mesh; the cover on the same prefab (same transforms, pivots, 0.01 node scale) matches exactly"),
+    ("Speaker_Boombox.prefab", 5650474337536192791,
+     "X fits exactly, Y and Z are 5–10 % smaller; the handle's boxes on the same prefab are a hand-built compound"),
+];
+
+#[test]
+fn box_colliders_fitted_by_unity_match_the_imported_mesh_bounds() {
+    let Some(corpus) = corpus() else { return };
+    let pairs = collider_pairs(&corpus);
+    let mut matched = 0;
+    let mut unexplained = Vec::new();
+    for p in &pairs {
+        let ok = p.matches();
+        let why = (!ok)
+            .then(|| {
+                p.edited().or_else(|| {
+                    EDITED
+                        .iter()
+                        .find(|(f, id, _)| p.file.ends_with(f) && *id == p.object)
+                        .map(|e| e.2)
+                })
+            })
+            .flatten();
+        println!(
+            "{} {} #{} → {} mesh {}\n    unity centre {:.4} size {:.4}\n    ours  centre {:.4} size {:.4}{}",
+            if ok { "MATCH" } else { "DIFF " },
+            p.file,
+            p.object,
+            p.model,
+            p.mesh,
+            p.unity.0,
+            p.unity.1,
+            p.ours.0,
+            p.ours.1,
+            why.map(|w| format!("\n    known: {w}")).unwrap_or_default()
+        );
+        if ok {
+            matched += 1;
+        } else if why.is_none() {
+            unexplained.push(format!("{} #{} ({})", p.file, p.object, p.mesh));
+        }
+    }
+    println!(
+        "{matched} of {} collider pairs match within 1 %",
+        pairs.len()
+    );
+    // What the matching pairs vouch for: the import settings and file features of the
+    // models they come from.
+    let mut features: std::collections::BTreeMap<String, usize> = Default::default();
+    let mut models: Vec<&str> = pairs
+        .iter()
+        .filter(|p| p.matches())
+        .map(|p| p.model.as_str())
+        .collect();
+    models.sort();
+    models.dedup();
+    for m in &models {
+        for f in model_features(&corpus.join(m)) {
+            *features.entry(f).or_default() += 1;
+        }
+    }
+    println!("{} models behind the matching pairs:", models.len());
+    for (f, n) in &features {
+        println!("    {n:3} {f}");
+    }
+    assert!(pairs.len() >= 10, "only {} pairs found", pairs.len());
+    assert!(
+        unexplained.is_empty(),
+        "{} pairs differ without a known reason: {unexplained:#?}",
+        unexplained.len()
+    );
+}
