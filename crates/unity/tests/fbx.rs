@@ -448,3 +448,15 @@ fn unreadable_files_are_typed_errors_naming_the_file() {
         "{e}"
     );
 }
+
+#[test]
+fn the_fuzz_seed_loads() {
+    // 3ds Max axes, inches, a pivot and a geometric translation; a triangle on the first
+    // material and a quad on the second.
+    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fuzz/corpus/unity_fbx/seed-triangle.fbx");
+    let m = fbx::load(&p, &file_scale()).unwrap();
+    assert_eq!(m.meshes[0].materials, ["red", "blue"]);
+    assert_eq!(m.triangle_count(), 3);
+    assert_eq!(m.materials.len(), 2);
+}

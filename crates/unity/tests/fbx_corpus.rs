@@ -416,3 +416,192 @@ fn box_colliders_fitted_by_unity_match_the_imported_mesh_bounds() {
         unexplained.len()
     );
 }
+
+/// Triangles of `path` the independent way: Σ (corners − 2) over the faces of every mesh
+/// node, from ufbx's face sizes (no triangulation involved).
+fn face_count_triangles(path: &Path) -> usize {
+    let scene = ufbx::load_file(&path.to_string_lossy(), ufbx::LoadOpts::default()).unwrap();
+    scene
+        .nodes
+        .iter()
+        .filter_map(|n| n.mesh.as_ref())
+        .map(|m| {
+            m.faces
+                .iter()
+                .map(|f| (f.num_indices as usize).saturating_sub(2))
+                .sum::<usize>()
+        })
+        .sum()
+}
+
+/// Triangles of an ASCII FBX straight from its text: every `PolygonVertexIndex` array
+/// lists corners with the last of each polygon stored as −(index + 1); Σ (corners − 2).
+/// (Each Geometry of these files hangs on exactly one Model.)
+fn ascii_triangles(text: &str) -> usize {
+    let mut tris = 0;
+    let mut rest = text;
+    while let Some(i) = rest.find("PolygonVertexIndex:") {
+        rest = &rest[i..];
+        let open = rest.find("a:").unwrap() + 2;
+        let close = rest[open..].find('}').unwrap() + open;
+        let mut corners = 0usize;
+        for v in rest[open..close].split(',') {
+            let v: i64 = v.trim().parse().unwrap();
+            corners += 1;
+            if v < 0 {
+                tris += corners.saturating_sub(2);
+                corners = 0;
+            }
+        }
+        rest = &rest[close..];
+    }
+    tris
+}
+
+fn corpus_file(corpus: &Path, rel: &str) -> PathBuf {
+    let p = corpus.join(rel);
+    assert!(p.is_file(), "{} missing from the corpus", p.display());
+    p
+}
+
+#[test]
+fn triangle_counts_equal_the_files_own_face_counts() {
+    let Some(corpus) = corpus() else { return };
+    for (rel, version) in [
+        ("Astraela__Escape-The-Room/Assets/Models/Book_by_Peter_Iliev_fbx.FBX", 7100),
+        ("notenoughbees__Unity-Essentials-Project-Unity-6/Assets/_Unity Essentials/Models/Furniture/LaundryBasket_Round_BR001.fbx", 7700),
+        ("notenoughbees__Unity-Essentials-Project-Unity-6/Assets/_Unity Essentials/Models/Furniture/Dresser_55in_BR001.fbx", 7700),
+    ] {
+        let p = corpus_file(&corpus, rel);
+        let scene = ufbx::load_file(&p.to_string_lossy(), ufbx::LoadOpts::default()).unwrap();
+        assert_eq!(scene.metadata.version, version, "{rel}");
+        let (m, _) = load(&p);
+        let want = face_count_triangles(&p);
+        println!("{rel}: {} triangles (faces say {want})", m.triangle_count());
+        assert_eq!(m.triangle_count(), want, "{rel}");
+    }
+    for rel in [
+        "thespeedyboy__CreateWithVR2021/Assets/_Course Library/Source Files/Models/Backgrounds/SkyscrapersPlane.fbx",
+        "thespeedyboy__CreateWithVR2021/Assets/_Course Library/models/uziLongSilencer.fbx",
+    ] {
+        let p = corpus_file(&corpus, rel);
+        let text = std::fs::read_to_string(&p).unwrap();
+        assert!(text.starts_with("; FBX"), "{rel} is not ASCII");
+        let (m, _) = load(&p);
+        let want = ascii_triangles(&text);
+        println!("{rel}: {} triangles (the text says {want})", m.triangle_count());
+        assert_eq!(m.triangle_count(), want, "{rel}");
+    }
+}
+
+fn corpus_fbx(corpus: &Path) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = all_files(corpus)
+        .into_iter()
+        .filter(|p| is_fbx(p))
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn every_corpus_fbx_loads_with_its_meta() {
+    let Some(corpus) = corpus() else { return };
+    let files = corpus_fbx(&corpus);
+    assert!(files.len() >= 80, "{} FBX files", files.len());
+    let (mut tris, mut skinned) = (0, 0);
+    for p in &files {
+        let (m, _) = load(p);
+        assert!(!m.meshes.is_empty(), "{}: no mesh", p.display());
+        for mesh in &m.meshes {
+            let n = mesh.mesh.positions.len() as u32;
+            assert_eq!(mesh.mesh.normals.len(), n as usize);
+            assert_eq!(mesh.materials.len(), mesh.mesh.submeshes.len());
+            assert!(mesh
+                .mesh
+                .submeshes
+                .iter()
+                .flatten()
+                .flatten()
+                .all(|&i| i < n));
+            assert!(mesh.mesh.positions.iter().all(|p| p.is_finite()));
+            if let Some(s) = &mesh.skin {
+                skinned += 1;
+                assert_eq!(s.weights.len(), n as usize);
+                assert_eq!(s.bones.len(), s.bind_poses.len());
+                for w in &s.weights {
+                    let sum: f32 = w.iter().map(|x| x.1).sum();
+                    assert!((sum - 1.0).abs() < 1e-4, "{}: weights {w:?}", p.display());
+                    assert!(w.iter().all(|x| (x.0 as usize) < s.bones.len()));
+                }
+            }
+        }
+        for w in &m.warnings {
+            println!("{}: {w}", p.strip_prefix(&corpus).unwrap().display());
+        }
+        tris += m.triangle_count();
+    }
+    println!(
+        "{} FBX files, {tris} triangles, {skinned} skinned meshes",
+        files.len()
+    );
+}
+
+/// A small deterministic generator for the corruption loop.
+struct XorShift(u64);
+
+impl XorShift {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        self.0
+    }
+}
+
+#[test]
+fn truncated_and_corrupted_corpus_files_never_panic_or_hang() {
+    let Some(corpus) = corpus() else { return };
+    let meta = ModelMeta::parse("ModelImporter:\n  meshes:\n    useFileScale: 1\n");
+    let mut rng = XorShift(0x9e37_79b9_7f4a_7c15);
+    let (mut loads, mut errors) = (0, 0);
+    let mut slowest = (std::time::Duration::ZERO, String::new());
+    for p in corpus_fbx(&corpus) {
+        let bytes = std::fs::read(&p).unwrap();
+        // The 1.7 MB model costs as much as all the others together: fewer variants.
+        let variants = if bytes.len() > 1 << 20 { 4 } else { 12 };
+        let mut inputs: Vec<Vec<u8>> = Vec::new();
+        for k in 1..=variants {
+            inputs.push(bytes[..bytes.len() * k / (variants + 1)].to_vec());
+        }
+        for _ in 0..variants {
+            let mut b = bytes.clone();
+            for _ in 0..1 + rng.next() % 8 {
+                let i = (rng.next() % b.len() as u64) as usize;
+                b[i] ^= 1 << (rng.next() % 8);
+            }
+            inputs.push(b);
+        }
+        for b in inputs {
+            let t = std::time::Instant::now();
+            let r = std::panic::catch_unwind(|| unity::fbx::load_bytes(&b, &p, &meta));
+            let dt = t.elapsed();
+            let r = r.unwrap_or_else(|_| panic!("{}: the reader panicked", p.display()));
+            loads += 1;
+            if let Err(e) = r {
+                errors += 1;
+                assert!(e.to_string().starts_with(&p.display().to_string()), "{e}");
+            }
+            if dt > slowest.0 {
+                slowest = (dt, p.display().to_string());
+            }
+        }
+    }
+    println!(
+        "{loads} corrupted loads, {errors} refused, slowest {:?} ({})",
+        slowest.0, slowest.1
+    );
+    assert!(
+        slowest.0 < std::time::Duration::from_secs(10),
+        "{slowest:?}"
+    );
+}
