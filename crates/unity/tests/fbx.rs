@@ -8,7 +8,7 @@
 #[path = "support/fbx_ascii.rs"]
 mod fbx_ascii;
 
-use fbx_ascii::{Fbx, Geometry, Node};
+use fbx_ascii::{Cluster, Fbx, Geometry, Node, SkinSpec};
 use glam::{Mat4, Quat, Vec3};
 use unity::fbx;
 use unity::meta::ModelMeta;
@@ -459,4 +459,85 @@ fn the_fuzz_seed_loads() {
     assert_eq!(m.meshes[0].materials, ["red", "blue"]);
     assert_eq!(m.triangle_count(), 3);
     assert_eq!(m.materials.len(), 2);
+}
+
+#[test]
+fn skin_bones_bind_poses_and_four_normalised_weights() {
+    // A mesh at the origin skinned to five bones B0..B4 whose bind-time global matrices
+    // are translations (10k, 100, 0) cm; the mesh's is the identity, so mesh → bone at
+    // bind is the translation (−10k, −100, 0). Unity's bind pose of
+    // B_k = (bone world at bind)⁻¹ · (mesh world): the bone sits at (−0.1k, 1, 0) in Unity
+    // (×0.01, X mirrored), so the bind pose is the translation (0.1k, −1, 0).
+    // Weights: vertex 0 has B0..B4 at 0.1..0.5 → the four largest, largest first,
+    // normalised by 1.4: B4 5/14, B3 4/14, B2 3/14, B1 2/14. Vertex 1: B0 0.5, B1 1.5 →
+    // B1 0.75, B0 0.25. Vertex 2: B2 alone → 1.
+    let v = [[0.0, 0.0, 0.0], [100.0, 0.0, 0.0], [0.0, 100.0, 0.0]];
+    let mut nodes = vec![Node::new("Body", None).mesh(Geometry::new(&v, &[&[0, 1, 2]]))];
+    let mut clusters = Vec::new();
+    for k in 0..5 {
+        nodes.push(
+            Node::new(&format!("B{k}"), None)
+                .limb()
+                .prop("Lcl Translation", [10.0 * k as f64, 100.0, 0.0]),
+        );
+        let mut weights = vec![(0, 0.1 * (k + 1) as f64)];
+        match k {
+            0 => weights.push((1, 0.5)),
+            1 => weights.push((1, 1.5)),
+            2 => weights.push((2, 1.0)),
+            _ => {}
+        }
+        let mut link = [0.0; 16];
+        for i in 0..4 {
+            link[i * 5] = 1.0;
+        }
+        let mut transform = link;
+        link[12] = 10.0 * k as f64;
+        link[13] = 100.0;
+        transform[12] = -10.0 * k as f64;
+        transform[13] = -100.0;
+        clusters.push(Cluster {
+            bone: k + 1,
+            weights,
+            transform,
+            link,
+        });
+    }
+    let f = Fbx {
+        nodes,
+        skins: vec![SkinSpec { mesh: 0, clusters }],
+        ..Default::default()
+    };
+    let m = load(&f, "skinned", &file_scale());
+    let mm = &m.meshes[0];
+    let skin = mm.skin.as_ref().expect("a skin");
+    assert_eq!(skin.bones, ["B0", "B1", "B2", "B3", "B4"]);
+    for (k, b) in skin.bind_poses.iter().enumerate() {
+        let want = Mat4::from_translation(Vec3::new(0.1 * k as f32, -1.0, 0.0));
+        assert!(b.abs_diff_eq(want, 1e-5), "bone {k}: {b}");
+    }
+    let at = |p: Vec3| {
+        let i = mm.mesh.positions.iter().position(|q| close(*q, p)).unwrap();
+        skin.weights[i]
+    };
+    let w0 = at(Vec3::ZERO);
+    let want0 = [
+        (4, 5.0 / 14.0),
+        (3, 4.0 / 14.0),
+        (2, 3.0 / 14.0),
+        (1, 2.0 / 14.0),
+    ];
+    for (got, want) in w0.iter().zip(want0) {
+        assert_eq!(got.0, want.0, "{w0:?}");
+        assert!((got.1 - want.1).abs() < 1e-6, "{w0:?}");
+    }
+    let w1 = at(Vec3::new(-1.0, 0.0, 0.0));
+    assert_eq!((w1[0].0, w1[1].0), (1, 0), "{w1:?}");
+    assert!(
+        (w1[0].1 - 0.75).abs() < 1e-6 && (w1[1].1 - 0.25).abs() < 1e-6,
+        "{w1:?}"
+    );
+    assert_eq!(w1[2].1 + w1[3].1, 0.0);
+    let w2 = at(Vec3::new(0.0, 1.0, 0.0));
+    assert_eq!(w2[0], (2, 1.0), "{w2:?}");
 }

@@ -11,6 +11,26 @@ pub struct Fbx {
     pub unit_scale_factor: f64,
     pub nodes: Vec<Node>,
     pub materials: Vec<(String, [f64; 3])>,
+    /// Skin deformers on mesh nodes.
+    pub skins: Vec<SkinSpec>,
+}
+
+pub struct SkinSpec {
+    /// Index in [`Fbx::nodes`] of the mesh node.
+    pub mesh: usize,
+    pub clusters: Vec<Cluster>,
+}
+
+pub struct Cluster {
+    /// Index in [`Fbx::nodes`] of the bone.
+    pub bone: usize,
+    /// (control point, weight).
+    pub weights: Vec<(u32, f64)>,
+    /// `Transform`: mesh space → bone space at bind time (what exporters write: the
+    /// bone's global matrix inverted times the mesh's), column-major.
+    pub transform: [f64; 16],
+    /// `TransformLink`: the bone's global matrix at bind time, column-major.
+    pub link: [f64; 16],
 }
 
 pub struct Node {
@@ -22,6 +42,8 @@ pub struct Node {
     pub mesh: Option<Geometry>,
     /// Indices into [`Fbx::materials`], in the node's slot order.
     pub materials: Vec<usize>,
+    /// A skeleton joint (`LimbNode`) rather than an empty (`Null`).
+    pub limb: bool,
 }
 
 pub struct Geometry {
@@ -41,7 +63,12 @@ impl Node {
             props: vec![],
             mesh: None,
             materials: vec![],
+            limb: false,
         }
+    }
+    pub fn limb(mut self) -> Node {
+        self.limb = true;
+        self
     }
     pub fn prop(mut self, name: &'static str, v: [f64; 3]) -> Node {
         self.props.push((name, v));
@@ -75,6 +102,7 @@ impl Default for Fbx {
             unit_scale_factor: 1.0,
             nodes: vec![],
             materials: vec![],
+            skins: vec![],
         }
     }
 }
@@ -112,7 +140,11 @@ impl Fbx {
         let mut conns = String::new();
         for (i, n) in self.nodes.iter().enumerate() {
             let id = 1000 + i as i64;
-            let kind = if n.mesh.is_some() { "Mesh" } else { "Null" };
+            let kind = match (&n.mesh, n.limb) {
+                (Some(_), _) => "Mesh",
+                (None, true) => "LimbNode",
+                (None, false) => "Null",
+            };
             writeln!(s, "\tModel: {id}, \"Model::{}\", \"{kind}\" {{", n.name).unwrap();
             s.push_str("\t\tVersion: 232\n\t\tProperties70:  {\n");
             for (p, v) in &n.props {
@@ -173,6 +205,21 @@ impl Fbx {
         }
         for (i, (name, c)) in self.materials.iter().enumerate() {
             writeln!(s, "\tMaterial: {}, \"Material::{name}\", \"\" {{\n\t\tVersion: 102\n\t\tShadingModel: \"phong\"\n\t\tMultiLayer: 0\n\t\tProperties70:  {{\n\t\t\tP: \"DiffuseColor\", \"Color\", \"\", \"A\",{},{},{}\n\t\t}}\n\t}}", 3000 + i, c[0], c[1], c[2]).unwrap();
+        }
+        for (k, sk) in self.skins.iter().enumerate() {
+            let sid = 4000 + 100 * k as i64;
+            writeln!(s, "\tDeformer: {sid}, \"Deformer::Skin\", \"Skin\" {{\n\t\tVersion: 101\n\t\tLink_DeformAcuracy: 50\n\t}}").unwrap();
+            writeln!(conns, "\tC: \"OO\",{sid},{}", 2000 + sk.mesh as i64).unwrap();
+            for (j, c) in sk.clusters.iter().enumerate() {
+                let cid = sid + 1 + j as i64;
+                let (ni, ix) = list(c.weights.iter().map(|w| w.0));
+                let (_, ws) = list(c.weights.iter().map(|w| w.1));
+                let (_, link) = list(c.link);
+                let (_, transform) = list(c.transform);
+                writeln!(s, "\tDeformer: {cid}, \"SubDeformer::Cluster {j}\", \"Cluster\" {{\n\t\tVersion: 100\n\t\tUserData: \"\", \"\"\n\t\tIndexes: *{ni} {{\n\t\t\ta: {ix}\n\t\t}}\n\t\tWeights: *{ni} {{\n\t\t\ta: {ws}\n\t\t}}\n\t\tTransform: *16 {{\n\t\t\ta: {transform}\n\t\t}}\n\t\tTransformLink: *16 {{\n\t\t\ta: {link}\n\t\t}}\n\t}}").unwrap();
+                writeln!(conns, "\tC: \"OO\",{cid},{sid}").unwrap();
+                writeln!(conns, "\tC: \"OO\",{},{cid}", 1000 + c.bone as i64).unwrap();
+            }
         }
         s.push_str("}\nConnections:  {\n");
         s.push_str(&conns);
