@@ -62,6 +62,17 @@ fn load(p: &Path) -> (Model, ModelMeta) {
     (m, meta)
 }
 
+fn load_logged(p: &Path) -> Option<(Model, ModelMeta)> {
+    let meta = ModelMeta::read(p);
+    match unity::fbx::load(p, &meta) {
+        Ok(m) => Some((m, meta)),
+        Err(e) => {
+            eprintln!("{e}");
+            None
+        }
+    }
+}
+
 /// Unity's fileIDs for each mesh: the legacy tables' entries of that name, else the
 /// hash of `Type:Mesh-><name><n>` (n counts earlier meshes of the same name).
 fn mesh_ids(m: &Model, meta: &ModelMeta) -> HashMap<i64, usize> {
@@ -154,8 +165,9 @@ impl Pair {
 
 /// Every (MeshFilter into an FBX, BoxCollider) pair on one GameObject in the corpus,
 /// and the pairs on GameObjects of FBX prefab instances whose collider was added there.
-fn collider_pairs(corpus: &Path) -> Vec<Pair> {
+fn collider_pairs(corpus: &Path) -> (Vec<Pair>, Vec<Slots>) {
     let mut pairs = Vec::new();
+    let mut slots = Vec::new();
     let mut models: HashMap<PathBuf, Option<(Model, ModelMeta)>> = HashMap::new();
     let mut projects: Vec<PathBuf> = std::fs::read_dir(corpus)
         .unwrap()
@@ -180,6 +192,7 @@ fn collider_pairs(corpus: &Path) -> Vec<Pair> {
             let mut filters: HashMap<i64, (PathBuf, i64)> = HashMap::new();
             let mut stripped: HashMap<i64, (PathBuf, i64)> = HashMap::new();
             let mut boxes: Vec<(i64, Vec3, Vec3)> = Vec::new();
+            let mut renderers: Vec<(i64, usize)> = Vec::new();
             for d in &docs {
                 let body = d.parse();
                 match d.class {
@@ -202,6 +215,13 @@ fn collider_pairs(corpus: &Path) -> Vec<Pair> {
                             }
                         }
                     }
+                    23 if !d.stripped => {
+                        if let (Some((go, _)), Some(m)) =
+                            (file_id(&body, "m_GameObject"), body.get("m_Materials"))
+                        {
+                            renderers.push((go, m.as_seq().len()));
+                        }
+                    }
                     65 => {
                         let (Some((go, _)), Some(c), Some(s)) = (
                             file_id(&body, "m_GameObject"),
@@ -213,6 +233,24 @@ fn collider_pairs(corpus: &Path) -> Vec<Pair> {
                         boxes.push((go, c, s));
                     }
                     _ => {}
+                }
+            }
+            let rel = |p: &Path| p.strip_prefix(corpus).unwrap_or(p).display().to_string();
+            for (go, n) in renderers {
+                let Some((model_path, mesh_id)) = filters.get(&go) else {
+                    continue;
+                };
+                let entry = models
+                    .entry(model_path.clone())
+                    .or_insert_with(|| load_logged(model_path));
+                let Some((model, meta)) = entry else { continue };
+                if let Some(&i) = mesh_ids(model, meta).get(mesh_id) {
+                    slots.push(Slots {
+                        file: rel(&file),
+                        mesh: format!("{} {}", rel(model_path), model.meshes[i].name),
+                        renderer: n,
+                        ours: model.meshes[i].materials.len(),
+                    });
                 }
             }
             let mut per_object: HashMap<i64, usize> = HashMap::new();
@@ -227,16 +265,9 @@ fn collider_pairs(corpus: &Path) -> Vec<Pair> {
                 } else {
                     continue;
                 };
-                let entry = models.entry(model_path.clone()).or_insert_with(|| {
-                    let meta = ModelMeta::read(model_path);
-                    match unity::fbx::load(model_path, &meta) {
-                        Ok(m) => Some((m, meta)),
-                        Err(e) => {
-                            eprintln!("{e}");
-                            None
-                        }
-                    }
-                });
+                let entry = models
+                    .entry(model_path.clone())
+                    .or_insert_with(|| load_logged(model_path));
                 let Some((model, meta)) = entry else { continue };
                 let mesh = match mesh_of {
                     Err(mesh_id) => mesh_ids(model, meta).get(&mesh_id).copied(),
@@ -244,7 +275,6 @@ fn collider_pairs(corpus: &Path) -> Vec<Pair> {
                         .get(&go_id)
                         .and_then(|&n| model.nodes[n].mesh),
                 };
-                let rel = |p: &Path| p.strip_prefix(corpus).unwrap_or(p).display().to_string();
                 let Some(mesh) = mesh else {
                     eprintln!(
                         "not compared: {} object {go} → {} ({mesh_of:?}): no such mesh, or a node without one",
@@ -266,7 +296,15 @@ fn collider_pairs(corpus: &Path) -> Vec<Pair> {
             }
         }
     }
-    pairs
+    (pairs, slots)
+}
+
+/// A MeshRenderer's material slot count beside the sub-mesh count of its FBX mesh.
+struct Slots {
+    file: String,
+    mesh: String,
+    renderer: usize,
+    ours: usize,
 }
 
 /// The file features and import settings one model exercises, as labels.
@@ -352,7 +390,7 @@ const EDITED: &[(&str, i64, &str)] = &[
 #[test]
 fn box_colliders_fitted_by_unity_match_the_imported_mesh_bounds() {
     let Some(corpus) = corpus() else { return };
-    let pairs = collider_pairs(&corpus);
+    let (pairs, _) = collider_pairs(&corpus);
     let mut matched = 0;
     let mut unexplained = Vec::new();
     for p in &pairs {
@@ -604,4 +642,30 @@ fn truncated_and_corrupted_corpus_files_never_panic_or_hang() {
         slowest.0 < std::time::Duration::from_secs(10),
         "{slowest:?}"
     );
+}
+
+#[test]
+fn renderer_material_slots_match_the_sub_mesh_counts() {
+    // Unity sizes a MeshRenderer's m_Materials to the mesh's sub-meshes when the object is
+    // made from the model; users rarely add or remove slots by hand.
+    let Some(corpus) = corpus() else { return };
+    let (_, slots) = collider_pairs(&corpus);
+    let mut same = 0;
+    let multi = slots.iter().filter(|s| s.ours > 1).count();
+    for s in &slots {
+        if s.renderer == s.ours {
+            same += 1;
+        } else {
+            println!(
+                "DIFF {}: {} has {} sub-meshes, the renderer {} slots",
+                s.file, s.mesh, s.ours, s.renderer
+            );
+        }
+    }
+    println!(
+        "{same} of {} MeshRenderers on FBX meshes have one slot per sub-mesh ({multi} with several)",
+        slots.len()
+    );
+    assert!(slots.len() >= 20, "only {} renderers", slots.len());
+    assert!(same * 20 >= slots.len() * 19, "{same} of {}", slots.len());
 }
