@@ -9,7 +9,9 @@
 //!
 //! * units: positions and translations (never node scales) times the import scale,
 //!   `UnitScaleFactor / 100 · globalScale` with `useFileScale: 1`, else `globalScale`;
-//! * axes: the rotation from the file's axis system to Unity's, either on the root node
+//! * axes: the rotation from the file's axis system to Unity's (a file that is not Y-up
+//!   lands with its up on +Y, its right on +X and its front on −Z once mirrored: a 3ds Max
+//!   file's (x, y, z) at Unity (x, z, y)), either on the root node
 //!   (`bakeAxisConversion: 0`) or conjugated through every node and vertex (`1`);
 //! * handedness: X negated (positions, normals, translations; rotations as
 //!   (x, −y, −z, w)) and every triangle's winding reversed, as for OBJ.
@@ -184,6 +186,9 @@ impl Importer {
                         .into(),
                 );
             }
+        }
+        if meta.normal_import_mode == 2 {
+            warnings.push("normalImportMode None: normals are computed instead".into());
         }
         Importer {
             scale,
@@ -387,11 +392,6 @@ impl Importer {
                 .collect();
             smooth_normals(&positions, &tris, self.smoothing_angle)
         };
-        if m.vertex_normal.exists && self.normal_import_mode == 2 {
-            self.warnings.push(format!(
-                "mesh {name}: normalImportMode None; normals computed instead"
-            ));
-        }
         let mut mesh = Mesh::default();
         let mut src_vertex: Vec<u32> = Vec::new();
         let mut vmap: HashMap<(u32, [u32; 3]), u32> = HashMap::new();

@@ -669,3 +669,39 @@ fn renderer_material_slots_match_the_sub_mesh_counts() {
     assert!(slots.len() >= 20, "only {} renderers", slots.len());
     assert!(same * 20 >= slots.len() * 19, "{same} of {}", slots.len());
 }
+
+#[test]
+fn import_settings_read_from_real_metas() {
+    let Some(corpus) = corpus() else { return };
+    let read = |rel: &str| ModelMeta::read(&corpus_file(&corpus, rel));
+    // Unity 5.x (ModelImporter sv 16): no useFileScale, the unit folded into globalScale.
+    let sky = read("DarthTekin__Prototype4_CreateWithCode2_UnityLearn_05.04.2023/Assets/Course Library/_Source_Files/FBX/SkyDome.fbx");
+    assert_eq!(sky.use_file_scale, None);
+    assert!((sky.global_scale - 0.01).abs() < 1e-6);
+    let door = read("Pjaerr__GDSJam-Reflection/Assets/Models/models/Animated_door.fbx");
+    assert_eq!(door.use_file_scale, Some(true));
+    assert_eq!(door.material_location, Some(0));
+    assert_eq!(
+        door.external_objects,
+        [(
+            "UnityEngine:Material".to_string(),
+            "Material #25".to_string(),
+            "456775c7489e4bb4cb7e9f37e2ea3fb2".to_string()
+        )]
+    );
+    let bed = read("notenoughbees__Unity-Essentials-Project-Unity-6/Assets/_Unity Essentials/Models/Furniture/Bed_Twin_BR003.fbx");
+    assert_eq!(bed.external_objects[0].1, "No Name");
+    assert_eq!(
+        bed.external_objects[0].2,
+        "bc4b2d6ed01096b4c967bbcdd11a0379"
+    );
+    let floor = read("notenoughbees__Unity-Essentials-Project-Unity-6/Assets/_Unity Essentials/Models/Floor/Floor2m.FBX");
+    assert!(floor.bake_axis_conversion);
+    assert_eq!(floor.normal_import_mode, 0);
+    assert_eq!(floor.normal_smoothing_angle, 60.0);
+    let ball = read(
+        "thespeedyboy__CreateWithVR2021/Assets/_Course Library/Source Files/Models/Ball_Tennis.fbx",
+    );
+    assert!((ball.global_scale - 1.05).abs() < 1e-6);
+    assert!(!ball.bake_axis_conversion);
+}
