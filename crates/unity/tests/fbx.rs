@@ -541,3 +541,19 @@ fn skin_bones_bind_poses_and_four_normalised_weights() {
     let w2 = at(Vec3::new(0.0, 1.0, 0.0));
     assert_eq!(w2[0], (2, 1.0), "{w2:?}");
 }
+
+#[test]
+fn blend_shapes_are_ignored_with_a_warning_naming_the_mesh() {
+    // The shape would lift vertex 0 by 1 cm; ignored, the mesh keeps its rest pose.
+    let f = Fbx {
+        nodes: vec![
+            Node::new("Face", None).mesh(Geometry::new(&TRI, &[&[0, 1, 2]])),
+            Node::new("Other", None),
+        ],
+        blend_shapes: vec![0],
+        ..Default::default()
+    };
+    let m = load(&f, "morph", &file_scale());
+    assert_eq!(m.warnings, ["mesh Face: blend shapes ignored"]);
+    assert_has(&m.meshes[0].mesh.positions, &[Vec3::ZERO]);
+}

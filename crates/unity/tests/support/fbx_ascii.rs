@@ -13,6 +13,8 @@ pub struct Fbx {
     pub materials: Vec<(String, [f64; 3])>,
     /// Skin deformers on mesh nodes.
     pub skins: Vec<SkinSpec>,
+    /// Mesh nodes (indices in [`Fbx::nodes`]) given one blend shape that lifts vertex 0.
+    pub blend_shapes: Vec<usize>,
 }
 
 pub struct SkinSpec {
@@ -103,6 +105,7 @@ impl Default for Fbx {
             nodes: vec![],
             materials: vec![],
             skins: vec![],
+            blend_shapes: vec![],
         }
     }
 }
@@ -220,6 +223,20 @@ impl Fbx {
                 writeln!(conns, "\tC: \"OO\",{cid},{sid}").unwrap();
                 writeln!(conns, "\tC: \"OO\",{},{cid}", 1000 + c.bone as i64).unwrap();
             }
+        }
+        for (k, &mesh) in self.blend_shapes.iter().enumerate() {
+            let id = 5000 + 10 * k as i64;
+            writeln!(s, "\tGeometry: {id}, \"Geometry::Key{k}\", \"Shape\" {{\n\t\tVersion: 100\n\t\tIndexes: *1 {{\n\t\t\ta: 0\n\t\t}}\n\t\tVertices: *3 {{\n\t\t\ta: 0,0,1\n\t\t}}\n\t\tNormals: *3 {{\n\t\t\ta: 0,0,0\n\t\t}}\n\t}}").unwrap();
+            writeln!(
+                s,
+                "\tDeformer: {}, \"Deformer::Morph{k}\", \"BlendShape\" {{\n\t\tVersion: 100\n\t}}",
+                id + 1
+            )
+            .unwrap();
+            writeln!(s, "\tDeformer: {}, \"SubDeformer::Key{k}\", \"BlendShapeChannel\" {{\n\t\tVersion: 100\n\t\tDeformPercent: 0\n\t\tFullWeights: *1 {{\n\t\t\ta: 100\n\t\t}}\n\t}}", id + 2).unwrap();
+            writeln!(conns, "\tC: \"OO\",{},{}", id + 1, 2000 + mesh as i64).unwrap();
+            writeln!(conns, "\tC: \"OO\",{},{}", id + 2, id + 1).unwrap();
+            writeln!(conns, "\tC: \"OO\",{id},{}", id + 2).unwrap();
         }
         s.push_str("}\nConnections:  {\n");
         s.push_str(&conns);
