@@ -87,6 +87,8 @@ fn load_opts(file_len: usize) -> ufbx::LoadOpts<'static> {
         load_external_files: false,
         generate_missing_normals: false,
         node_depth_limit: NODE_DEPTH_LIMIT,
+        // Unity reads a `.fbx` as FBX whatever it holds; ufbx would otherwise sniff OBJ.
+        file_format: ufbx::FileFormat::Fbx,
         pivot_handling: ufbx::PivotHandling::AdjustToRotationPivot,
         geometry_transform_handling: ufbx::GeometryTransformHandling::Preserve,
         ..Default::default()

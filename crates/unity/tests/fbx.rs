@@ -435,6 +435,13 @@ fn unreadable_files_are_typed_errors_naming_the_file() {
     assert!(matches!(e, fbx::FbxError::LfsPointer(_)), "{e}");
     assert!(e.to_string().contains("git lfs pull"), "{e}");
 
+    // An OBJ saved as .fbx is not read as OBJ.
+    let obj = dir.path().join("obj.fbx");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let e = fbx::load(&obj, &m).unwrap_err();
+    assert!(matches!(e, fbx::FbxError::Corrupt { .. }), "{e}");
+    println!("{e}");
+
     let junk = dir.path().join("junk.fbx");
     std::fs::write(
         &junk,
