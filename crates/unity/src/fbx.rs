@@ -9,10 +9,10 @@
 //!
 //! * units: positions and translations (never node scales) times the import scale,
 //!   `UnitScaleFactor / 100 · globalScale` with `useFileScale: 1`, else `globalScale`;
-//! * axes: the rotation from the file's axis system to Unity's (a file that is not Y-up
-//!   lands with its up on +Y, its right on +X and its front on −Z once mirrored: a 3ds Max
-//!   file's (x, y, z) at Unity (x, z, y)), either on the root node
-//!   (`bakeAxisConversion: 0`) or conjugated through every node and vertex (`1`);
+//! * axes: the rotation that brings the file's up axis to +Y (Unity ignores the file's
+//!   front and right axes: a Z-up file's (x, y, z) lands at Unity (x, z, y)), either on
+//!   the root node (`bakeAxisConversion: 0`) or conjugated through every node and vertex
+//!   (`1`);
 //! * handedness: X negated (positions, normals, translations; rotations as
 //!   (x, −y, −z, w)) and every triangle's winding reversed, as for OBJ.
 //!
@@ -99,7 +99,7 @@ fn load_opts(file_len: usize) -> ufbx::LoadOpts<'static> {
 struct Importer {
     /// Metres per file unit as Unity scales it.
     scale: f64,
-    /// File axes → Unity's before the mirror (a signed permutation; identity for Y-up
+    /// File axes → Unity's before the mirror (a signed permutation; identity for +Y-up
     /// files).
     axes: DQuat,
     axes_mat: DMat3,
@@ -165,29 +165,20 @@ impl Importer {
             ));
             scale = meta.global_scale as f64;
         }
-        let ax = &scene.settings.axes;
-        // The conversion sends the file's right, up and front to +X, +Y, +Z (ufbx's
-        // right-handed Y-up), so its rows are those three axes.
-        let rows = [ax.right, ax.up, ax.front].map(axis_vec);
+        // Unity goes by the file's up axis alone: it takes the right-handed system with
+        // that up whose front is the FBX "odd parity" axis (Z for X or Y up, Y for Z up)
+        // with a positive sign, whatever the file's FrontAxisSign and CoordAxis say. Its
+        // own numbers show it: 3ds Max files (right +X, front −Y) baked into the mesh
+        // (bakeAxisConversion 1) land at Unity (x, z, y), and a Blender-style Z-up file
+        // (right −X, front +Y) gets the same conversion as its root rotation.
         let (mut axes, mut axes_mat) = (DQuat::IDENTITY, DMat3::IDENTITY);
-        if let [Some(r), Some(u), Some(f)] = rows {
-            let mut m = DMat3::from_cols(r, u, f).transpose();
-            if m != DMat3::IDENTITY {
-                // Unity turns a converted file half a turn about Y on top: Unity-fitted
-                // colliders on 3ds Max Z-up files (bakeAxisConversion 1) put file
-                // (x, y, z) at Unity (x, z, y), where "front to +Z, then mirror X" would
-                // give (−x, z, −y).
-                m = DMat3::from_diagonal(DVec3::new(-1.0, 1.0, -1.0)) * m;
-            }
-            if (m.determinant() - 1.0).abs() < 1e-6 {
-                axes_mat = m;
-                axes = DQuat::from_mat3(&m);
-            } else {
-                warnings.push(
-                    "the file's axis system is left-handed or degenerate; its axes are ignored"
-                        .into(),
-                );
-            }
+        if let Some(up) = axis_vec(scene.settings.axes.up) {
+            let front = if up.z != 0.0 { DVec3::Y } else { DVec3::Z };
+            let right = up.cross(front);
+            // Sends right, up and front to +X, +Y, +Z (right-handed Y-up, before the
+            // mirror), so its rows are those three axes.
+            axes_mat = DMat3::from_cols(right, up, front).transpose();
+            axes = DQuat::from_mat3(&axes_mat);
         }
         if meta.normal_import_mode == 2 {
             warnings.push("normalImportMode None: normals are computed instead".into());

@@ -281,10 +281,12 @@ fn maya_style_pivots_move_into_the_node_translation() {
 
 #[test]
 fn z_up_axis_conversion_on_the_root_or_baked() {
-    // 3ds Max axes: up +Z, front −Y, right +X; UnitScaleFactor 100 (m) → ×1. Unity puts
-    // file (x,y,z) at (x,z,y) (what its fitted colliders show on the corpus's baked Max
-    // files): before the mirror that is (−x,z,y) = Ry(180°)·Rx(−90°), quaternion
-    // (0,½√2,½√2,0), mirrored (0,−½√2,−½√2,0).
+    // Up +Z; UnitScaleFactor 100 (m) → ×1. Unity goes by the up axis alone and treats a
+    // Z-up file as right −X, up +Z, front +Y: before the mirror (x,y,z) → (−x,z,y), the
+    // half turn about (0,1,1)/√2, quaternion (0,½√2,½√2,0), mirrored (0,−½√2,−½√2,0);
+    // after the mirror a file point lands at (x,z,y). Checked for two files that differ
+    // only in front and right signs: 3ds Max's (right +X, front −Y) and Blender-style
+    // (right −X, front +Y).
     // Two root children (no collapse): A at (1,2,3) with vertices (1,0,0) (0,1,0)
     // (0,0,1), and an empty B. World positions either way: (t + v) with y and z swapped:
     // (2,2,3) → (2,3,2); (1,3,3) → (1,3,3); (1,2,4) → (1,4,2).
@@ -292,47 +294,49 @@ fn z_up_axis_conversion_on_the_root_or_baked() {
     // mirror(1,2,3) = (−1,2,3), vertex (1,0,0) → (−1,0,0).
     // bakeAxisConversion 1: root rotation identity, A's translation (1,3,2), vertices
     // (1,0,0) (0,0,1) (0,1,0).
-    let g = Geometry::new(
-        &[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
-        &[&[0, 1, 2]],
-    );
-    let f = Fbx {
-        axes: [2, 1, 1, -1, 0, 1],
-        unit_scale_factor: 100.0,
-        nodes: vec![
-            Node::new("A", None)
-                .prop("Lcl Translation", [1.0, 2.0, 3.0])
-                .mesh(g),
-            Node::new("B", None),
-        ],
-        ..Default::default()
-    };
-    let world_want = [
-        Vec3::new(2.0, 3.0, 2.0),
-        Vec3::new(1.0, 3.0, 3.0),
-        Vec3::new(1.0, 4.0, 2.0),
-    ];
-    let m = load(&f, "zup", &file_scale());
-    assert_eq!(m.nodes.len(), 3);
-    assert!(
-        close_q(m.nodes[0].rotation, Quat::from_xyzw(0.0, -H, -H, 0.0)),
-        "{:?}",
-        m.nodes[0]
-    );
-    assert!(close(m.nodes[1].translation, Vec3::new(-1.0, 2.0, 3.0)));
-    assert_has(&m.meshes[0].mesh.positions, &[Vec3::NEG_X]);
-    assert_has(&world_positions(&m, 1), &world_want);
+    for axes in [[2, 1, 1, -1, 0, 1], [2, 1, 1, 1, 0, -1]] {
+        let g = Geometry::new(
+            &[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            &[&[0, 1, 2]],
+        );
+        let f = Fbx {
+            axes,
+            unit_scale_factor: 100.0,
+            nodes: vec![
+                Node::new("A", None)
+                    .prop("Lcl Translation", [1.0, 2.0, 3.0])
+                    .mesh(g),
+                Node::new("B", None),
+            ],
+            ..Default::default()
+        };
+        let world_want = [
+            Vec3::new(2.0, 3.0, 2.0),
+            Vec3::new(1.0, 3.0, 3.0),
+            Vec3::new(1.0, 4.0, 2.0),
+        ];
+        let m = load(&f, "zup", &file_scale());
+        assert_eq!(m.nodes.len(), 3);
+        let root = m.nodes[0].rotation;
+        assert!(
+            close_q(root, Quat::from_xyzw(0.0, -H, -H, 0.0)),
+            "{axes:?}: {root}"
+        );
+        assert!(close(m.nodes[1].translation, Vec3::new(-1.0, 2.0, 3.0)));
+        assert_has(&m.meshes[0].mesh.positions, &[Vec3::NEG_X]);
+        assert_has(&world_positions(&m, 1), &world_want);
 
-    let baked = meta("  meshes:\n    useFileScale: 1\n    bakeAxisConversion: 1\n");
-    let m = load(&f, "zup", &baked);
-    assert!(
-        close_q(m.nodes[0].rotation, Quat::IDENTITY),
-        "{:?}",
-        m.nodes[0]
-    );
-    assert!(close(m.nodes[1].translation, Vec3::new(1.0, 3.0, 2.0)));
-    assert_has(&m.meshes[0].mesh.positions, &[Vec3::X, Vec3::Z, Vec3::Y]);
-    assert_has(&world_positions(&m, 1), &world_want);
+        let baked = meta("  meshes:\n    useFileScale: 1\n    bakeAxisConversion: 1\n");
+        let m = load(&f, "zup", &baked);
+        assert!(
+            close_q(m.nodes[0].rotation, Quat::IDENTITY),
+            "{:?}",
+            m.nodes[0]
+        );
+        assert!(close(m.nodes[1].translation, Vec3::new(1.0, 3.0, 2.0)));
+        assert_has(&m.meshes[0].mesh.positions, &[Vec3::X, Vec3::Z, Vec3::Y]);
+        assert_has(&world_positions(&m, 1), &world_want);
+    }
 }
 
 #[test]

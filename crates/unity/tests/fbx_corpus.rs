@@ -775,3 +775,25 @@ fn import_settings_read_from_real_metas() {
     assert!((ball.global_scale - 1.05).abs() < 1e-6);
     assert!(!ball.bake_axis_conversion);
 }
+
+#[test]
+fn z_up_root_rotation_matches_unitys() {
+    // CreateWithVR2021's target.prefab holds the GameObject Unity made from target.fbx
+    // (Z-up, right −X, front +Y, bakeAxisConversion 0; its one child, Cube, collapses
+    // into the root): m_LocalRotation {x: -4.3e-17, y: 0.7071068, z: 0.7071068,
+    // w: -4.3e-17} with m_LocalEulerAnglesHint 0 (set by the import, not typed in). The
+    // prefab's own scale is the node's times a uniform 0.158 the user applied, so only
+    // the rotation is compared.
+    let Some(corpus) = corpus() else { return };
+    let p = corpus_file(
+        &corpus,
+        "thespeedyboy__CreateWithVR2021/Assets/_Course Library/models/target.fbx",
+    );
+    let (m, _) = load(&p);
+    let unity = glam::Quat::from_xyzw(-4.3297806e-17, 0.7071068, 0.7071068, -4.3297806e-17);
+    let ours = m.nodes[0].rotation;
+    assert!(
+        ours.dot(unity).abs() > 1.0 - 1e-6,
+        "ours {ours}, Unity {unity}"
+    );
+}
