@@ -777,6 +777,7 @@ fn import_settings_read_from_real_metas() {
 }
 
 #[test]
+#[allow(clippy::approx_constant)] // Unity's numbers, as the prefab writes them
 fn z_up_root_rotation_matches_unitys() {
     // CreateWithVR2021's target.prefab holds the GameObject Unity made from target.fbx
     // (Z-up, right −X, front +Y, bakeAxisConversion 0; its one child, Cube, collapses
