@@ -11,8 +11,8 @@
 //!   `UnitScaleFactor / 100 · globalScale` with `useFileScale: 1`, else `globalScale`;
 //! * axes: the rotation that brings the file's up axis to +Y (Unity ignores the file's
 //!   front and right axes: a Z-up file's (x, y, z) lands at Unity (x, z, y)), either on
-//!   the root node (`bakeAxisConversion: 0`) or conjugated through every node and vertex
-//!   (`1`);
+//!   each node directly under the file's root (`bakeAxisConversion: 0`) or conjugated
+//!   through every node and vertex (`1`);
 //! * handedness: X negated (positions, normals, translations; rotations as
 //!   (x, −y, −z, w)) and every triangle's winding reversed, as for OBJ.
 //!
@@ -233,31 +233,38 @@ impl Importer {
     fn model(mut self, scene: &ufbx::Scene, stem: String) -> Model {
         let mut model = Model::default();
         let root = &scene.root_node;
-        let root_axes = if self.bake {
+        // Without baking, the axis conversion is a rotation on each node directly under
+        // the file's root (as the FBX SDK's scene conversion does it), so it is on the
+        // root GameObject only when the model collapses into its single top node: Unity
+        // made target.fbx's collapsed root the converted rotation, while Car.FBX (six top
+        // nodes) keeps an identity root in its prefab variant.
+        let top_axes = if self.bake {
             DQuat::IDENTITY
         } else {
             mirror_q(self.axes)
         };
-        // (ufbx node, parent index) in depth-first order.
-        let mut stack: Vec<(&ufbx::Node, Option<usize>)> = Vec::new();
+        // (ufbx node, parent index, directly under the file's root) in depth-first order.
+        let mut stack: Vec<(&ufbx::Node, Option<usize>, bool)> = Vec::new();
         if root.children.len() == 1 {
-            stack.push((&root.children[0], None));
+            stack.push((&root.children[0], None, true));
         } else {
             model.nodes.push(ModelNode {
                 name: stem.clone(),
                 parent: None,
                 translation: Vec3::ZERO,
-                rotation: root_axes.as_quat(),
+                rotation: glam::Quat::IDENTITY,
                 scale: Vec3::ONE,
                 mesh: None,
             });
-            stack.extend(root.children.iter().rev().map(|c| (&**c, Some(0))));
+            stack.extend(root.children.iter().rev().map(|c| (&**c, Some(0), true)));
         }
-        while let Some((node, parent)) = stack.pop() {
+        while let Some((node, parent, top)) = stack.pop() {
             let (mut t, mut q, s) = self.node_trs(&node.local_transform);
+            if top {
+                t = top_axes * t;
+                q = top_axes * q;
+            }
             let name = if parent.is_none() {
-                t = root_axes * t;
-                q = root_axes * q;
                 stem.clone()
             } else {
                 node.element.name.to_string()
@@ -276,7 +283,12 @@ impl Importer {
                 scale: s.as_vec3(),
                 mesh,
             });
-            stack.extend(node.children.iter().rev().map(|c| (&**c, Some(index))));
+            stack.extend(
+                node.children
+                    .iter()
+                    .rev()
+                    .map(|c| (&**c, Some(index), false)),
+            );
         }
         for m in scene.materials.iter() {
             let diffuse = &m.fbx.diffuse_color;

@@ -280,7 +280,7 @@ fn maya_style_pivots_move_into_the_node_translation() {
 }
 
 #[test]
-fn z_up_axis_conversion_on_the_root_or_baked() {
+fn z_up_axis_conversion_below_the_root_or_baked() {
     // Up +Z; UnitScaleFactor 100 (m) → ×1. Unity goes by the up axis alone and treats a
     // Z-up file as right −X, up +Z, front +Y: before the mirror (x,y,z) → (−x,z,y), the
     // half turn about (0,1,1)/√2, quaternion (0,½√2,½√2,0), mirrored (0,−½√2,−½√2,0);
@@ -290,8 +290,9 @@ fn z_up_axis_conversion_on_the_root_or_baked() {
     // Two root children (no collapse): A at (1,2,3) with vertices (1,0,0) (0,1,0)
     // (0,0,1), and an empty B. World positions either way: (t + v) with y and z swapped:
     // (2,2,3) → (2,3,2); (1,3,3) → (1,3,3); (1,2,4) → (1,4,2).
-    // bakeAxisConversion 0: the root carries the rotation, A's local translation is
-    // mirror(1,2,3) = (−1,2,3), vertex (1,0,0) → (−1,0,0).
+    // bakeAxisConversion 0: each node under the file's root carries the rotation (the
+    // model's root stays identity): A's rotation is the half turn, its translation the
+    // half turn of mirror(1,2,3) = (−1,2,3) → (1,3,2), its vertex (1,0,0) → (−1,0,0).
     // bakeAxisConversion 1: root rotation identity, A's translation (1,3,2), vertices
     // (1,0,0) (0,0,1) (0,1,0).
     for axes in [[2, 1, 1, -1, 0, 1], [2, 1, 1, 1, 0, -1]] {
@@ -317,12 +318,19 @@ fn z_up_axis_conversion_on_the_root_or_baked() {
         ];
         let m = load(&f, "zup", &file_scale());
         assert_eq!(m.nodes.len(), 3);
-        let root = m.nodes[0].rotation;
         assert!(
-            close_q(root, Quat::from_xyzw(0.0, -H, -H, 0.0)),
-            "{axes:?}: {root}"
+            close_q(m.nodes[0].rotation, Quat::IDENTITY),
+            "{:?}",
+            m.nodes[0]
         );
-        assert!(close(m.nodes[1].translation, Vec3::new(-1.0, 2.0, 3.0)));
+        for n in &m.nodes[1..] {
+            let q = n.rotation;
+            assert!(
+                close_q(q, Quat::from_xyzw(0.0, -H, -H, 0.0)),
+                "{axes:?}: {n:?}"
+            );
+        }
+        assert!(close(m.nodes[1].translation, Vec3::new(1.0, 3.0, 2.0)));
         assert_has(&m.meshes[0].mesh.positions, &[Vec3::NEG_X]);
         assert_has(&world_positions(&m, 1), &world_want);
 

@@ -798,3 +798,38 @@ fn z_up_root_rotation_matches_unitys() {
         "ours {ours}, Unity {unity}"
     );
 }
+
+#[test]
+fn z_up_conversion_sits_below_the_root_when_the_model_does_not_collapse() {
+    // Unity-Essentials' Car.FBX (Z-up, bakeAxisConversion 0, six nodes under the file's
+    // root): its prefab variant Car_Taxi keeps the root's m_LocalRotation at identity
+    // (m_LocalEulerAnglesHint 0), and the box a user fitted around the car on that root,
+    // size (0.194, 0.181, 0.357), has its long side on Z, as the converted children give.
+    let Some(corpus) = corpus() else { return };
+    let p = corpus_file(
+        &corpus,
+        "notenoughbees__Unity-Essentials-Project-Unity-6/Assets/_Unity Essentials/Models/Characters/Car.FBX",
+    );
+    let (m, _) = load(&p);
+    assert!(m.nodes[0].rotation.abs_diff_eq(glam::Quat::IDENTITY, 1e-6));
+    let local = |i: usize| {
+        let n = &m.nodes[i];
+        glam::Mat4::from_scale_rotation_translation(n.scale, n.rotation, n.translation)
+    };
+    let mut pts = Vec::new();
+    for (i, n) in m.nodes.iter().enumerate() {
+        let (Some(k), Some(0)) = (n.mesh, n.parent) else {
+            continue;
+        };
+        pts.extend(
+            m.meshes[k]
+                .mesh
+                .positions
+                .iter()
+                .map(|&p| local(i).transform_point3(p)),
+        );
+    }
+    let (_, size) = aabb(&pts);
+    println!("Car.FBX under its root: size {size}");
+    assert!(size.z > size.x && size.z > size.y, "{size}");
+}
