@@ -11,6 +11,7 @@ pub mod docs;
 pub mod embedded;
 pub mod emit;
 pub mod environment;
+pub mod fbx;
 pub mod graph;
 pub mod light;
 pub mod material;

@@ -141,6 +141,22 @@ pub struct ModelMeta {
     pub generation2: bool,
     /// `globalScale` (ModelImporter scale factor).
     pub global_scale: f32,
+    /// `useFileScale` ("Convert Units"); `None` in Unity 5.x metas, which fold the file's
+    /// unit into `globalScale` instead.
+    pub use_file_scale: Option<bool>,
+    /// `bakeAxisConversion: 1`: the file's axis conversion is baked into the geometry
+    /// rather than kept as a rotation on the root GameObject.
+    pub bake_axis_conversion: bool,
+    /// `materials.materialLocation`: 0 extracted `.mat` files found by name, 1 sub-assets
+    /// of the model; `None` when the meta does not say.
+    pub material_location: Option<i64>,
+    /// `externalObjects` remaps: (type, name, guid), e.g.
+    /// (`UnityEngine:Material`, FBX material name, `.mat` guid).
+    pub external_objects: Vec<(String, String, String)>,
+    /// `tangentSpace.normalImportMode`: 0 import, 1 calculate, 2 none.
+    pub normal_import_mode: i64,
+    /// `tangentSpace.normalSmoothAngle` in degrees (Unity's default 60).
+    pub normal_smoothing_angle: f32,
 }
 
 impl ModelMeta {
@@ -159,6 +175,7 @@ impl ModelMeta {
             .unwrap_or(Node::Map(vec![]));
         let mut m = ModelMeta {
             global_scale: 1.0,
+            normal_smoothing_angle: 60.0,
             ..Default::default()
         };
         for (k, v) in imp
@@ -187,6 +204,35 @@ impl ModelMeta {
                 if s.is_finite() && s > 0.0 {
                     m.global_scale = s;
                 }
+            }
+        }
+        m.use_file_scale = imp
+            .path(&["meshes", "useFileScale"])
+            .and_then(Node::as_i64)
+            .map(|v| v != 0);
+        m.bake_axis_conversion = imp
+            .path(&["meshes", "bakeAxisConversion"])
+            .and_then(Node::as_i64)
+            == Some(1);
+        m.material_location = imp
+            .path(&["materials", "materialLocation"])
+            .and_then(Node::as_i64);
+        for e in imp.get("externalObjects").map(Node::as_seq).unwrap_or(&[]) {
+            let (Some(first), Some(guid)) = (e.get("first"), e.path(&["second", "guid"])) else {
+                continue;
+            };
+            let field = |k: &str| first.str_at(k).unwrap_or("").to_string();
+            if let Some(guid) = guid.as_str() {
+                m.external_objects
+                    .push((field("type"), field("name"), guid.to_string()));
+            }
+        }
+        if let Some(ts) = imp.get("tangentSpace") {
+            if let Some(v) = ts.i64_at("normalImportMode") {
+                m.normal_import_mode = v;
+            }
+            if let Some(a) = ts.f32_at("normalSmoothAngle").filter(|a| a.is_finite()) {
+                m.normal_smoothing_angle = a;
             }
         }
         m.generation2 = imp
@@ -338,5 +384,28 @@ mod tests {
         let g2 = ModelMeta::parse("ModelImporter:\n  internalIDToNameTable:\n  - first:\n      43: 777\n    second: Foo\n  meshes:\n    fileIdsGeneration: 2\n");
         assert!(g2.generation2);
         assert_eq!(g2.ids(docs::MESH, "Foo", "Foo")[0], 777);
+        assert_eq!(g2.use_file_scale, None);
+        assert_eq!(g2.normal_smoothing_angle, 60.0);
+    }
+
+    #[test]
+    fn fbx_import_settings() {
+        // The layout of GDSJam-Reflection's Animated_door.fbx.meta (2017.2), cut down.
+        let text = "ModelImporter:\n  externalObjects:\n  - first:\n      type: UnityEngine:Material\n      assembly: UnityEngine.CoreModule\n      name: 'Material #25'\n    second: {fileID: 2100000, guid: 456775c7489e4bb4cb7e9f37e2ea3fb2, type: 2}\n  materials:\n    importMaterials: 1\n    materialLocation: 0\n  meshes:\n    globalScale: 1.5\n    useFileScale: 1\n    bakeAxisConversion: 1\n  tangentSpace:\n    normalSmoothAngle: 110\n    normalImportMode: 1\n";
+        let m = ModelMeta::parse(text);
+        assert_eq!(m.global_scale, 1.5);
+        assert_eq!(m.use_file_scale, Some(true));
+        assert!(m.bake_axis_conversion);
+        assert_eq!(m.material_location, Some(0));
+        assert_eq!(
+            m.external_objects,
+            [(
+                "UnityEngine:Material".to_string(),
+                "Material #25".to_string(),
+                "456775c7489e4bb4cb7e9f37e2ea3fb2".to_string()
+            )]
+        );
+        assert_eq!(m.normal_import_mode, 1);
+        assert_eq!(m.normal_smoothing_angle, 110.0);
     }
 }

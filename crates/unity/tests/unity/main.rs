@@ -1,7 +1,11 @@
 //! The crate's integration tests, one binary: the command-line tools, conversions of
-//! tiny hand-written projects, and the real projects of the corpus.
+//! tiny hand-written projects, the FBX reader on hand-written ASCII files, and the real
+//! projects of the corpus.
 
 mod cli;
 mod convert;
 mod corpus;
+mod fbx;
+mod fbx_ascii;
+mod fbx_corpus;
 mod support;
