@@ -7,11 +7,11 @@
 //! a thin command line over both.
 
 pub mod accuracy;
-pub mod brute;
 #[cfg(feature = "embree")]
 pub mod embree;
 pub mod error;
 pub mod measure;
+pub mod plain;
 pub mod rays;
 pub mod report;
 pub mod run;

@@ -3,6 +3,7 @@
 //! All are generated once per scene, so every contender sees exactly the same rays.
 
 use glam::Vec3;
+use kdtree::testkit::Rng;
 use kdtree::Ray;
 
 /// A ray from its parts (the kdtree crate's struct literal, spelled once).
@@ -120,24 +121,6 @@ pub fn random(bounds: [Vec3; 2], n: usize, seed: u64) -> Vec<Ray> {
             ray(o, dir, 0.0, f32::INFINITY)
         })
         .collect()
-}
-
-/// SplitMix64: small, fast and good enough for benchmark ray sets.
-pub struct Rng(pub u64);
-
-impl Rng {
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [0, 1).
-    pub fn unit(&mut self) -> f32 {
-        (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
-    }
 }
 
 #[cfg(test)]

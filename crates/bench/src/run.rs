@@ -7,6 +7,7 @@ use crate::rays::{self, View};
 use crate::scenes::{self, Scene};
 use formats::BuildParams;
 use glam::Vec3;
+use kdtree::testkit::brute;
 use kdtree::{Accel, Ray};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -274,7 +275,7 @@ struct Brute<'a>(&'a [[Vec3; 3]]);
 
 impl Tracer for Brute<'_> {
     fn closest(&self, ray: &Ray) -> Found {
-        crate::brute::intersect(self.0, ray)
+        brute::intersect_f64(self.0, ray)
             .map(|(t, prim)| Found {
                 t,
                 prim,
@@ -284,7 +285,7 @@ impl Tracer for Brute<'_> {
             .unwrap_or_default()
     }
     fn occluded(&self, ray: &Ray) -> bool {
-        crate::brute::occluded(self.0, ray)
+        brute::occluded_f64(self.0, ray)
     }
 }
 
@@ -474,7 +475,7 @@ impl Bench<'_> {
             for (i, k, o) in differ.iter().take(REFEREE_RAYS) {
                 let ray = &rays[*i];
                 let truth = if kind == Kind::Shadow {
-                    let occ = crate::brute::occluded(tris, ray);
+                    let occ = brute::occluded_f64(tris, ray);
                     (occ == k.is_hit(), occ == o.is_hit())
                 } else {
                     let b = Brute(tris).closest(ray);
