@@ -12,6 +12,9 @@
 //! compare like with like: the same tree and triangle order, the same fixed stack left
 //! uninitialised, the same four-wide leaf groups and the same tie rule.
 
+// `!(a <= b)` is deliberate, as in the product: true when either side is NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use formats::{Hit, KdFile, KdNode};
 use glam::Vec3;
 use kdtree::triangle::{widen, RawHit, RayPre};

@@ -92,6 +92,11 @@ fn setup(ray: &Ray, b: &Aabb) -> Option<Setup> {
     })
 }
 
+#[inline(always)]
+fn test<const KZ: usize>(s: &Setup, ray: &Ray, tri: &[[f32; 3]; 3], tmax: f32) -> Option<RawHit> {
+    triangle::intersect_along::<KZ>(&s.pre, tri, ray.tmin, tmax)
+}
+
 /// Children of interior node `i` to visit, in order, with their intervals.
 enum Step {
     One(u32),
@@ -338,12 +343,7 @@ impl Tree<'_> {
                 }
             } else {
                 for &p in leaf {
-                    if let Some(h) = triangle::intersect_along::<KZ>(
-                        &s.pre,
-                        self.tri(p),
-                        ray.tmin,
-                        triangle::widen(best_t),
-                    ) {
+                    if let Some(h) = test::<KZ>(s, ray, self.tri(p), triangle::widen(best_t)) {
                         keep_closer(&mut best, &mut best_t, self.soup_index(p), h);
                     }
                 }
@@ -407,9 +407,7 @@ impl Tree<'_> {
                 }
             } else {
                 for &p in leaf {
-                    if triangle::intersect_along::<KZ>(&s.pre, self.tri(p), ray.tmin, ray.tmax)
-                        .is_some()
-                    {
+                    if test::<KZ>(s, ray, self.tri(p), ray.tmax).is_some() {
                         return true;
                     }
                 }

@@ -1,7 +1,8 @@
 //! The quick benchmark, in process, on a tiny generated scene: the report has the rows
 //! the tables need and every contender agrees with the k-d tree.
 
-use bench::run::{Kind, Role, BRUTE, EMBREE, KDTREE, MEDIAN};
+use bench::contenders::{BRUTE, EMBREE, KDTREE, MEDIAN};
+use bench::results::{Kind, Role};
 use bench::{report, run, scenes, Config};
 use std::path::PathBuf;
 
