@@ -6,16 +6,6 @@ use glam::Vec3;
 use kdtree::testkit::Rng;
 use kdtree::Ray;
 
-/// A ray from its parts (the kdtree crate's struct literal, spelled once).
-pub fn ray(origin: Vec3, dir: Vec3, tmin: f32, tmax: f32) -> Ray {
-    Ray {
-        origin,
-        dir,
-        tmin,
-        tmax,
-    }
-}
-
 /// A pinhole camera (square image).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct View {
@@ -59,7 +49,7 @@ pub fn primary(view: &View, size: u32) -> Vec<Ray> {
             let sx = ((x as f32 + 0.5) / size as f32 * 2.0 - 1.0) * half;
             let sy = (1.0 - (y as f32 + 0.5) / size as f32 * 2.0) * half;
             let dir = (view.forward + right * sx + up * sy).normalize();
-            out.push(ray(view.eye, dir, 0.0, f32::INFINITY));
+            out.push(Ray::new(view.eye, dir, 0.0, f32::INFINITY));
         }
     }
     out
@@ -101,7 +91,7 @@ pub fn shadow(
             let o = p + n * offset;
             let to = light - o;
             let dist = to.length();
-            (dist > 0.0 && dist.is_finite()).then(|| ray(o, to / dist, 0.0, dist))
+            (dist > 0.0 && dist.is_finite()).then(|| Ray::new(o, to / dist, 0.0, dist))
         })
         .collect()
 }
@@ -118,7 +108,7 @@ pub fn random(bounds: [Vec3; 2], n: usize, seed: u64) -> Vec<Ray> {
             let phi = std::f32::consts::TAU * rng.unit();
             let r = (1.0 - z * z).max(0.0).sqrt();
             let dir = Vec3::new(r * phi.cos(), r * phi.sin(), z);
-            ray(o, dir, 0.0, f32::INFINITY)
+            Ray::new(o, dir, 0.0, f32::INFINITY)
         })
         .collect()
 }
