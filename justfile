@@ -72,3 +72,11 @@ large SIDE="16": build
 # Render speed-up from 1 to 2 threads on the baseline (interleaved pairs, one process); `just threads --width 320 --height 240`.
 threads *ARGS:
     cargo run --release --quiet -p bench --bin threads -- {{ARGS}}
+
+# k-d tree build and traversal table plus what watertightness costs (leaks from inside closed meshes); `just robustbench --only spot`.
+robustbench *ARGS:
+    cargo run --release --quiet -p bench --bin robustbench -- {{ARGS}}
+
+# Build-parameter experiments with a tree digest per file; `just kdtune 1.5 1 0.5 0 1 out/baseline.soup`.
+kdtune *ARGS:
+    cargo run --release --quiet -p bench --bin kdtune -- {{ARGS}}

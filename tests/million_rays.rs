@@ -5,7 +5,8 @@
 //! `cargo test --release --test million_rays -- --ignored`.
 
 use formats::rays::{self, RayRecord};
-use kdtree::{brute, Ray};
+use kdtree::testkit::brute;
+use kdtree::Ray;
 use rayon::prelude::*;
 use unitrace::run_ok;
 

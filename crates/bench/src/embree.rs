@@ -392,7 +392,6 @@ impl Drop for EmbreeScene {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rays::ray;
 
     fn quad() -> Vec<[Vec3; 3]> {
         // Unit square at z = 2 split into two triangles, plus a small triangle behind it.
@@ -418,7 +417,7 @@ mod tests {
     #[test]
     fn hits_the_front_triangle_with_its_barycentrics() {
         let s = EmbreeScene::new(&quad()).unwrap();
-        let r = ray(Vec3::new(0.75, 0.25, 0.0), Vec3::Z, 0.0, f32::INFINITY);
+        let r = Ray::new(Vec3::new(0.75, 0.25, 0.0), Vec3::Z, 0.0, f32::INFINITY);
         let (t, prim, u, v) = s.intersect(&r).unwrap();
         assert!((t - 2.0).abs() < 1e-6, "t = {t}");
         assert_eq!(prim, 0);
@@ -429,10 +428,10 @@ mod tests {
         );
         assert!(s.occluded(&r));
         // The interval excludes the front quad: the back triangle at t = 5 is found.
-        let r2 = ray(Vec3::new(0.1, 0.1, 0.0), Vec3::Z, 3.0, 10.0);
+        let r2 = Ray::new(Vec3::new(0.1, 0.1, 0.0), Vec3::Z, 3.0, 10.0);
         assert_eq!(s.intersect(&r2).map(|h| h.1), Some(2));
         // Too short to reach anything.
-        let r3 = ray(Vec3::new(0.1, 0.1, 0.0), Vec3::Z, 0.0, 1.5);
+        let r3 = Ray::new(Vec3::new(0.1, 0.1, 0.0), Vec3::Z, 0.0, 1.5);
         assert!(s.intersect(&r3).is_none());
         assert!(!s.occluded(&r3));
         assert!(s.memory_bytes() > 0);

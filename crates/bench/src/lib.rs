@@ -7,15 +7,22 @@
 //! a thin command line over both.
 
 pub mod accuracy;
-pub mod brute;
+pub mod agreement;
+pub mod config;
+pub mod contenders;
 #[cfg(feature = "embree")]
 pub mod embree;
 pub mod error;
+pub mod header;
 pub mod measure;
+pub mod plain;
 pub mod rays;
 pub mod report;
+pub mod results;
 pub mod run;
 pub mod scenes;
 
+pub use config::Config;
 pub use error::BenchError;
-pub use run::{run, Config, Report};
+pub use results::Report;
+pub use run::run;

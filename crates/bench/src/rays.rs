@@ -3,17 +3,8 @@
 //! All are generated once per scene, so every contender sees exactly the same rays.
 
 use glam::Vec3;
+use kdtree::testkit::Rng;
 use kdtree::Ray;
-
-/// A ray from its parts (the kdtree crate's struct literal, spelled once).
-pub fn ray(origin: Vec3, dir: Vec3, tmin: f32, tmax: f32) -> Ray {
-    Ray {
-        origin,
-        dir,
-        tmin,
-        tmax,
-    }
-}
 
 /// A pinhole camera (square image).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -58,7 +49,7 @@ pub fn primary(view: &View, size: u32) -> Vec<Ray> {
             let sx = ((x as f32 + 0.5) / size as f32 * 2.0 - 1.0) * half;
             let sy = (1.0 - (y as f32 + 0.5) / size as f32 * 2.0) * half;
             let dir = (view.forward + right * sx + up * sy).normalize();
-            out.push(ray(view.eye, dir, 0.0, f32::INFINITY));
+            out.push(Ray::new(view.eye, dir, 0.0, f32::INFINITY));
         }
     }
     out
@@ -100,7 +91,7 @@ pub fn shadow(
             let o = p + n * offset;
             let to = light - o;
             let dist = to.length();
-            (dist > 0.0 && dist.is_finite()).then(|| ray(o, to / dist, 0.0, dist))
+            (dist > 0.0 && dist.is_finite()).then(|| Ray::new(o, to / dist, 0.0, dist))
         })
         .collect()
 }
@@ -117,27 +108,9 @@ pub fn random(bounds: [Vec3; 2], n: usize, seed: u64) -> Vec<Ray> {
             let phi = std::f32::consts::TAU * rng.unit();
             let r = (1.0 - z * z).max(0.0).sqrt();
             let dir = Vec3::new(r * phi.cos(), r * phi.sin(), z);
-            ray(o, dir, 0.0, f32::INFINITY)
+            Ray::new(o, dir, 0.0, f32::INFINITY)
         })
         .collect()
-}
-
-/// SplitMix64: small, fast and good enough for benchmark ray sets.
-pub struct Rng(pub u64);
-
-impl Rng {
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [0, 1).
-    pub fn unit(&mut self) -> f32 {
-        (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
-    }
 }
 
 #[cfg(test)]

@@ -1,7 +1,8 @@
-//! The report as markdown: header, the issue's targets, build, traversal (with the
+//! The report as markdown: header, the performance targets, build, traversal (with the
 //! kdtree/Embree ratio) and agreement tables, then notes.
 
-use crate::run::{Kind, Report, Role, SceneResult, TraceRow, BRUTE, EMBREE, KDTREE, MEDIAN};
+use crate::contenders::{BRUTE, EMBREE, KDTREE, MEDIAN};
+use crate::results::{Kind, Referee, Report, Role, SceneResult, TraceRow};
 use std::fmt::Write;
 
 fn trace<'a>(s: &'a SceneResult, who: &str, threads: usize, kind: Kind) -> Option<&'a TraceRow> {
@@ -36,7 +37,7 @@ fn yes(ok: bool) -> &'static str {
     }
 }
 
-/// The issue's targets, for the scenes this run measured.
+/// The performance targets, for the scenes this run measured.
 fn targets(r: &Report, out: &mut String) {
     let mut rows = vec![];
     for s in &r.scenes {
@@ -106,7 +107,7 @@ fn targets(r: &Report, out: &mut String) {
     if rows.is_empty() {
         return;
     }
-    out.push_str("## Targets (issue 4)\n\n| target | measured | met |\n|---|---:|:---:|\n");
+    out.push_str("## Targets\n\n| target | measured | met |\n|---|---:|:---:|\n");
     for (what, measured, ok) in rows {
         let _ = writeln!(out, "| {what} | {measured} | {} |", yes(ok));
     }
@@ -242,14 +243,14 @@ fn agreement(r: &Report, out: &mut String) {
             };
             let worst = rows.iter().map(|a| a.agreement()).fold(1.0f64, f64::min);
             let ok = rows.iter().all(|a| a.ok());
-            let referee =
-                rows.iter()
-                    .filter_map(|a| a.referee)
-                    .reduce(|a, b| crate::run::Referee {
-                        checked: a.checked + b.checked,
-                        kdtree_right: a.kdtree_right + b.kdtree_right,
-                        other_right: a.other_right + b.other_right,
-                    });
+            let referee = rows
+                .iter()
+                .filter_map(|a| a.referee)
+                .reduce(|a, b| Referee {
+                    checked: a.checked + b.checked,
+                    kdtree_right: a.kdtree_right + b.kdtree_right,
+                    other_right: a.other_right + b.other_right,
+                });
             let _ = writeln!(
                 out,
                 "| {} | {who} | {} | {} | {} | {:.4}% | {} | {} |",

@@ -4,8 +4,9 @@
 //!   with perfect splits, parallel over subtrees).
 //! * [`Accel`] pairs a soup's triangles with a compiled tree and answers closest-hit
 //!   ([`Accel::intersect`]) and any-hit ([`Accel::occluded`]) queries.
-//! * [`brute`] answers the same queries by testing every triangle: the reference for
-//!   tests and benchmarks.
+//! * `testkit` (feature `testkit`, and this crate's own tests) holds what tests and
+//!   benchmarks need and the product does not: test meshes, an RNG and brute-force
+//!   references.
 //!
 //! See docs/ROBUSTNESS.md for the numerical hard cases and the tests that pin them.
 
@@ -15,7 +16,8 @@
 
 pub mod aabb;
 pub mod build;
-pub mod gen;
+#[cfg(any(test, feature = "testkit"))]
+pub mod testkit;
 mod traverse;
 pub mod triangle;
 
@@ -179,18 +181,12 @@ impl Accel {
     /// Closest hit with t in [tmin, tmax], or None. Ties in t go to the lower triangle
     /// index. NaN/infinite rays, zero directions and tmin > tmax are misses.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        self.tree().closest::<true>(ray)
+        self.tree().closest(ray)
     }
 
     /// Whether anything blocks the ray in [tmin, tmax]; stops at the first blocker.
     pub fn occluded(&self, ray: &Ray) -> bool {
-        self.tree().any::<true>(ray)
-    }
-
-    /// Closest hit with plain Möller–Trumbore and unpadded textbook traversal: NOT
-    /// watertight. Only for measuring what robustness costs.
-    pub fn intersect_plain(&self, ray: &Ray) -> Option<Hit> {
-        self.tree().closest::<false>(ray)
+        self.tree().any(ray)
     }
 
     /// Bytes held for queries: nodes, leaf lists and triangle data.
@@ -218,21 +214,6 @@ pub fn query_bytes(kd: &KdFile) -> usize {
     kd.nodes.len() * std::mem::size_of::<KdNode>()
         + kd.leaf_tris.len() * 4
         + kd.stats.triangles as usize * (std::mem::size_of::<[[f32; 3]; 3]>() + 4)
-}
-
-/// Brute-force queries: every triangle, the same watertight test and tie rule as the tree.
-pub mod brute {
-    use super::*;
-
-    /// Closest hit in [tmin, tmax] by testing every triangle.
-    pub fn intersect(triangles: &[[Vec3; 3]], ray: &Ray) -> Option<Hit> {
-        traverse::brute_closest(triangles, ray)
-    }
-
-    /// Whether any triangle is hit in [tmin, tmax].
-    pub fn occluded(triangles: &[[Vec3; 3]], ray: &Ray) -> bool {
-        intersect(triangles, ray).is_some()
-    }
 }
 
 #[cfg(test)]
@@ -268,8 +249,8 @@ mod tree_tests {
     use super::*;
 
     fn scene() -> Vec<[Vec3; 3]> {
-        let mut t = gen::sphere(Vec3::new(0.0, 1.0, 0.0), 1.0, 16, 32);
-        t.extend(gen::grid(8, 8.0, 0.0));
+        let mut t = testkit::sphere(Vec3::new(0.0, 1.0, 0.0), 1.0, 16, 32);
+        t.extend(testkit::grid(8, 8.0, 0.0));
         t
     }
 

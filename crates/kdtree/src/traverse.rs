@@ -1,6 +1,6 @@
 //! Front-to-back k-d tree traversal with a fixed-size stack.
 //!
-//! Robustness rules (DESIGN §7, docs/ROBUSTNESS.md):
+//! Robustness rules (docs/ROBUSTNESS.md):
 //! * A direction component that is ±0 (or so small that its reciprocal overflows) makes
 //!   the ray parallel to that axis's planes: the box test decides from the origin alone,
 //!   and at a split the plane distance (split − o)·(±∞) is ±∞ on the origin's side, so
@@ -13,14 +13,13 @@
 //!   cell the ray only grazes is visited rather than skipped by rounding.
 //! * NaN or infinite rays, zero directions and empty intervals are misses, never a hang.
 //!
-//! The `ROBUST = false` instantiation (plain Möller–Trumbore, unpadded intervals and
-//! plain IEEE arithmetic on ±0) exists only for the robustness-cost benchmark.
+//! This is the product's only traversal; the textbook variant that measures what these
+//! rules cost lives in the bench crate.
 
 use crate::aabb::Aabb;
 use crate::triangle::{self, RawHit, RayPre};
 use crate::Ray;
 use formats::{Hit, KdNode};
-use glam::Vec3;
 use std::mem::MaybeUninit;
 
 /// Entries of the traversal stack (≥ the build's depth bound, which is at most 60).
@@ -57,7 +56,7 @@ struct Setup {
 
 /// None when the ray cannot hit anything (bad numbers, empty interval, misses the box).
 #[inline(always)]
-fn setup<const ROBUST: bool>(ray: &Ray, b: &Aabb) -> Option<Setup> {
+fn setup(ray: &Ray, b: &Aabb) -> Option<Setup> {
     if !(ray.tmin <= ray.tmax) || ray.tmax == f32::NEG_INFINITY || ray.tmin == f32::INFINITY {
         return None;
     }
@@ -65,15 +64,11 @@ fn setup<const ROBUST: bool>(ray: &Ray, b: &Aabb) -> Option<Setup> {
     let o = ray.origin.to_array();
     let d = ray.dir.to_array();
     let inv = [1.0 / d[0], 1.0 / d[1], 1.0 / d[2]];
-    let parallel = if ROBUST {
-        [
-            !inv[0].is_finite(),
-            !inv[1].is_finite(),
-            !inv[2].is_finite(),
-        ]
-    } else {
-        [false; 3]
-    };
+    let parallel = [
+        !inv[0].is_finite(),
+        !inv[1].is_finite(),
+        !inv[2].is_finite(),
+    ];
     let (mut t0, mut t1) = (ray.tmin, ray.tmax);
     for a in 0..3 {
         if parallel[a] {
@@ -84,26 +79,11 @@ fn setup<const ROBUST: bool>(ray: &Ray, b: &Aabb) -> Option<Setup> {
             let ta = (b.lo[a] - o[a]) * inv[a];
             let tb = (b.hi[a] - o[a]) * inv[a];
             let (near, far) = if inv[a] > 0.0 { (ta, tb) } else { (tb, ta) };
-            if ROBUST {
-                t0 = t0.max(near);
-                t1 = t1.min(far);
-            } else {
-                // Plain slabs: NaN from 0·inf falls through as in textbook code.
-                if near > t0 {
-                    t0 = near;
-                }
-                if far < t1 {
-                    t1 = far;
-                }
-            }
+            t0 = t0.max(near);
+            t1 = t1.min(far);
         }
     }
-    let open = if ROBUST {
-        pad_down(t0) <= pad_up(t1)
-    } else {
-        t0 <= t1
-    };
-    open.then_some(Setup {
+    (pad_down(t0) <= pad_up(t1)).then_some(Setup {
         pre,
         o,
         inv,
@@ -113,17 +93,8 @@ fn setup<const ROBUST: bool>(ray: &Ray, b: &Aabb) -> Option<Setup> {
 }
 
 #[inline(always)]
-fn test<const ROBUST: bool, const KZ: usize>(
-    s: &Setup,
-    ray: &Ray,
-    tri: &[[f32; 3]; 3],
-    tmax: f32,
-) -> Option<RawHit> {
-    if ROBUST {
-        triangle::intersect_along::<KZ>(&s.pre, tri, ray.tmin, tmax)
-    } else {
-        triangle::intersect_moller(ray.origin, ray.dir, tri, ray.tmin, tmax)
-    }
+fn test<const KZ: usize>(s: &Setup, ray: &Ray, tri: &[[f32; 3]; 3], tmax: f32) -> Option<RawHit> {
+    triangle::intersect_along::<KZ>(&s.pre, tri, ray.tmin, tmax)
 }
 
 /// Children of interior node `i` to visit, in order, with their intervals.
@@ -159,56 +130,33 @@ fn far_start(t_split: f32, t0: f32) -> f32 {
     }
 }
 
-/// The robust path needs no case for rays parallel to the split plane (a direction
-/// component of ±0, or one whose reciprocal overflowed): `inv` is then ±∞ with the
-/// direction's sign, so the plane distance is ±∞ on the side the origin is on and picks
-/// that child alone by the same comparisons as every other ray, and a ray lying in the
-/// plane gets 0·∞ = NaN, which no comparison accepts: both children, over the whole
-/// interval ([`near_end`], [`far_start`]).
+/// No case is needed for rays parallel to the split plane (a direction component of ±0,
+/// or one whose reciprocal overflowed): `inv` is then ±∞ with the direction's sign, so the
+/// plane distance is ±∞ on the side the origin is on and picks that child alone by the
+/// same comparisons as every other ray, and a ray lying in the plane gets 0·∞ = NaN,
+/// which no comparison accepts: both children, over the whole interval ([`near_end`],
+/// [`far_start`]).
 #[inline(always)]
-fn step<const ROBUST: bool>(s: &Setup, i: u32, node: KdNode, t0: f32, t1: f32) -> Step {
+fn step(s: &Setup, i: u32, node: KdNode, t0: f32, t1: f32) -> Step {
     let a = node.axis();
     let below = i + 1;
     let above = node.above_child();
     let tp = (node.split() - s.o[a]) * s.inv[a];
-    if ROBUST {
-        // The ray comes from the side opposite its direction and goes to the other.
-        let (first, second) = if s.inv[a] > 0.0 {
-            (below, above)
-        } else {
-            (above, below)
-        };
-        if tp > pad_up(t1) {
-            Step::One(first)
-        } else if tp < pad_down(t0) {
-            Step::One(second)
-        } else {
-            Step::Two {
-                first,
-                second,
-                t_split: tp,
-            }
-        }
+    // The ray comes from the side opposite its direction and goes to the other.
+    let (first, second) = if s.inv[a] > 0.0 {
+        (below, above)
     } else {
-        // pbrt-v3's textbook rule.
-        let o = s.o[a];
-        let split = node.split();
-        let below_first = o < split || (o == split && s.inv[a] <= 0.0);
-        let (first, second) = if below_first {
-            (below, above)
-        } else {
-            (above, below)
-        };
-        if tp > t1 || tp <= 0.0 {
-            Step::One(first)
-        } else if tp < t0 {
-            Step::One(second)
-        } else {
-            Step::Two {
-                first,
-                second,
-                t_split: tp,
-            }
+        (above, below)
+    };
+    if tp > pad_up(t1) {
+        Step::One(first)
+    } else if tp < pad_down(t0) {
+        Step::One(second)
+    } else {
+        Step::Two {
+            first,
+            second,
+            t_split: tp,
         }
     }
 }
@@ -242,7 +190,7 @@ fn pop(stack: &Stack, sp: usize) -> (u32, f32, f32) {
 /// into a struct it cost 4–12 % of ray speed.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn take_step<const ROBUST: bool>(
+fn take_step(
     s: &Setup,
     node: KdNode,
     node_i: &mut u32,
@@ -251,7 +199,7 @@ fn take_step<const ROBUST: bool>(
     stack: &mut Stack,
     sp: &mut usize,
 ) {
-    match step::<ROBUST>(s, *node_i, node, t0, *t1) {
+    match step(s, *node_i, node, t0, *t1) {
         Step::One(c) => *node_i = c,
         Step::Two {
             first,
@@ -267,13 +215,13 @@ fn take_step<const ROBUST: bool>(
 }
 
 /// `take_step` for any-hit (shadow) rays, whose choice of children changes from ray to
-/// ray and mispredicts: branch-free in the robust path (the far child is always written
+/// ray and mispredicts: branch-free (the far child is always written
 /// and the stack only grows when both children are visited; the cases and their order are
 /// `step`'s), with the far child's node prefetched, as it is the next node or waits on
 /// the stack. Shadow rays +10–12 %.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn take_step_branch_free<const ROBUST: bool>(
+fn take_step_branch_free(
     nodes: &[KdNode],
     s: &Setup,
     node: KdNode,
@@ -283,9 +231,6 @@ fn take_step_branch_free<const ROBUST: bool>(
     stack: &mut Stack,
     sp: &mut usize,
 ) {
-    if !ROBUST {
-        return take_step::<ROBUST>(s, node, node_i, t0, t1, stack, sp);
-    }
     let a = node.axis();
     let below = *node_i + 1;
     let above = node.above_child();
@@ -337,7 +282,7 @@ impl Tree<'_> {
     /// The watertight test on a group of 1–4 leaf entries (short groups repeat their last
     /// entry, which cannot change an answer); returns the entries lane by lane.
     #[inline(always)]
-    fn test4<const ROBUST: bool, const KZ: usize>(
+    fn test4<const KZ: usize>(
         &self,
         s: &Setup,
         ray: &Ray,
@@ -347,11 +292,7 @@ impl Tree<'_> {
         let last = group[group.len() - 1];
         let lanes: [u32; 4] = std::array::from_fn(|l| *group.get(l).unwrap_or(&last));
         let tris = lanes.map(|p| self.tri(p));
-        let hits = if ROBUST {
-            triangle::intersect4_along::<KZ>(&s.pre, tris, ray.tmin, tmax)
-        } else {
-            triangle::intersect4_moller(ray.origin, ray.dir, tris, ray.tmin, tmax)
-        };
+        let hits = triangle::intersect4_along::<KZ>(&s.pre, tris, ray.tmin, tmax);
         (lanes, hits)
     }
 
@@ -365,23 +306,19 @@ impl Tree<'_> {
     /// Closest hit in [tmin, tmax]; ties in t go to the lower triangle index (so the
     /// answer is the brute-force loop's, whatever the leaf order).
     #[inline(always)]
-    pub fn closest<const ROBUST: bool>(&self, ray: &Ray) -> Option<Hit> {
-        let s = setup::<ROBUST>(ray, self.bounds)?;
+    pub fn closest(&self, ray: &Ray) -> Option<Hit> {
+        let s = setup(ray, self.bounds)?;
         // One instantiation per dominant axis: the triangle test's permutation is then a
         // constant (see `triangle::intersect_along`).
         match s.pre.kz {
-            0 => self.closest_along::<ROBUST, 0>(ray, &s),
-            1 => self.closest_along::<ROBUST, 1>(ray, &s),
-            _ => self.closest_along::<ROBUST, 2>(ray, &s),
+            0 => self.closest_along::<0>(ray, &s),
+            1 => self.closest_along::<1>(ray, &s),
+            _ => self.closest_along::<2>(ray, &s),
         }
     }
 
     #[inline(always)]
-    fn closest_along<const ROBUST: bool, const KZ: usize>(
-        &self,
-        ray: &Ray,
-        s: &Setup,
-    ) -> Option<Hit> {
+    fn closest_along<const KZ: usize>(&self, ray: &Ray, s: &Setup) -> Option<Hit> {
         let mut best = Hit::MISS;
         let mut best_t = ray.tmax;
         let mut stack = new_stack();
@@ -390,14 +327,14 @@ impl Tree<'_> {
         loop {
             let node = self.node(node_i);
             if !node.is_leaf() {
-                take_step::<ROBUST>(s, node, &mut node_i, t0, &mut t1, &mut stack, &mut sp);
+                take_step(s, node, &mut node_i, t0, &mut t1, &mut stack, &mut sp);
                 continue;
             }
             let leaf = self.leaf(node);
             if leaf.len() >= 2 {
                 for group in leaf.chunks(4) {
                     let bound = triangle::widen(best_t);
-                    let (lanes, hits) = self.test4::<ROBUST, KZ>(s, ray, group, bound);
+                    let (lanes, hits) = self.test4::<KZ>(s, ray, group, bound);
                     for (p, h) in lanes.into_iter().zip(hits) {
                         if let Some(h) = h {
                             keep_closer(&mut best, &mut best_t, self.soup_index(p), h);
@@ -406,9 +343,7 @@ impl Tree<'_> {
                 }
             } else {
                 for &p in leaf {
-                    if let Some(h) =
-                        test::<ROBUST, KZ>(s, ray, self.tri(p), triangle::widen(best_t))
-                    {
+                    if let Some(h) = test::<KZ>(s, ray, self.tri(p), triangle::widen(best_t)) {
                         keep_closer(&mut best, &mut best_t, self.soup_index(p), h);
                     }
                 }
@@ -422,8 +357,7 @@ impl Tree<'_> {
             }
             sp -= 1;
             (node_i, t0, t1) = pop(&stack, sp);
-            let enter = if ROBUST { pad_down(t0) } else { t0 };
-            if best_t < enter {
+            if best_t < pad_down(t0) {
                 break;
             }
         }
@@ -432,26 +366,26 @@ impl Tree<'_> {
 
     /// Whether any triangle is hit in [tmin, tmax]; stops at the first one found.
     #[inline(always)]
-    pub fn any<const ROBUST: bool>(&self, ray: &Ray) -> bool {
-        let Some(s) = setup::<ROBUST>(ray, self.bounds) else {
+    pub fn any(&self, ray: &Ray) -> bool {
+        let Some(s) = setup(ray, self.bounds) else {
             return false;
         };
         match s.pre.kz {
-            0 => self.any_along::<ROBUST, 0>(ray, &s),
-            1 => self.any_along::<ROBUST, 1>(ray, &s),
-            _ => self.any_along::<ROBUST, 2>(ray, &s),
+            0 => self.any_along::<0>(ray, &s),
+            1 => self.any_along::<1>(ray, &s),
+            _ => self.any_along::<2>(ray, &s),
         }
     }
 
     #[inline(always)]
-    fn any_along<const ROBUST: bool, const KZ: usize>(&self, ray: &Ray, s: &Setup) -> bool {
+    fn any_along<const KZ: usize>(&self, ray: &Ray, s: &Setup) -> bool {
         let mut stack = new_stack();
         let mut sp = 0;
         let (mut node_i, mut t0, mut t1) = (0u32, s.t0, s.t1);
         loop {
             let node = self.node(node_i);
             if !node.is_leaf() {
-                take_step_branch_free::<ROBUST>(
+                take_step_branch_free(
                     self.nodes,
                     s,
                     node,
@@ -466,14 +400,14 @@ impl Tree<'_> {
             let leaf = self.leaf(node);
             if leaf.len() >= 2 {
                 for group in leaf.chunks(4) {
-                    let (_, hits) = self.test4::<ROBUST, KZ>(s, ray, group, ray.tmax);
+                    let (_, hits) = self.test4::<KZ>(s, ray, group, ray.tmax);
                     if hits.iter().any(Option::is_some) {
                         return true;
                     }
                 }
             } else {
                 for &p in leaf {
-                    if test::<ROBUST, KZ>(s, ray, self.tri(p), ray.tmax).is_some() {
+                    if test::<KZ>(s, ray, self.tri(p), ray.tmax).is_some() {
                         return true;
                     }
                 }
@@ -492,7 +426,7 @@ impl Tree<'_> {
 /// and four-wide groups against the bound at the group's start, so `h.t <= best_t` here is
 /// the exact test.
 #[inline(always)]
-fn keep_closer(best: &mut Hit, best_t: &mut f32, prim: u32, h: RawHit) {
+pub(crate) fn keep_closer(best: &mut Hit, best_t: &mut f32, prim: u32, h: RawHit) {
     if h.t <= *best_t && (h.t < *best_t || prim < best.prim) {
         *best_t = h.t;
         *best = Hit {
@@ -502,21 +436,4 @@ fn keep_closer(best: &mut Hit, best_t: &mut f32, prim: u32, h: RawHit) {
             v: h.v,
         };
     }
-}
-
-/// Brute-force closest hit with the same intersector and tie rule as the tree.
-pub(crate) fn brute_closest(tris: &[[Vec3; 3]], ray: &Ray) -> Option<Hit> {
-    if !(ray.tmin <= ray.tmax) || ray.tmax == f32::NEG_INFINITY || ray.tmin == f32::INFINITY {
-        return None;
-    }
-    let pre = RayPre::new(ray.origin, ray.dir)?;
-    let mut best = Hit::MISS;
-    let mut best_t = ray.tmax;
-    for (i, t) in tris.iter().enumerate() {
-        let tri = [t[0].to_array(), t[1].to_array(), t[2].to_array()];
-        if let Some(h) = triangle::intersect(&pre, &tri, ray.tmin, triangle::widen(best_t)) {
-            keep_closer(&mut best, &mut best_t, i as u32, h);
-        }
-    }
-    (!best.is_miss()).then_some(best)
 }

@@ -222,93 +222,6 @@ pub fn intersect4_along<const KZ: usize>(
     })
 }
 
-/// Plain Möller–Trumbore (1997), kept only to measure what watertightness costs: it leaks
-/// rays through shared edges and rejects hits with an absolute determinant epsilon.
-#[inline(always)]
-pub fn intersect_moller(
-    origin: Vec3,
-    dir: Vec3,
-    tri: &[[f32; 3]; 3],
-    tmin: f32,
-    tmax: f32,
-) -> Option<RawHit> {
-    let v0 = Vec3::from(tri[0]);
-    let e1 = Vec3::from(tri[1]) - v0;
-    let e2 = Vec3::from(tri[2]) - v0;
-    let p = dir.cross(e2);
-    let det = e1.dot(p);
-    if det.abs() < 1e-8 {
-        return None;
-    }
-    let inv = 1.0 / det;
-    let s = origin - v0;
-    let u = s.dot(p) * inv;
-    if !(0.0..=1.0).contains(&u) {
-        return None;
-    }
-    let q = s.cross(e1);
-    let v = dir.dot(q) * inv;
-    if v < 0.0 || u + v > 1.0 {
-        return None;
-    }
-    let t = e2.dot(q) * inv;
-    if t >= tmin && t <= tmax {
-        Some(RawHit { t, u, v })
-    } else {
-        None
-    }
-}
-
-/// [`intersect_moller`] on four triangles, lane by lane (the plain path's counterpart
-/// of [`intersect4_along`], so the robustness benchmark compares like with like).
-#[inline(always)]
-pub fn intersect4_moller(
-    origin: Vec3,
-    dir: Vec3,
-    tri: [&[[f32; 3]; 3]; 4],
-    tmin: f32,
-    tmax: f32,
-) -> [Option<RawHit>; 4] {
-    let lanes = |f: &dyn Fn(&[[f32; 3]; 3]) -> f32| -> [f32; 4] {
-        [f(tri[0]), f(tri[1]), f(tri[2]), f(tri[3])]
-    };
-    let (o, d) = (origin.to_array(), dir.to_array());
-    let e1: [[f32; 4]; 3] = std::array::from_fn(|k| lanes(&|t| t[1][k] - t[0][k]));
-    let e2: [[f32; 4]; 3] = std::array::from_fn(|k| lanes(&|t| t[2][k] - t[0][k]));
-    let s: [[f32; 4]; 3] = std::array::from_fn(|k| lanes(&|t| o[k] - t[0][k]));
-    let mut out = [None; 4];
-    let mut candidate = [false; 4];
-    let (mut u, mut inv) = ([0f32; 4], [0f32; 4]);
-    for l in 0..4 {
-        // p = d × e2, det = e1 · p, u = s · p / det
-        let p = [
-            d[1] * e2[2][l] - d[2] * e2[1][l],
-            d[2] * e2[0][l] - d[0] * e2[2][l],
-            d[0] * e2[1][l] - d[1] * e2[0][l],
-        ];
-        let det = e1[0][l] * p[0] + e1[1][l] * p[1] + e1[2][l] * p[2];
-        inv[l] = 1.0 / det;
-        u[l] = (s[0][l] * p[0] + s[1][l] * p[1] + s[2][l] * p[2]) * inv[l];
-        candidate[l] = det.abs() >= 1e-8 && (0.0..=1.0).contains(&u[l]);
-    }
-    for l in 0..4 {
-        if !candidate[l] {
-            continue;
-        }
-        let q = Vec3::from([s[0][l], s[1][l], s[2][l]])
-            .cross(Vec3::from([e1[0][l], e1[1][l], e1[2][l]]));
-        let v = dir.dot(q) * inv[l];
-        if v < 0.0 || u[l] + v > 1.0 {
-            continue;
-        }
-        let t = Vec3::from([e2[0][l], e2[1][l], e2[2][l]]).dot(q) * inv[l];
-        if t >= tmin && t <= tmax {
-            out[l] = Some(RawHit { t, u: u[l], v });
-        }
-    }
-    out
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -353,14 +266,9 @@ mod tests {
     /// every lane answers with exactly the scalar test's bits.
     #[test]
     fn four_wide_matches_the_scalar_test_bit_for_bit() {
-        let mut state = 7u64;
-        let mut unit = move || {
-            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = state;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 23) as f32 - 1.0
-        };
+        // Uniform in [-1, 1): 2·unit − 1 is exact on unit's 2⁻²⁴ grid.
+        let mut rng = crate::testkit::Rng(7);
+        let mut unit = move || 2.0 * rng.unit() - 1.0;
         let bits = |h: Option<RawHit>| h.map(|h| (h.t.to_bits(), h.u.to_bits(), h.v.to_bits()));
         let (mut hits, mut on_edges) = (0, 0);
         for i in 0..30_000 {

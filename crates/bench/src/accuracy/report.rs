@@ -101,7 +101,7 @@ pub fn markdown(results: &[SceneResult], cfg: &Config, command: &str, notes: &[S
         let _ = writeln!(
             s,
             "\nRobust vs plain intersection (the renderer cannot switch intersectors, so this \
-             is kdtree's `intersect` against `intersect_plain` on {} primary rays, 4 per pixel, \
+             is kdtree's `intersect` against the bench crate's textbook traversal with plain Möller–Trumbore on {} primary rays, 4 per pixel, \
              one thread): robust {:.4} s, plain {:.4} s ({:+.1} %), {} rays disagree on the hit.\n",
             i.rays,
             i.robust_seconds,

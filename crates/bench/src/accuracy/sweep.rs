@@ -279,7 +279,7 @@ pub fn measure(scene: &Scene, cfg: &Config, log: &dyn Fn(&str)) -> Result<SceneR
         .with_context(|| format!("scene {}: median tree does not fit", scene.name))?;
     let b = Some(median_build);
     point("tree", "median".into(), false, &maccel, &base, b, None)?;
-    let intersector = intersectors(scene, &accel, cfg)?;
+    let intersector = intersectors(scene, &accel, &kd, cfg)?;
     log(&format!(
         "{}: robust {:.3} s, plain {:.3} s, {} of {} rays disagree",
         scene.name,
@@ -300,7 +300,15 @@ pub fn measure(scene: &Scene, cfg: &Config, log: &dyn Fn(&str)) -> Result<SceneR
 
 /// Time closest-hit queries on 4 jittered primary rays per pixel with the robust and the
 /// plain intersector (single thread, median of the runs) and count disagreements.
-fn intersectors(scene: &Scene, accel: &Accel, cfg: &Config) -> Result<Intersector> {
+fn intersectors(
+    scene: &Scene,
+    accel: &Accel,
+    kd: &formats::KdFile,
+    cfg: &Config,
+) -> Result<Intersector> {
+    let plain = crate::plain::PlainAccel::new(&scene.soup.triangles, kd)
+        .map_err(anyhow::Error::msg)
+        .with_context(|| format!("scene {}: the textbook traversal", scene.name))?;
     let camera = render::CameraModel::new(&scene.soup.camera, cfg.width, cfg.height)
         .with_context(|| format!("scene {}: camera", scene.name))?;
     let mut rays = Vec::with_capacity((cfg.width * cfg.height * 4) as usize);
@@ -322,7 +330,7 @@ fn intersectors(scene: &Scene, accel: &Accel, cfg: &Config) -> Result<Intersecto
         (median(times), hits)
     };
     let (robust_seconds, a) = time(&|r| accel.intersect(r));
-    let (plain_seconds, b) = time(&|r| accel.intersect_plain(r));
+    let (plain_seconds, b) = time(&|r| plain.intersect(r));
     Ok(Intersector {
         scene: scene.name.clone(),
         rays: rays.len(),

@@ -1,26 +1,22 @@
-//! Numerical hard cases (issue 5, docs/ROBUSTNESS.md): closed meshes never leak, vertex
-//! and edge hits are never lost, tiny/huge/needle triangles are hit, degenerate input is
-//! harmless, and the f32 intersector agrees with an f64 reference.
+//! Numerical hard cases (docs/ROBUSTNESS.md): closed meshes never leak, vertex and edge
+//! hits are never lost, tiny/huge/needle triangles are hit, degenerate input is harmless,
+//! and the f32 intersector agrees with an f64 reference. (The same leak test on a corpus
+//! mesh is in the bench crate, which reads OBJ files.)
 
-mod common;
-
-use common::*;
 use formats::BuildParams;
 use glam::{DVec3, Vec3};
+use kdtree::testkit::{brute, grid, grid_box, rays_inside, sphere, Rng};
 use kdtree::triangle::{intersect, RayPre};
-use kdtree::{brute, Accel, Ray};
+use kdtree::{Accel, Ray};
 use proptest::prelude::*;
-use std::path::PathBuf;
 
-/// Rays from random points strictly inside (within 0.45 of the half-size of) a closed
-/// mesh; returns how many escaped (found no hit).
+/// Rays from random points strictly inside a closed mesh ([`rays_inside`]); returns how
+/// many escaped (found no hit).
 fn escapes(tris: &[[Vec3; 3]], center: Vec3, half: f32, n: usize, seed: u64) -> usize {
     let accel = Accel::build(tris, &BuildParams::default());
     let mut rng = Rng(seed);
     let mut leaks = 0;
-    for _ in 0..n {
-        let o = center + rng.dir() * (0.45 * half * rng.f32());
-        let r = Ray::new(o, rng.dir(), 0.0, f32::INFINITY);
+    for r in rays_inside(&mut rng, center, half).take(n) {
         match accel.intersect(&r) {
             Some(h) => {
                 assert!(
@@ -64,7 +60,7 @@ fn closed_meshes() -> Vec<(String, Vec<[Vec3; 3]>, Vec3, f32)> {
 
 #[test]
 fn closed_meshes_never_leak() {
-    // 10 meshes × 10⁴ rays = 10⁵ rays; the 10⁶ run is the ignored test below and kdbench.
+    // 10 meshes × 10⁴ rays = 10⁵ rays; the 10⁶ run is the ignored test below and robustbench.
     for (i, (name, tris, c, half)) in closed_meshes().iter().enumerate() {
         let leaks = escapes(tris, *c, *half, 10_000, 1000 + i as u64);
         assert_eq!(leaks, 0, "{name}: {leaks} rays escaped");
@@ -78,37 +74,6 @@ fn closed_meshes_never_leak_million() {
         let leaks = escapes(tris, *c, *half, 1_000_000, 2000 + i as u64);
         assert_eq!(leaks, 0, "{name}: {leaks} rays escaped");
     }
-}
-
-fn corpus_meshes() -> Option<PathBuf> {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/corpus/meshes");
-    if p.is_dir() {
-        Some(p)
-    } else {
-        eprintln!(
-            "SKIPPED: corpus mesh test because {} is absent (the shared corpus is not next to the repo)",
-            p.display()
-        );
-        None
-    }
-}
-
-#[test]
-fn spot_never_leaks() {
-    let Some(dir) = corpus_meshes() else { return };
-    let tris = load_obj(&dir.join("spot.obj")).expect("spot.obj loads");
-    assert_eq!(tris.len(), 5856);
-    // Spot's body is around its bounding box centre; a small ball there is inside.
-    let (mut lo, mut hi) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
-    for t in &tris {
-        for v in t {
-            lo = lo.min(*v);
-            hi = hi.max(*v);
-        }
-    }
-    let c = 0.5 * (lo + hi);
-    let half = 0.1 * (hi - lo).min_element();
-    assert_eq!(escapes(&tris, c, half, 50_000, 77), 0);
 }
 
 /// Rays from the centre aimed exactly at every vertex and every edge midpoint.

@@ -1,11 +1,10 @@
-//! The tree answers exactly what testing every triangle answers (issue 2 item 10, issue 4
-//! "done when"): same triangle, or the same t within 1e-6 relative for ties.
-
-mod common;
+//! The tree answers exactly what testing every triangle answers: same triangle, or the
+//! same t within 1e-6 relative for ties.
 
 use formats::BuildParams;
 use glam::Vec3;
-use kdtree::{brute, Accel, Ray};
+use kdtree::testkit::{self, brute};
+use kdtree::{Accel, Ray};
 use proptest::prelude::*;
 
 fn check(tris: &[[Vec3; 3]], accel: &Accel, ray: &Ray) -> Result<(), TestCaseError> {
@@ -148,7 +147,7 @@ proptest! {
         walls in prop::collection::vec((0usize..3, lattice(), lattice(), lattice()), 0..12),
         targets in prop::collection::vec((0usize..9, 0usize..9, 0usize..3, free_vec()), 48),
     ) {
-        let mut tris = common::grid(n, 4.0, 0.0);
+        let mut tris = testkit::grid(n, 4.0, 0.0);
         for &(axis, c, a, b) in &walls {
             let p = |u: f32, w: f32| {
                 let mut v = [0.0; 3];
@@ -190,7 +189,7 @@ fn origins_on_split_planes_with_signed_zeros() {
     for i in 0..4 {
         for j in 0..4 {
             let c = Vec3::new(i as f32 * 2.0, j as f32 * 2.0, 0.0);
-            tris.extend(common::grid_box(c, 0.5, 1));
+            tris.extend(testkit::grid_box(c, 0.5, 1));
         }
     }
     let accel = Accel::build(&tris, &BuildParams::default());
@@ -218,7 +217,7 @@ fn origins_on_split_planes_with_signed_zeros() {
 /// Bad rays are misses: NaN, infinities, zero direction, empty interval.
 #[test]
 fn nan_and_infinite_rays_miss() {
-    let tris = common::grid_box(Vec3::ZERO, 1.0, 2);
+    let tris = testkit::grid_box(Vec3::ZERO, 1.0, 2);
     let accel = Accel::build(&tris, &BuildParams::default());
     let o = Vec3::new(0.0, 0.0, -5.0);
     let bad = [

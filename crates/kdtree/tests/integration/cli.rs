@@ -1,11 +1,10 @@
 //! The real binaries: soup2kd (file, cache hit/miss, concurrent builders, --stats, bad
 //! input) and raycast (hits equal brute force, any-hit, --json).
 
-mod common;
-
 use formats::{rays, BuildParams, KdFile, Material, Object, RayRecord, Soup};
 use glam::Vec3;
-use kdtree::{brute, Ray};
+use kdtree::testkit::{self, brute, Rng};
+use kdtree::Ray;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -39,9 +38,9 @@ fn make_soup(dir: &Path, tris: Vec<[Vec3; 3]>) -> PathBuf {
 }
 
 fn scene() -> Vec<[Vec3; 3]> {
-    let mut tris = common::sphere(Vec3::new(0.0, 1.0, 0.0), 1.0, 24, 48);
-    tris.extend(common::grid_box(Vec3::new(3.0, 0.5, 0.0), 0.5, 3));
-    tris.extend(common::grid(10, 10.0, 0.0));
+    let mut tris = testkit::sphere(Vec3::new(0.0, 1.0, 0.0), 1.0, 24, 48);
+    tris.extend(testkit::grid_box(Vec3::new(3.0, 0.5, 0.0), 0.5, 3));
+    tris.extend(testkit::grid(10, 10.0, 0.0));
     tris
 }
 
@@ -221,7 +220,7 @@ fn bad_input_is_one_clear_line() {
         .success());
     let other = dir.path().join("other");
     std::fs::create_dir(&other).unwrap();
-    let b = make_soup(&other, common::grid(3, 1.0, 0.0));
+    let b = make_soup(&other, testkit::grid(3, 1.0, 0.0));
     let r = dir.path().join("r.rays");
     rays::write_rays(&r, &[]).unwrap();
     let out = raycast()
@@ -249,7 +248,7 @@ fn raycast_matches_brute_force() {
         .status()
         .unwrap()
         .success());
-    let mut rng = common::Rng(7);
+    let mut rng = Rng(7);
     let mut input: Vec<RayRecord> = (0..20_000)
         .map(|_| RayRecord {
             origin: Vec3::new(
@@ -259,7 +258,7 @@ fn raycast_matches_brute_force() {
             ),
             tmin: 0.0,
             dir: rng.dir(),
-            tmax: if rng.f32() < 0.5 {
+            tmax: if rng.unit() < 0.5 {
                 f32::INFINITY
             } else {
                 rng.range(0.1, 5.0)

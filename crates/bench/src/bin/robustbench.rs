@@ -4,14 +4,18 @@
 //! Mrays/s of primary, shadow and random rays for the SAH tree, a median-split tree and
 //! brute force (on a sample of rays), 1 thread. Then the robustness cost: watertight
 //! test + robust traversal against plain Möller–Trumbore + unpadded traversal, with the
-//! number of rays that leak out of closed meshes.
+//! number of rays that leak out of closed meshes (the textbook variant is
+//! [`bench::plain`]).
 
 use anyhow::{Context, Result};
+use bench::measure::pool;
+use bench::plain::PlainAccel;
+use bench::scenes::{self, bounds};
 use clap::Parser;
 use formats::BuildParams;
 use glam::Vec3;
-use kdtree::gen::{self, Rng};
-use kdtree::{brute, Accel, Ray};
+use kdtree::testkit::{self, brute, rays_inside, Rng};
+use kdtree::{Accel, Ray};
 use rayon::prelude::*;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -48,20 +52,8 @@ struct Rays {
     random: Vec<Ray>,
 }
 
-fn bounds(tris: &[[Vec3; 3]]) -> (Vec3, Vec3) {
-    let mut lo = Vec3::splat(f32::INFINITY);
-    let mut hi = Vec3::splat(f32::NEG_INFINITY);
-    for t in tris {
-        for v in t {
-            lo = lo.min(*v);
-            hi = hi.max(*v);
-        }
-    }
-    (lo, hi)
-}
-
 fn make_rays(accel: &Accel, tris: &[[Vec3; 3]], n: usize) -> Rays {
-    let (lo, hi) = bounds(tris);
+    let [lo, hi] = bounds(tris);
     let c = 0.5 * (lo + hi);
     let r = 0.5 * (hi - lo).length();
     let eye = c + Vec3::new(0.3, 0.4, 1.0).normalize() * 2.2 * r;
@@ -124,21 +116,21 @@ fn mrays<F: Fn(&Ray) -> bool>(rays: &[Ray], f: F) -> f64 {
     rays.len() as f64 / start.elapsed().as_secs_f64() / 1e6
 }
 
-fn pool(n: usize) -> rayon::ThreadPool {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(n)
-        .build()
-        .expect("thread pool")
-}
-
-fn bench_scene(name: &str, tris: &[[Vec3; 3]], cli: &Cli, params: &BuildParams, out: &mut String) {
+fn bench_scene(
+    name: &str,
+    tris: &[[Vec3; 3]],
+    cli: &Cli,
+    params: &BuildParams,
+    out: &mut String,
+) -> Result<()> {
     eprintln!("robustbench: {name}: {} triangles", tris.len());
     let hash = formats::soup::geometry_hash(tris);
-    let kd1 = pool(1).install(|| kdtree::build(tris, params, hash));
-    let kd2 = pool(2).install(|| kdtree::build(tris, params, hash));
+    let (one, two) = (pool(1)?, pool(2)?);
+    let kd1 = one.install(|| kdtree::build(tris, params, hash));
+    let kd2 = two.install(|| kdtree::build(tris, params, hash));
     let kdm = kdtree::build_median(tris, params, hash);
-    let sah = Accel::from_triangles(tris, &kd2).expect("tree fits");
-    let med = Accel::from_triangles(tris, &kdm).expect("tree fits");
+    let sah = Accel::from_triangles(tris, &kd2)?;
+    let med = Accel::from_triangles(tris, &kdm)?;
     eprintln!("  SAH tree: {:?}", kd2.stats);
     eprintln!("  median tree: {:?}", kdm.stats);
     let rays = make_rays(&sah, tris, cli.rays);
@@ -171,7 +163,7 @@ fn bench_scene(name: &str, tris: &[[Vec3; 3]], cli: &Cli, params: &BuildParams, 
         let m_med = mrays(rs, |r| q(&med, r));
         let sample = &rs[..rs.len().min(brute_sample)];
         let m_brute = mrays(sample, |r| brute::intersect(tris, r).is_some());
-        let m2 = pool(2).install(|| {
+        let m2 = two.install(|| {
             let start = Instant::now();
             let n: usize = rs.par_iter().map(|r| q(&sah, r) as usize).sum();
             std::hint::black_box(n);
@@ -182,6 +174,7 @@ fn bench_scene(name: &str, tris: &[[Vec3; 3]], cli: &Cli, params: &BuildParams, 
     }
     out.push_str(&row);
     out.push('\n');
+    Ok(())
 }
 
 fn leak_scene(
@@ -191,21 +184,22 @@ fn leak_scene(
     scale: f32,
     n: usize,
     out: &mut String,
-) {
-    let accel = Accel::build(tris, &BuildParams::default());
-    let mut rng = Rng(12345);
-    let rays: Vec<Ray> = (0..n)
-        .map(|_| {
-            // Strictly inside: 0.45 of the half-size, so no origin rounds onto a face.
-            let o = center + rng.dir() * (0.45 * scale * rng.f32());
-            Ray::new(o, rng.dir(), 0.0, f32::INFINITY)
-        })
+) -> Result<()> {
+    let kd = kdtree::build(
+        tris,
+        &BuildParams::default(),
+        formats::soup::geometry_hash(tris),
+    );
+    let accel = Accel::from_triangles(tris, &kd)?;
+    let textbook = PlainAccel::new(tris, &kd).map_err(anyhow::Error::msg)?;
+    let rays: Vec<Ray> = rays_inside(&mut Rng(12345), center, scale)
+        .take(n)
         .collect();
     let leaks = |f: &dyn Fn(&Ray) -> bool| rays.iter().filter(|r| !f(r)).count();
     let wt = mrays(&rays, |r| accel.intersect(r).is_some());
-    let plain = mrays(&rays, |r| accel.intersect_plain(r).is_some());
+    let plain = mrays(&rays, |r| textbook.intersect(r).is_some());
     let lw = leaks(&|r| accel.intersect(r).is_some());
-    let lp = leaks(&|r| accel.intersect_plain(r).is_some());
+    let lp = leaks(&|r| textbook.intersect(r).is_some());
     eprintln!(
         "robustbench: leaks {name}: watertight {lw} ({wt:.2} Mrays/s), plain {lp} ({plain:.2} Mrays/s)"
     );
@@ -215,6 +209,7 @@ fn leak_scene(
         tris.len()
     )
     .unwrap();
+    Ok(())
 }
 
 fn run(cli: Cli) -> Result<()> {
@@ -228,37 +223,35 @@ fn run(cli: Cli) -> Result<()> {
     writeln!(out, "Build parameters: {params:?}. Mrays/s columns: SAH 1 thread / SAH 2 threads / median-split 1 thread / brute force 1 thread (on a sample).\n").unwrap();
     writeln!(out, "| scene | triangles | build 1T s | build 2T s | speedup | Mtris/s (2T) | SAH cost | median SAH cost | bytes/tri | primary | shadow | random |").unwrap();
     writeln!(out, "|---|---|---|---|---|---|---|---|---|---|---|---|").unwrap();
-    let mut scenes: Vec<(String, Vec<[Vec3; 3]>)> = Vec::new();
+    let mut meshes_out: Vec<(String, Vec<[Vec3; 3]>)> = Vec::new();
     // Generated: scattered spheres on a floor, roughly the baseline scene's size.
     let mut rng = Rng(42);
-    let mut spheres = gen::grid(40, 40.0, 0.0);
+    let mut spheres = testkit::grid(40, 40.0, 0.0);
     for _ in 0..14 {
         let c = Vec3::new(
             rng.range(2.0, 38.0),
             rng.range(1.0, 4.0),
             rng.range(2.0, 38.0),
         );
-        spheres.extend(gen::sphere(c, rng.range(0.5, 3.0), 40, 80));
+        spheres.extend(testkit::sphere(c, rng.range(0.5, 3.0), 40, 80));
     }
-    scenes.push(("generated spheres".into(), spheres));
+    meshes_out.push(("generated spheres".into(), spheres));
     let meshes = cli.meshes.clone().unwrap_or_else(|| {
         PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/corpus/meshes")
     });
     if meshes.is_dir() {
-        let mut files: Vec<PathBuf> = std::fs::read_dir(&meshes)?
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| p.extension().is_some_and(|e| e == "obj"))
-            .collect();
-        files.sort();
-        for f in files {
+        for f in scenes::obj_files(&meshes)? {
             let name = f
                 .file_stem()
                 .unwrap_or_default()
                 .to_string_lossy()
                 .into_owned();
             if want(&name) {
-                let tris = gen::load_obj(&f).map_err(anyhow::Error::msg)?;
-                scenes.push((name, tris));
+                let scene = scenes::load_obj(&f)?;
+                for note in &scene.notes {
+                    eprintln!("robustbench: {note}");
+                }
+                meshes_out.push((name, scene.triangles));
             }
         }
     } else {
@@ -277,13 +270,13 @@ fn run(cli: Cli) -> Result<()> {
                 rng.range(0.0, 10.0 * side),
                 rng.range(0.0, 10.0 * side),
             );
-            tris.extend(gen::sphere(c, rng.range(1.0, 6.0), 80, 160));
+            tris.extend(testkit::sphere(c, rng.range(1.0, 6.0), 80, 160));
         }
-        scenes.push((format!("generated {}M", tris.len() / 1_000_000), tris));
+        meshes_out.push((format!("generated {}M", tris.len() / 1_000_000), tris));
     }
-    for (name, tris) in &scenes {
+    for (name, tris) in &meshes_out {
         if want(name) {
-            bench_scene(name, tris, &cli, &params, &mut out);
+            bench_scene(name, tris, &cli, &params, &mut out)?;
         }
     }
     writeln!(out, "\n## Robustness cost: watertight + robust traversal vs Möller–Trumbore + textbook traversal\n").unwrap();
@@ -300,9 +293,9 @@ fn run(cli: Cli) -> Result<()> {
         ("sphere, scale 1e5", 1e5, Vec3::ZERO),
         ("sphere, offset 1e5", 1.0, Vec3::splat(1e5)),
     ] {
-        let tris = gen::sphere(center, scale, 48, 96);
-        leak_scene(name, &tris, center, scale, cli.leak_rays, &mut out);
-        let b = gen::grid_box(center, 0.5 * scale, 12);
+        let tris = testkit::sphere(center, scale, 48, 96);
+        leak_scene(name, &tris, center, scale, cli.leak_rays, &mut out)?;
+        let b = testkit::grid_box(center, 0.5 * scale, 12);
         leak_scene(
             &name.replace("sphere", "box"),
             &b,
@@ -310,12 +303,12 @@ fn run(cli: Cli) -> Result<()> {
             scale,
             cli.leak_rays,
             &mut out,
-        );
+        )?;
     }
     let spot = meshes.join("spot.obj");
     if spot.exists() {
-        let tris = gen::load_obj(&spot).map_err(anyhow::Error::msg)?;
-        let (lo, hi) = bounds(&tris);
+        let tris = scenes::load_obj(&spot)?.triangles;
+        let [lo, hi] = bounds(&tris);
         // The body's centre is inside spot (a cow); start rays within a small ball there.
         leak_scene(
             "spot.obj",
@@ -324,7 +317,7 @@ fn run(cli: Cli) -> Result<()> {
             0.1 * (hi - lo).min_element(),
             cli.leak_rays,
             &mut out,
-        );
+        )?;
     }
     match &cli.output {
         Some(p) => formats::write_atomic(p, out.as_bytes())

@@ -1,5 +1,5 @@
 //! Build-parameter experiments:
-//! `cargo run --release -p bench --example kdtune -- KT KI BONUS MAX_DEPTH LEAF_SIZE FILE…`
+//! `cargo run --release -p bench --bin kdtune -- KT KI BONUS MAX_DEPTH LEAF_SIZE FILE…`
 //! builds each soup or OBJ (or `gen:N`, kdbench's generated scene of N triangles) with
 //! those parameters and prints build time (best of up to 9 builds, all threads), primary,
 //! shadow and random-ray Mrays/s (best of 15, 1 thread), the tree's statistics and a

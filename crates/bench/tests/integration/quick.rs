@@ -1,7 +1,8 @@
 //! The quick benchmark, in process, on a tiny generated scene: the report has the rows
 //! the tables need and every contender agrees with the k-d tree.
 
-use bench::run::{Kind, Role, BRUTE, EMBREE, KDTREE, MEDIAN};
+use bench::contenders::{BRUTE, EMBREE, KDTREE, MEDIAN};
+use bench::results::{Kind, Role};
 use bench::{report, run, scenes, Config};
 use std::path::PathBuf;
 
@@ -131,22 +132,4 @@ fn a_missing_baseline_is_skipped_with_a_note() {
     assert_eq!(report.notes.len(), 1);
     assert!(report.notes[0].starts_with("SKIPPED: baseline soup /nonexistent/baseline.soup"));
     assert_eq!(lines, report.notes);
-}
-
-#[test]
-fn loads_the_corpus_suzanne_triangulated() {
-    let path =
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/corpus/meshes/suzanne.obj");
-    if !path.exists() {
-        println!(
-            "SKIPPED: suzanne OBJ test because {} is absent",
-            path.display()
-        );
-        return;
-    }
-    let s = scenes::load_obj(&path).unwrap();
-    // 32 triangles + 468 quads (two triangles each), per the corpus MANIFEST.
-    assert_eq!(s.triangles.len(), 32 + 2 * 468);
-    assert_eq!(s.name, "suzanne");
-    assert!(s.notes.is_empty());
 }
