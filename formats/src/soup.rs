@@ -1,5 +1,6 @@
 //! The triangle soup: world-space geometry plus everything the renderer needs from the
-//! scene. Right-handed, Y up, metres (see DESIGN §3). Colours are linear RGB.
+//! scene. Right-handed, Y up, metres: Unity's left-handed positions with X negated, so an
+//! OBJ placed at the identity in Unity keeps its file's coordinates. Colours are linear RGB.
 
 use crate::{envelope, Digest, FormatError};
 use glam::Vec3;
@@ -71,13 +72,14 @@ impl Material {
         }
     }
 
-    /// Lambert albedo: colour·(1 − metallic) (DESIGN §6).
+    /// Lambert albedo: colour·(1 − metallic), because a metal's colour shows in its
+    /// reflection, not in diffuse light.
     pub fn albedo(&self) -> Vec3 {
         self.color * (1.0 - self.metallic.clamp(0.0, 1.0))
     }
 
     /// Mirror reflectance, tinted by the colour: `_Reflectivity` if set, else
-    /// metallic·smoothness (DESIGN §6).
+    /// metallic·smoothness, so only smooth metals mirror unless a material says otherwise.
     pub fn reflectance(&self) -> Vec3 {
         let r = self
             .reflectivity

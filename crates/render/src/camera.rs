@@ -28,7 +28,8 @@ impl CameraModel {
             detail,
         };
         let forward = cam.forward.normalize_or_zero();
-        // Image right is forward × up (DESIGN §3); re-derive up so the frame is orthonormal.
+        // Image right is forward × up in the right-handed soup, which puts +X of an unrotated
+        // Unity camera on the right as in the Game view; re-derive up so the frame is orthonormal.
         let right = cam.right();
         if forward == Vec3::ZERO || right == Vec3::ZERO || !cam.position.is_finite() {
             return Err(bad(format!(

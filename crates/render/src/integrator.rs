@@ -1,4 +1,4 @@
-//! Whitted ray tracing (DESIGN §6), driven by the effects plan:
+//! Whitted ray tracing, driven by the effects plan:
 //!
 //! ```text
 //! L = emission + ambient(n)·albedo

@@ -1,5 +1,5 @@
 //! `kd2exr`'s library: renders a unitrace soup through its compiled k-d tree into an
-//! OpenEXR image, Whitted style (DESIGN §6).
+//! OpenEXR image, Whitted style.
 //!
 //! The steps, each in its own module:
 //! * [`plan`]: decide from the soup which effects can change the image (and why);
@@ -8,7 +8,7 @@
 //! * [`integrator`]: emission, ambient, direct light with hard/soft shadows, mirrors;
 //! * [`offset`]: secondary rays spawned past the hit point's rounding error;
 //! * [`sampling`]: per-pixel seeded RNG, stratified pixel and shadow samples;
-//! * [`render`]: tiles in parallel (rayon work stealing), ray counters;
+//! * [`mod@render`]: tiles in parallel (rayon work stealing), ray counters;
 //! * [`exrio`], [`preview`]: EXR with AOVs, crop windows and merging; PNG preview;
 //! * [`memory`]: refuse a render that cannot fit before it starts.
 

@@ -1,4 +1,4 @@
-//! The seed's baseline scene as a Unity project: a mirror sphere on a blue reflective
+//! The original Haskell ray tracer's baseline scene as a Unity project: a mirror sphere on a blue reflective
 //! floor, a man, a car, three pigs and two trees, two point lights with hard shadows and a
 //! camera looking down slightly. 41,833 triangles in 9 mesh objects.
 
@@ -243,7 +243,7 @@ mod tests {
     /// Triangles of every mesh object the scene places, counted from the OBJ text that is
     /// written (not the in-memory meshes), plus the built-in cube's 12.
     #[test]
-    fn scene_places_exactly_the_seeds_triangles() {
+    fn scene_places_exactly_the_original_triangles() {
         let p = project();
         let scene = String::from_utf8(p.files[SCENE_PATH].clone()).unwrap();
         let mut total = 0;

@@ -1,5 +1,5 @@
-//! One small project per rendering effect (issue 6's gallery), built from Unity's built-in
-//! primitives: each isolates one thing the renderer must get right.
+//! One small project per rendering effect (what `just gallery` renders), built from Unity's
+//! built-in primitives: each isolates one thing the renderer must get right.
 
 use crate::material::{write_material, MatDesc};
 use crate::meta;

@@ -46,7 +46,7 @@ mod tests {
 
     #[test]
     fn mesh_file_id_matches_unity_on_the_corpus_value() {
-        // Read from a real fileIdsGeneration 2 project (DESIGN §4).
+        // Read from a real fileIdsGeneration 2 project.
         assert_eq!(mesh_file_id("default"), -2_432_090_755_550_338_912);
     }
 

@@ -1,5 +1,6 @@
-//! Generator of the Unity projects bundled in `scenes/`: the seed's baseline scene (OBJ
-//! models at exact triangle counts) and one small project per rendering effect.
+//! Generator of the Unity projects bundled in `scenes/`: the original Haskell ray tracer's
+//! baseline scene (OBJ models at exact triangle counts) and one small project per rendering
+//! effect.
 //!
 //! Everything is built in memory first ([`project::Project`]), so the same bytes are
 //! written to disk by the binary and compared with the committed files by the tests.

@@ -1,7 +1,7 @@
 //! Triangle meshes built from tessellated primitives, and their OBJ text.
 //!
 //! Every primitive states its exact triangle count in its doc comment, because the
-//! baseline models must hit the seed's counts to the triangle. Winding is
+//! baseline models must match the original Haskell ray tracer's scene to the triangle. Winding is
 //! counter-clockwise seen from outside (OBJ's right-handed convention).
 
 use glam::{Affine3A, Vec3};

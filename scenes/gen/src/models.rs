@@ -1,9 +1,9 @@
-//! The baseline's models, rebuilt from tessellated primitives at the seed's exact triangle
-//! counts. Units are metres, +Y up, each model faces +Z and stands on y = 0 (the mirror
+//! The baseline's models, rebuilt from tessellated primitives at the exact triangle counts
+//! of the original Haskell ray tracer's scene, so the two trace scenes of the same size. Units are metres, +Y up, each model faces +Z and stands on y = 0 (the mirror
 //! sphere is centred on the origin). Every model is symmetric in X, so Unity's X flip on
 //! OBJ import does not change how it looks.
 //!
-//! The per-part counts are written next to each part; `tests::counts_are_the_seeds` holds
+//! The per-part counts are written next to each part; `tests::counts_match_the_original` holds
 //! the totals to the triangle.
 
 use crate::mesh::{box_grid, cone, cylinder, disc, leaf, tapered, torus, tube, uv_sphere, Mesh};
@@ -369,7 +369,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn counts_are_the_seeds() {
+    fn counts_match_the_original() {
         assert_eq!(mirror_sphere().triangle_count(), MIRROR_SPHERE_TRIANGLES);
         assert_eq!(man().triangle_count(), MAN_TRIANGLES);
         assert_eq!(car().triangle_count(), CAR_TRIANGLES);

@@ -1,9 +1,7 @@
 //! EXR output: AOV channels read back with the exr crate, f16 colour, header attributes,
 //! and crops merged into an image bit-identical to a one-shot render.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use exr::prelude::{FlatSamples, ReadChannels, ReadLayers};
 use formats::Shadows;
 use glam::Vec3;

@@ -59,7 +59,8 @@ fn write_project(root: &Path) -> std::path::PathBuf {
     root.join("e2e/Assets/Scenes/E2E.unity")
 }
 
-/// Unity's point-light attenuation as DESIGN §6 states it (independent of the renderer).
+/// Unity's point-light attenuation, written out again here so the pixels are checked against
+/// Unity's formula rather than against the renderer's own code.
 fn unity_falloff(d: f32, range: f32) -> f32 {
     let x = d / range;
     if x >= 1.0 {
@@ -151,7 +152,7 @@ fn unity_scene_through_the_three_binaries_gives_the_known_pixels() {
     let mirror = soup.materials.iter().find(|m| m.name == "Mirror").unwrap();
     let glow = soup.materials.iter().find(|m| m.name == "Glow").unwrap();
     let light = &soup.lights[0];
-    // The soup is right-handed (DESIGN §3): Unity (x, y, z) is (−x, y, z) there.
+    // The soup is right-handed: Unity's X is negated, so Unity (x, y, z) is (−x, y, z) there.
     assert_eq!(light.position, Vec3::new(2.0, 2.0, 0.0));
     let lit = |ux: f32, uz: f32| {
         let to = light.position - Vec3::new(-ux, 0.0, uz);

@@ -1,9 +1,7 @@
 //! The real `kd2exr` binary, end to end: artifacts written by the libraries into a
 //! temporary folder, then rendered, merged and refused.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use formats::Shadows;
 use glam::Vec3;
 use render::ExrImage;

@@ -1,9 +1,7 @@
 //! Pixel values where the answer is known: the lighting formula, shadows, mirrors, image
 //! orientation, spot cones, directional cosines, ambient and emission.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use formats::{AmbientMode, Camera, Projection, Shadows};
 use glam::Vec3;
 

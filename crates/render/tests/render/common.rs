@@ -1,5 +1,4 @@
 //! Small scenes built in code for the renderer's tests: quads, boxes, lights, cameras.
-#![allow(dead_code)]
 
 use formats::{Camera, KdFile, Light, LightKind, Material, Object, Projection, Shadows, Soup};
 use glam::Vec3;

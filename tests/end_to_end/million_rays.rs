@@ -1,8 +1,8 @@
-//! Issue 4's check at full size: `raycast` on a file of a million random rays against the
+//! The k-d tree's exactness at full size: `raycast` on a file of a million random rays against the
 //! baseline scene gives exactly the brute-force hits (same triangle and t, or the same
 //! miss). Brute force tests all 41,833 triangles per ray, about 4·10¹⁰ tests: about 3 minutes
 //! on 2 cores, so it is ignored by default. Run it with
-//! `cargo test --release --test million_rays -- --ignored`.
+//! `cargo test --release --test end_to_end million_rays -- --ignored`.
 
 use formats::rays::{self, RayRecord};
 use kdtree::testkit::brute;

@@ -1,9 +1,7 @@
-//! Secondary rays stay robust (issue 5 item 3): no self-intersection at any scale or
-//! distance from the origin, no acne under grazing light, finite images always.
+//! Secondary rays stay robust: no self-intersection at any scale or distance from the
+//! origin, no acne under grazing light, finite images always.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use formats::{Camera, Projection, Shadows};
 use glam::Vec3;
 use kdtree::{Accel, Ray};

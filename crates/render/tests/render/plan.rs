@@ -1,9 +1,7 @@
 //! The effects plan traces no ray that cannot change the image: ray counts per kind, and
 //! each effect, turned on, changes the pixels where it should.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use formats::Shadows;
 use glam::Vec3;
 use render::plan::ShadowMode;

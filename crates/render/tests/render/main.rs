@@ -1,0 +1,10 @@
+//! The renderer's integration tests, in one binary so the workspace links it once: the
+//! `kd2exr` command line, EXR output, known pixel values, the effects plan and robust
+//! secondary rays. `common` builds the small scenes they render.
+
+mod cli;
+mod common;
+mod exr;
+mod lighting;
+mod plan;
+mod robustness;

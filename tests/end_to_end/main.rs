@@ -1,0 +1,7 @@
+//! End-to-end tests of the real binaries, in one test binary so the workspace links it
+//! once: the pipeline on a Unity project with known pixels, bad input at every stage, and
+//! (ignored by default) a million rays through `raycast` against brute force.
+
+mod million_rays;
+mod pipeline;
+mod reliability;
