@@ -1,6 +1,6 @@
 //! SAH k-d tree: build, traversal and watertight ray/triangle intersection.
 //!
-//! * [`build`] compiles triangles into a [`KdFile`] (Wald & Havran's O(N log N) SAH build
+//! * [`build()`] compiles triangles into a [`KdFile`] (Wald & Havran's O(N log N) SAH build
 //!   with perfect splits, parallel over subtrees).
 //! * [`Accel`] pairs a soup's triangles with a compiled tree and answers closest-hit
 //!   ([`Accel::intersect`]) and any-hit ([`Accel::occluded`]) queries.

@@ -314,7 +314,7 @@ mod tests {
 
     /// Two overlapping coplanar triangles of the baseline scene (soup triangles 8880 and
     /// 12361, the floor under a pig's foot) hit at the same t by a random ray of
-    /// tests/million_rays.rs. Tested against exactly the other's t, the scaled early out
+    /// tests/end_to_end/million_rays.rs. Tested against exactly the other's t, the scaled early out
     /// (T ≤ tmax·|det|, T rounded) refuses one of them, so a traversal that passed the best
     /// t as the bound kept whichever came first; against `widen(t)` each is accepted with
     /// its own t, and the caller's exact `t ≤ best` comparison decides the tie by index.

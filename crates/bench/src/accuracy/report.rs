@@ -164,7 +164,7 @@ fn noise_floor(r: &SceneResult) -> f64 {
 }
 
 /// Index of the first point (sweeps run from cheapest to most accurate) whose bias is at
-/// most [`bias_fraction`] of `noise`.
+/// most `bias_fraction` of `noise`.
 pub fn unbiased(points: &[&Point], noise: f64) -> Option<usize> {
     points
         .iter()

@@ -16,7 +16,7 @@ struct Cli {
     /// Write the tree to this file.
     #[arg(short, long, conflicts_with = "cache")]
     output: Option<PathBuf>,
-    /// Cache folder: reuse DIR/<geometry hash>-<params hash>.kd when valid, else build it.
+    /// Cache folder: reuse `DIR/<geometry hash>-<params hash>.kd` when valid, else build it.
     #[arg(long, value_name = "DIR")]
     cache: Option<PathBuf>,
     /// Print one JSON object on stdout instead of a summary on stderr.

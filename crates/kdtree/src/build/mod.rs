@@ -8,8 +8,8 @@
 //! * Triangles lying in a candidate plane are tried on both sides; a split that cuts off
 //!   empty space gets the empty-space bonus; a node becomes a leaf when no split is
 //!   cheaper than intersecting all its triangles, at the depth bound, or at `leaf_size`.
-//! * Subtrees above [`JOIN_MIN`] triangles are built in parallel (`rayon::join`), and
-//!   above [`PARALLEL_MIN`] the three axes' sweeps, classification and sorting run in
+//! * Subtrees above `JOIN_MIN` triangles are built in parallel (`rayon::join`), and
+//!   above `PARALLEL_MIN` the three axes' sweeps, classification and sorting run in
 //!   parallel too.
 
 pub mod clip;
