@@ -59,27 +59,11 @@ impl PlainAccel {
         if height[0] as usize >= STACK {
             return Err(format!("the tree is {} levels deep", height[0]));
         }
-        let mut slot = vec![u32::MAX; triangles.len()];
-        let mut soup_index = Vec::with_capacity(triangles.len());
-        let leaf_tris = kd
-            .leaf_tris
-            .iter()
-            .map(|&p| {
-                let s = &mut slot[p as usize];
-                if *s == u32::MAX {
-                    *s = soup_index.len() as u32;
-                    soup_index.push(p);
-                }
-                *s
-            })
-            .collect();
-        let tris = soup_index
-            .iter()
-            .map(|&p| {
-                let t = &triangles[p as usize];
-                [t[0].to_array(), t[1].to_array(), t[2].to_array()]
-            })
-            .collect();
+        let kdtree::Renumbered {
+            tris,
+            soup_index,
+            leaf_tris,
+        } = kdtree::renumber(triangles, &kd.leaf_tris);
         Ok(PlainAccel {
             tris,
             soup_index,

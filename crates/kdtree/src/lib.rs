@@ -133,28 +133,11 @@ impl Accel {
                 max,
             });
         }
-        // Renumber triangles by first appearance in the leaves (depth-first order).
-        let mut slot = vec![u32::MAX; triangles.len()];
-        let mut soup_index = Vec::with_capacity(triangles.len());
-        let leaf_tris = kd
-            .leaf_tris
-            .iter()
-            .map(|&p| {
-                let s = &mut slot[p as usize];
-                if *s == u32::MAX {
-                    *s = soup_index.len() as u32;
-                    soup_index.push(p);
-                }
-                *s
-            })
-            .collect();
-        let tris = soup_index
-            .iter()
-            .map(|&p| {
-                let t = &triangles[p as usize];
-                [t[0].to_array(), t[1].to_array(), t[2].to_array()]
-            })
-            .collect();
+        let Renumbered {
+            tris,
+            soup_index,
+            leaf_tris,
+        } = renumber(triangles, &kd.leaf_tris);
         Ok(Accel {
             tris,
             soup_index,
@@ -214,6 +197,47 @@ pub fn query_bytes(kd: &KdFile) -> usize {
     kd.nodes.len() * std::mem::size_of::<KdNode>()
         + kd.leaf_tris.len() * 4
         + kd.stats.triangles as usize * (std::mem::size_of::<[[f32; 3]; 3]>() + 4)
+}
+
+/// A tree's triangles renumbered by first appearance in its leaves (depth-first order),
+/// so that a ray walking the tree reads them from memory mostly in order.
+pub struct Renumbered {
+    /// The triangles in leaf order.
+    pub tris: Vec<[[f32; 3]; 3]>,
+    /// Soup index of each triangle in leaf order (hits report soup indices).
+    pub soup_index: Vec<u32>,
+    /// The leaves' triangle lists in leaf-order indices.
+    pub leaf_tris: Vec<u32>,
+}
+
+/// Renumber `triangles` by their first appearance in `leaf_tris` (a tree's leaf lists in
+/// soup indices).
+pub fn renumber(triangles: &[[Vec3; 3]], leaf_tris: &[u32]) -> Renumbered {
+    let mut slot = vec![u32::MAX; triangles.len()];
+    let mut soup_index = Vec::with_capacity(triangles.len());
+    let leaf_tris = leaf_tris
+        .iter()
+        .map(|&p| {
+            let s = &mut slot[p as usize];
+            if *s == u32::MAX {
+                *s = soup_index.len() as u32;
+                soup_index.push(p);
+            }
+            *s
+        })
+        .collect();
+    let tris = soup_index
+        .iter()
+        .map(|&p| {
+            let t = &triangles[p as usize];
+            [t[0].to_array(), t[1].to_array(), t[2].to_array()]
+        })
+        .collect();
+    Renumbered {
+        tris,
+        soup_index,
+        leaf_tris,
+    }
 }
 
 #[cfg(test)]

@@ -2,9 +2,7 @@
 //! benchmark's OBJ loader; each test is skipped, saying so, when the corpus is absent.
 
 use bench::scenes;
-use formats::BuildParams;
-use kdtree::testkit::{rays_inside, Rng};
-use kdtree::Accel;
+use kdtree::testkit::escapes;
 use std::path::PathBuf;
 
 fn corpus_mesh(name: &str) -> Option<PathBuf> {
@@ -47,20 +45,6 @@ fn spot_never_leaks() {
     let [lo, hi] = scenes::bounds(&tris);
     let c = 0.5 * (lo + hi);
     let half = 0.1 * (hi - lo).min_element();
-    let accel = Accel::build(&tris, &BuildParams::default());
-    let mut leaks = 0;
-    for r in rays_inside(&mut Rng(77), c, half).take(50_000) {
-        match accel.intersect(&r) {
-            Some(h) => {
-                assert!(
-                    h.t.is_finite() && h.u.is_finite() && h.v.is_finite(),
-                    "{h:?}"
-                );
-                // Closest hit and any-hit agree.
-                assert!(accel.occluded(&r));
-            }
-            None => leaks += 1,
-        }
-    }
+    let leaks = escapes(&tris, c, half, 50_000, 77);
     assert_eq!(leaks, 0);
 }

@@ -3,7 +3,8 @@
 //! closed mesh and so must hit it.
 
 use super::Rng;
-use crate::Ray;
+use crate::{Accel, Ray};
+use formats::BuildParams;
 use glam::Vec3;
 
 /// Indexed mesh → triangle soup (vertices shared bit for bit).
@@ -92,4 +93,29 @@ pub fn rays_inside(rng: &mut Rng, center: Vec3, half: f32) -> impl Iterator<Item
         let o = center + rng.dir() * (0.45 * half * rng.unit());
         Ray::new(o, rng.dir(), 0.0, f32::INFINITY)
     })
+}
+
+/// How many of `n` rays from inside a closed mesh ([`rays_inside`], generator seeded with
+/// `seed`) escape it, finding no hit. Every hit must be finite and agree with the any-hit
+/// query.
+pub fn escapes(tris: &[[Vec3; 3]], center: Vec3, half: f32, n: usize, seed: u64) -> usize {
+    let accel = Accel::build(tris, &BuildParams::default());
+    let mut rng = Rng(seed);
+    let mut leaks = 0;
+    for r in rays_inside(&mut rng, center, half).take(n) {
+        match accel.intersect(&r) {
+            Some(h) => {
+                assert!(
+                    h.t.is_finite() && h.u.is_finite() && h.v.is_finite(),
+                    "{h:?}"
+                );
+                assert!(
+                    accel.occluded(&r),
+                    "closest hit and any-hit disagree on {r:?}"
+                );
+            }
+            None => leaks += 1,
+        }
+    }
+    leaks
 }

@@ -10,5 +10,5 @@ pub mod brute;
 mod meshes;
 mod rng;
 
-pub use meshes::{grid, grid_box, rays_inside, sphere};
+pub use meshes::{escapes, grid, grid_box, rays_inside, sphere};
 pub use rng::Rng;

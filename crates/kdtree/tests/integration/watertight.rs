@@ -5,32 +5,10 @@
 
 use formats::BuildParams;
 use glam::{DVec3, Vec3};
-use kdtree::testkit::{brute, grid, grid_box, rays_inside, sphere, Rng};
+use kdtree::testkit::{brute, escapes, grid, grid_box, sphere, Rng};
 use kdtree::triangle::{intersect, RayPre};
 use kdtree::{Accel, Ray};
 use proptest::prelude::*;
-
-/// Rays from random points strictly inside a closed mesh ([`rays_inside`]); returns how
-/// many escaped (found no hit).
-fn escapes(tris: &[[Vec3; 3]], center: Vec3, half: f32, n: usize, seed: u64) -> usize {
-    let accel = Accel::build(tris, &BuildParams::default());
-    let mut rng = Rng(seed);
-    let mut leaks = 0;
-    for r in rays_inside(&mut rng, center, half).take(n) {
-        match accel.intersect(&r) {
-            Some(h) => {
-                assert!(
-                    h.t.is_finite() && h.u.is_finite() && h.v.is_finite(),
-                    "{h:?}"
-                );
-                // Closest hit and any-hit agree.
-                assert!(accel.occluded(&r));
-            }
-            None => leaks += 1,
-        }
-    }
-    leaks
-}
 
 /// The closed test meshes: (name, triangles, centre, half-size).
 fn closed_meshes() -> Vec<(String, Vec<[Vec3; 3]>, Vec3, f32)> {
