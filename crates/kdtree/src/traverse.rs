@@ -348,20 +348,22 @@ impl Tree<'_> {
                     }
                 }
             }
-            // Next cell. The stack is front to back (each entry starts no earlier than the
-            // one above it: a push is the far side of the current cell, which lies before
-            // every cell already waiting), so a hit closer than the next cell's entry is
-            // closer than all of them.
-            if sp == 0 {
-                break;
-            }
-            sp -= 1;
-            (node_i, t0, t1) = pop(&stack, sp);
-            if best_t < pad_down(t0) {
-                break;
+            // Next cell: the first waiting one that starts before the best hit. The stack
+            // is not always front to back, so a cell that starts beyond the hit is skipped,
+            // not taken as the end: a ray lying in a split plane waits on the far child over
+            // its whole interval, and cells pushed later inside the near child may start
+            // after it.
+            loop {
+                if sp == 0 {
+                    return (!best.is_miss()).then_some(best);
+                }
+                sp -= 1;
+                (node_i, t0, t1) = pop(&stack, sp);
+                if best_t >= pad_down(t0) {
+                    break;
+                }
             }
         }
-        (!best.is_miss()).then_some(best)
     }
 
     /// Whether any triangle is hit in [tmin, tmax]; stops at the first one found.

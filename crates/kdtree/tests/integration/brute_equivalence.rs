@@ -247,3 +247,36 @@ fn nan_and_infinite_rays_miss() {
         .unwrap();
     assert_eq!(good.t, 4.0);
 }
+
+/// A ray lying in two split planes at once (x = 2 and z = 1, straight down) through the
+/// corner of a small wall above a grid. Both children of each such split wait over the whole
+/// interval, so the waiting cells are not front to back: the closest-hit loop once took a
+/// waiting cell that starts beyond the grid hit for the end of the search and missed the
+/// wall's corner at t = 0.5 (found by `shared_edges_and_split_planes`).
+#[test]
+fn a_ray_in_two_split_planes_finds_the_nearer_corner() {
+    let mut tris = testkit::grid(4, 4.0, 0.0);
+    let walls = [
+        (1, 0.5, 1.0, 2.0),
+        (0, 0.0, 0.0, -3.5),
+        (2, 0.0, 0.0, -0.5),
+        (1, -2.5, 1.0, 0.0),
+    ];
+    for (axis, c, a, b) in walls {
+        let p = |u: f32, w: f32| {
+            let mut v = [0.0; 3];
+            v[axis] = c;
+            v[(axis + 1) % 3] = u;
+            v[(axis + 2) % 3] = w;
+            Vec3::from(v)
+        };
+        tris.push([p(a, b), p(a + 1.0, b), p(a, b + 1.0)]);
+    }
+    let accel = Accel::build(&tris, &BuildParams::default());
+    let ray = Ray::new(Vec3::new(2.0, 1.0, 1.0), Vec3::NEG_Y, 0.0, f32::INFINITY);
+    let hit = accel.intersect(&ray).expect("the wall's corner is hit");
+    // The first wall, y = 0.5 with corner (2, 0.5, 1), is triangle 32 (after the grid's 32).
+    assert_eq!((hit.t, hit.prim), (0.5, 32));
+    let want = brute::intersect(&tris, &ray).expect("brute force hits it too");
+    assert_eq!((hit.t, hit.prim), (want.t, want.prim));
+}
