@@ -334,9 +334,11 @@ pub fn merge_labelled(parts: &[(String, &ExrImage)]) -> std::result::Result<ExrI
                         &covered[to..to + pw],
                         |a, b| a == b,
                     ),
-                    _ => return Err(bad(format!(
+                    _ => {
+                        return Err(bad(format!(
                         "channel {name} of {label} has another sample type than in {first_label}"
-                    ))),
+                    )))
+                    }
                 };
                 if let Err(x) = ok {
                     return Err(bad(format!(
