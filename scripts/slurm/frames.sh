@@ -6,7 +6,7 @@
 #
 # FRAMES lists one frame per line, four tab-separated fields: SOUP KD OUT.exr OUT.png
 # (scripts/slurm/frame.sbatch). The kd2exr options apply to every frame. Logs go to
-# FRAMES.logs/frame-I.log (I counts lines from 0); a frame that fails twice is named with
+# logs/frame-I.log beside FRAMES (I counts lines from 0); a frame that fails twice is named with
 # its log and the script exits 1. Environment as for render.sh: KD2EXR, CPUS_PER_TASK,
 # PARTITION, TIME_LIMIT, SBATCH_ARGS, POLL_SECONDS.
 set -euo pipefail
@@ -36,7 +36,7 @@ export KD2EXR
 
 mapfile -t exrs < <(cut -f3 "$frames")
 KIND=frame
-LOGDIR=$frames.logs
+LOGDIR=$(dirname "$frames")/logs
 output_of() { echo "${exrs[$1]}"; }
 # shellcheck source=scripts/slurm/array.sh
 source "$here/array.sh"
