@@ -80,3 +80,28 @@ robustbench *ARGS:
 # Build-parameter experiments with a tree digest per file; `just kdtune 1.5 1 0.5 0 1 out/baseline.soup`.
 kdtune *ARGS:
     cargo run --release --quiet -p bench --bin kdtune -- {{ARGS}}
+
+# Render one frame on a Slurm cluster: convert and compile here, render TILES row-band crop tiles as one array job, merge into out/NAME.exr and out/NAME.png (scripts/slurm/render.sh; env CPUS_PER_TASK, PARTITION, TIME_LIMIT, SBATCH_ARGS).
+slurm SCENE NAME TILES *KD2EXR_ARGS: build
+    mkdir -p "$(dirname "out/{{NAME}}")"
+    {{bin}}/unity2soup "{{SCENE}}" -o "out/{{NAME}}.soup"
+    kd=$(just --quiet compile "out/{{NAME}}.soup") && \
+        KD2EXR="${KD2EXR:-{{bin}}/kd2exr}" scripts/slurm/render.sh "out/{{NAME}}.soup" "$kd" "out/{{NAME}}.exr" {{TILES}} {{KD2EXR_ARGS}}
+
+# Render several scenes on a Slurm cluster, one frame per task of one array job, to out/frames/PROJECT-SCENE.exr/.png; SCENES is one quoted list (globs work): just slurm-frames "scenes/*/Assets/Scenes/*.unity" --spp 4.
+slurm-frames SCENES *KD2EXR_ARGS: build
+    #!/usr/bin/env bash
+    set -euo pipefail
+    mkdir -p out/frames
+    list=out/frames/frames.tsv
+    : > "$list"
+    for scene in {{SCENES}}; do
+        [ -f "$scene" ] || { echo "slurm-frames: no scene at $scene" >&2; exit 1; }
+        project=$(basename "$(dirname "$(dirname "$(dirname "$scene")")")")
+        name=$project-$(basename "$scene" .unity)
+        {{bin}}/unity2soup "$scene" -o "out/frames/$name.soup"
+        kd=$(just --quiet compile "out/frames/$name.soup")
+        out=$PWD/out/frames/$name
+        printf '%s\t%s\t%s\t%s\n' "$out.soup" "$(realpath "$kd")" "$out.exr" "$out.png" >> "$list"
+    done
+    KD2EXR="${KD2EXR:-{{bin}}/kd2exr}" scripts/slurm/frames.sh "$list" {{KD2EXR_ARGS}}

@@ -79,6 +79,24 @@ impl ExrImage {
         self.channels.iter().map(|c| c.0.as_str()).collect()
     }
 
+    /// Linear RGB of the data window, row-major, as the preview encodes it; None without
+    /// R, G and B channels.
+    pub fn color(&self) -> Option<Vec<glam::Vec3>> {
+        let [r, g, b] = ["R", "G", "B"].map(|n| self.channel(n));
+        let (r, g, b) = (r?, g?, b?);
+        Some(
+            (0..self.window.pixels() as usize)
+                .map(|i| {
+                    glam::Vec3::new(
+                        r.value_by_flat_index(i).to_f32(),
+                        g.value_by_flat_index(i).to_f32(),
+                        b.value_by_flat_index(i).to_f32(),
+                    )
+                })
+                .collect(),
+        )
+    }
+
     /// Value of channel `name` at full-image pixel (x, y), as f32.
     pub fn value(&self, name: &str, x: u32, y: u32) -> Option<f32> {
         let w = self.window;
@@ -202,38 +220,63 @@ impl ExrImage {
     }
 }
 
-/// Attributes that must agree between the crops of one image.
-const SAME_RENDER: [&str; 6] = [
+/// Attributes that must agree between the crops of one image: the settings that change
+/// pixels, the scene (its geometry, and the soup's checksum, which also covers materials,
+/// lights and camera), the tree's build parameters and the renderer's version. Crops that
+/// differ in any of them may still cover the image without a gap or a disagreeing overlap.
+const SAME_RENDER: [&str; 9] = [
     "spp",
     "depth",
     "seed",
     "geometryHash",
     "softSamples",
     "cutoff",
+    "soupDigest",
+    "treeParams",
+    "version",
 ];
 
 /// Assemble crops of one render into the full image. Every pixel must be covered; where
 /// crops overlap they must agree bit for bit. The result's pixels are bit-identical to a
-/// one-shot render; its `renderSeconds` is the sum of the parts'.
+/// one-shot render; its `renderSeconds` is the sum of the parts'. Errors name the inputs
+/// by position ("input 2"); [`merge_labelled`] names them as the caller likes.
 pub fn merge(parts: &[ExrImage]) -> std::result::Result<ExrImage, RenderError> {
+    let labelled: Vec<(String, &ExrImage)> = parts
+        .iter()
+        .enumerate()
+        .map(|(i, p)| (format!("input {}", i + 1), p))
+        .collect();
+    merge_labelled(&labelled)
+}
+
+/// [`merge`], each error naming the offending input by its label (kd2exr passes the file
+/// names, so a refusal says which tile to look at).
+pub fn merge_labelled(parts: &[(String, &ExrImage)]) -> std::result::Result<ExrImage, RenderError> {
     let bad = |s: String| RenderError::Merge(s);
-    let first = parts.first().ok_or_else(|| bad("no input images".into()))?;
+    let (first_label, first) = parts.first().ok_or_else(|| bad("no input images".into()))?;
+    let first = *first;
     let names = first.channel_names();
-    for (i, p) in parts.iter().enumerate() {
+    let crop_key = format!("{ATTR_PREFIX}crop");
+    for (label, p) in parts {
         if (p.width, p.height) != (first.width, first.height) {
             return Err(bad(format!(
-                "input {} is a crop of a {}×{} image, input 1 of {}×{}",
-                i + 1,
-                p.width,
-                p.height,
-                first.width,
-                first.height
+                "{label} is a crop of a {}×{} image, {first_label} of {}×{}",
+                p.width, p.height, first.width, first.height
             )));
+        }
+        // A crop whose header names another window than the one it holds was cut or
+        // edited after rendering: its pixels are not where the render put them.
+        if let Some(crop) = p.attributes.get(&crop_key) {
+            if *crop != p.window.to_string() {
+                return Err(bad(format!(
+                    "{label} was rendered as the crop {crop} but holds the window {}",
+                    p.window
+                )));
+            }
         }
         if p.channel_names() != names {
             return Err(bad(format!(
-                "input {} has channels {:?}, input 1 has {:?}",
-                i + 1,
+                "{label} has channels {:?}, {first_label} has {:?}",
                 p.channel_names(),
                 names
             )));
@@ -242,8 +285,8 @@ pub fn merge(parts: &[ExrImage]) -> std::result::Result<ExrImage, RenderError> {
             let k = format!("{ATTR_PREFIX}{key}");
             if p.attributes.get(&k) != first.attributes.get(&k) {
                 return Err(bad(format!(
-                    "input {} was rendered with {key} {:?}, input 1 with {:?}",
-                    i + 1,
+                    "{label} was rendered with {key} {:?}, {first_label} with {:?}: \
+                     they are not crops of one render",
                     p.attributes.get(&k),
                     first.attributes.get(&k)
                 )));
@@ -264,7 +307,7 @@ pub fn merge(parts: &[ExrImage]) -> std::result::Result<ExrImage, RenderError> {
             (n.clone(), full)
         })
         .collect();
-    for (pi, p) in parts.iter().enumerate() {
+    for (label, p) in parts {
         let pw = p.window.width() as usize;
         for (ci, (name, src)) in p.channels.iter().enumerate() {
             let dst = &mut channels[ci].1;
@@ -293,15 +336,14 @@ pub fn merge(parts: &[ExrImage]) -> std::result::Result<ExrImage, RenderError> {
                     ),
                     _ => {
                         return Err(bad(format!(
-                            "channel {name} of input {} has another sample type than in input 1",
-                            pi + 1
-                        )))
+                        "channel {name} of {label} has another sample type than in {first_label}"
+                    )))
                     }
                 };
                 if let Err(x) = ok {
                     return Err(bad(format!(
-                        "inputs overlap at pixel ({}, {y}) with different {name} values: \
-                         they are not crops of one render",
+                        "{label} overlaps an earlier input at pixel ({}, {y}) with a \
+                         different {name} value: they are not crops of one render",
                         p.window.x0 as usize + x
                     )));
                 }
@@ -323,7 +365,7 @@ pub fn merge(parts: &[ExrImage]) -> std::result::Result<ExrImage, RenderError> {
     let mut attributes = first.attributes.clone();
     let seconds: f64 = parts
         .iter()
-        .filter_map(|p| {
+        .filter_map(|(_, p)| {
             p.attributes
                 .get(&format!("{ATTR_PREFIX}renderSeconds"))?
                 .parse::<f64>()
@@ -365,6 +407,74 @@ fn copy_row<T: Copy>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn crop(window: Window, attrs: &[(&str, &str)]) -> ExrImage {
+        let n = window.pixels() as usize;
+        ExrImage {
+            width: 4,
+            height: 2,
+            window,
+            channels: vec![("R".into(), FlatSamples::F32(vec![0.5; n]))],
+            attributes: attrs
+                .iter()
+                .map(|(k, v)| (format!("{ATTR_PREFIX}{k}"), v.to_string()))
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn merge_refuses_a_crop_that_holds_another_window_than_it_names() {
+        let left = Window {
+            x0: 0,
+            y0: 0,
+            x1: 2,
+            y1: 2,
+        };
+        let right = Window {
+            x0: 2,
+            y0: 0,
+            x1: 4,
+            y1: 2,
+        };
+        let a = crop(left, &[("crop", "0,0,2,2")]);
+        let b = crop(right, &[("crop", "0,0,2,2")]);
+        let err = merge_labelled(&[("a.exr".into(), &a), ("b.exr".into(), &b)])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("b.exr was rendered as the crop 0,0,2,2 but holds the window 2,0,4,2"),
+            "{err}"
+        );
+        let b = crop(right, &[("crop", "2,0,4,2")]);
+        assert!(merge(&[a, b]).is_ok());
+    }
+
+    #[test]
+    fn merge_names_the_input_of_another_soup_or_tree() {
+        let left = Window {
+            x0: 0,
+            y0: 0,
+            x1: 2,
+            y1: 2,
+        };
+        let right = Window {
+            x0: 2,
+            y0: 0,
+            x1: 4,
+            y1: 2,
+        };
+        for key in ["soupDigest", "treeParams", "version"] {
+            let a = crop(left, &[(key, "1")]);
+            let b = crop(right, &[(key, "2")]);
+            let err = merge_labelled(&[("a.exr".into(), &a), ("b.exr".into(), &b)])
+                .unwrap_err()
+                .to_string();
+            assert!(
+                err.contains("b.exr was rendered with") && err.contains(key),
+                "{err}"
+            );
+        }
+    }
 
     #[test]
     fn ascii_json_escapes_unicode() {

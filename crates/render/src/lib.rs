@@ -63,3 +63,18 @@ pub fn header_attributes(
     }
     a
 }
+
+/// The header attributes that tie an EXR to the exact inputs it was rendered from, so
+/// `kd2exr merge` refuses crops of another soup or tree even when the geometry is the same:
+/// the soup file's payload checksum (it also covers materials, lights and camera) and the
+/// tree's build parameters.
+pub fn source_attributes(
+    soup_digest: &formats::Digest,
+    tree: &formats::BuildParams,
+) -> std::collections::BTreeMap<String, String> {
+    let p = exrio::ATTR_PREFIX;
+    std::collections::BTreeMap::from([
+        (format!("{p}soupDigest"), formats::hex(soup_digest)),
+        (format!("{p}treeParams"), tree.short_hash()),
+    ])
+}

@@ -1,6 +1,7 @@
 //! The PNG preview: exposure, sRGB encoding, 8 bits.
 
 use crate::{Frame, RenderError};
+use glam::Vec3;
 use std::path::Path;
 
 /// The sRGB opto-electronic transfer function (IEC 61966-2-1) on a linear value in [0, 1].
@@ -27,8 +28,13 @@ pub fn to_8bit(linear: f32, exposure: f32) -> u8 {
 /// Encode the frame's window as an 8-bit sRGB PNG.
 pub fn encode_png(frame: &Frame, exposure: f32) -> Result<Vec<u8>, String> {
     let (w, h) = (frame.window.width(), frame.window.height());
-    let mut rgb = Vec::with_capacity(frame.color.len() * 3);
-    for c in &frame.color {
+    encode_rgb_png(w, h, &frame.color, exposure)
+}
+
+/// Encode `w`×`h` linear RGB pixels (row-major) as an 8-bit sRGB PNG.
+pub fn encode_rgb_png(w: u32, h: u32, color: &[Vec3], exposure: f32) -> Result<Vec<u8>, String> {
+    let mut rgb = Vec::with_capacity(color.len() * 3);
+    for c in color {
         rgb.extend(c.to_array().map(|v| to_8bit(v, exposure)));
     }
     let mut out = Vec::new();
@@ -45,7 +51,19 @@ pub fn encode_png(frame: &Frame, exposure: f32) -> Result<Vec<u8>, String> {
 
 /// Write the preview atomically (temp file + rename).
 pub fn write_png(path: &Path, frame: &Frame, exposure: f32) -> Result<(), RenderError> {
-    let bytes = encode_png(frame, exposure).map_err(|detail| RenderError::PngWrite {
+    let (w, h) = (frame.window.width(), frame.window.height());
+    write_rgb_png(path, w, h, &frame.color, exposure)
+}
+
+/// Write `w`×`h` linear RGB pixels as a preview, atomically.
+pub fn write_rgb_png(
+    path: &Path,
+    w: u32,
+    h: u32,
+    color: &[Vec3],
+    exposure: f32,
+) -> Result<(), RenderError> {
+    let bytes = encode_rgb_png(w, h, color, exposure).map_err(|detail| RenderError::PngWrite {
         path: path.to_path_buf(),
         detail,
     })?;

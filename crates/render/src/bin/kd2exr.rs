@@ -5,7 +5,7 @@
 //!        [--depth 4] [--spp 1] [--seed 0] [--threads N] [--json] [--half]
 //!        [--aov depth,normal,albedo,object] [--exposure 0] [--crop x0,y0,x1,y1]
 //!        [--soft-samples 16] [--cutoff 0.004]
-//! kd2exr merge a.exr b.exr … -o full.exr
+//! kd2exr merge a.exr b.exr … -o full.exr [--preview full.png] [--exposure 0]
 //! ```
 
 use anyhow::{Context, Result};
@@ -40,6 +40,12 @@ enum Command {
         inputs: Vec<PathBuf>,
         #[arg(short, long)]
         output: PathBuf,
+        /// Also write an 8-bit sRGB PNG preview of the merged image.
+        #[arg(long)]
+        preview: Option<PathBuf>,
+        /// Preview exposure in stops (the PNG is scaled by 2^exposure).
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+        exposure: f32,
     },
 }
 
@@ -99,7 +105,12 @@ struct RenderArgs {
 fn main() {
     let cli = Cli::parse();
     let result = match cli.command {
-        Some(Command::Merge { inputs, output }) => merge(&inputs, &output),
+        Some(Command::Merge {
+            inputs,
+            output,
+            preview,
+            exposure,
+        }) => merge(&inputs, &output, preview.as_deref(), exposure),
         None => run(cli.render),
     };
     if let Err(e) = result {
@@ -108,15 +119,33 @@ fn main() {
     }
 }
 
-fn merge(inputs: &[PathBuf], output: &std::path::Path) -> Result<()> {
+fn merge(
+    inputs: &[PathBuf],
+    output: &std::path::Path,
+    preview: Option<&std::path::Path>,
+    exposure: f32,
+) -> Result<()> {
     let start = Instant::now();
+    finite_exposure(exposure)?;
+    for p in std::iter::once(output).chain(preview) {
+        writable_folder(p)?;
+    }
     let parts = inputs
         .iter()
-        .map(|p| ExrImage::read(p))
-        .collect::<Result<Vec<_>, _>>()?;
-    writable_folder(output)?;
-    let full = render::exrio::merge(&parts)?;
+        .map(|p| Ok((p.display().to_string(), ExrImage::read(p)?)))
+        .collect::<Result<Vec<_>, render::RenderError>>()?;
+    let labelled: Vec<(String, &ExrImage)> = parts.iter().map(|(l, p)| (l.clone(), p)).collect();
+    let full = render::exrio::merge_labelled(&labelled)?;
     full.write(output)?;
+    if let Some(png) = preview {
+        let color = full.color().with_context(|| {
+            format!(
+                "cannot write the preview {}: the crops have no RGB channels",
+                png.display()
+            )
+        })?;
+        preview::write_rgb_png(png, full.width, full.height, &color, exposure)?;
+    }
     eprintln!(
         "kd2exr: merged {} crops into {} ({}×{}) in {:.2} s",
         parts.len(),
@@ -125,6 +154,13 @@ fn merge(inputs: &[PathBuf], output: &std::path::Path) -> Result<()> {
         full.height,
         start.elapsed().as_secs_f64()
     );
+    Ok(())
+}
+
+fn finite_exposure(exposure: f32) -> Result<()> {
+    if !exposure.is_finite() {
+        anyhow::bail!("invalid option: --exposure {exposure} is not a finite number");
+    }
     Ok(())
 }
 
@@ -160,12 +196,7 @@ fn run(a: RenderArgs) -> Result<()> {
         threads: a.threads,
         ..RenderOptions::default()
     };
-    if !a.exposure.is_finite() {
-        anyhow::bail!(
-            "invalid option: --exposure {} is not a finite number",
-            a.exposure
-        );
-    }
+    finite_exposure(a.exposure)?;
     // Everything that can be refused is refused before loading or tracing anything.
     opts.validate()?;
     memory::check(&opts, memory::available_bytes())?;
@@ -174,7 +205,14 @@ fn run(a: RenderArgs) -> Result<()> {
     }
 
     let t_load = Instant::now();
-    let soup = Soup::read(&soup_path)?;
+    let soup_bytes = formats::envelope::read_file(&soup_path)?;
+    let soup = Soup::from_bytes(&soup_bytes, &soup_path)?;
+    // The envelope's payload checksum, verified by the decode, identifies the whole soup.
+    let soup_digest: formats::Digest = soup_bytes
+        [formats::envelope::HEADER_LEN - 32..formats::envelope::HEADER_LEN]
+        .try_into()
+        .context("the soup's envelope header")?;
+    drop(soup_bytes);
     let kd = KdFile::read(&kd_path)?;
     let accel = kdtree::Accel::new(&soup, &kd)
         .with_context(|| format!("{} and {}", soup_path.display(), kd_path.display()))?;
@@ -207,7 +245,8 @@ fn run(a: RenderArgs) -> Result<()> {
         b.finish_and_clear();
     }
 
-    let attrs = render::header_attributes(&plan, &opts, out.seconds, &soup.geometry_hash);
+    let mut attrs = render::header_attributes(&plan, &opts, out.seconds, &soup.geometry_hash);
+    attrs.extend(render::source_attributes(&soup_digest, &kd.params));
     ExrImage::from_frame(&out.frame, a.half, attrs).write(&out_path)?;
     if let Some(png) = &a.preview {
         preview::write_png(png, &out.frame, a.exposure)?;
