@@ -162,9 +162,17 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FormatError> {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".unitrace-")
-        .suffix(".tmp")
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".unitrace-").suffix(".tmp");
+    // A temporary file is private (0600) by default; the output should be what creating it
+    // directly gives (0666 less the umask), so that, say, a cluster's merge step running as
+    // another user can read the tiles.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    let mut tmp = builder
         .tempfile_in(dir)
         .map_err(|e| FormatError::io(path, e))?;
     tmp.write_all(bytes).map_err(|e| FormatError::io(path, e))?;

@@ -256,3 +256,23 @@ fn payload_layout_matches_soup_md() {
         30.0
     );
 }
+
+/// Outputs get the permissions a plain create gives (0666 less the umask), not the
+/// temporary file's private 0600, so another user (a cluster's merge step) can read them.
+#[cfg(target_os = "linux")]
+#[test]
+fn atomic_outputs_get_the_umask_permissions_not_the_temporary_files() {
+    use std::os::unix::fs::PermissionsExt;
+    let status = std::fs::read_to_string("/proc/self/status").unwrap();
+    let umask = status
+        .lines()
+        .find_map(|l| l.strip_prefix("Umask:"))
+        .map(|v| u32::from_str_radix(v.trim(), 8).unwrap())
+        .expect("Linux reports the umask");
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("out.bin");
+    write_atomic(&path, b"bytes").unwrap();
+    let mode = std::fs::metadata(&path).unwrap().permissions().mode() & 0o777;
+    assert_eq!(mode, 0o666 & !umask, "mode {mode:o} with umask {umask:o}");
+    assert_eq!(std::fs::read(&path).unwrap(), b"bytes");
+}
