@@ -320,7 +320,11 @@ impl Emitter<'_, '_> {
             }
             // A sub-mesh without a material name: Unity's importer gives it its default
             // material.
-            None if name == Model::UNNAMED_MATERIAL => (self.default_material(), "default".into()),
+            None if name == Model::UNNAMED_MATERIAL
+                || (fbx && name == Model::FBX_UNNAMED_MATERIAL) =>
+            {
+                (self.default_material(), "default".into())
+            }
             None if fbx => {
                 let why = format!("{rel}: material '{name}' is not defined in the file");
                 (self.warn_default(what, why), "default".into())

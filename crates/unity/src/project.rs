@@ -211,7 +211,15 @@ impl Project {
                 m.scale(meta.global_scale);
                 m
             }
-            _ => fbx::load(path, &meta).map_err(|e| self.read_error(path, &e))?,
+            _ => {
+                let mut m = fbx::load(path, &meta).map_err(|e| self.read_error(path, &e))?;
+                for name in m.meshes.iter_mut().flat_map(|x| &mut x.materials) {
+                    if name.is_empty() {
+                        *name = Model::FBX_UNNAMED_MATERIAL.to_string();
+                    }
+                }
+                m
+            }
         };
         Ok(ModelAsset { model, meta })
     }

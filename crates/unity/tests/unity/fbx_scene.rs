@@ -576,3 +576,40 @@ fn scene_skinned_mesh_renderer_uses_its_m_bones_or_falls_back_to_the_bind_pose()
         ["Assets/s.unity: object 'Lone' (fileID 1007): SkinnedMeshRenderer has no bones (m_Bones is empty); drawn in its bind pose at the renderer's transform"]
     );
 }
+
+#[test]
+fn an_fbx_mesh_without_material_is_unitys_no_name_for_remaps() {
+    // A mesh with no material: Unity names its material "No Name"; the meta remaps that
+    // name to Remap.mat (grey 0.5 → linear 0.21404114). Without the remap it is Unity's
+    // default material, silently.
+    let remap = "7e3a0000000000000000000000000000";
+    let extra = format!("  externalObjects:\n  - first:\n      type: UnityEngine:Material\n      assembly: UnityEngine.CoreModule\n      name: No Name\n    second: {{fileID: 2100000, guid: {remap}, type: 2}}\n");
+    let f = Fbx {
+        nodes: vec![
+            Node::new("Bare", None).mesh(Geometry::new(
+                &[[0.0, 0.0, 0.0], [100.0, 0.0, 0.0], [0.0, 100.0, 0.0]],
+                &[&[0, 1, 2]],
+            )),
+            Node::new("Other", None),
+        ],
+        ..Default::default()
+    };
+    let mut sc = Scene::default();
+    sc.raw(&instance(500, G, "", " []"));
+    sc.camera(&Tf::at(0.0, 0.0, -10.0));
+    let (_d, root) = project(&[
+        ("Assets/m.fbx", &text_of(&f)),
+        ("Assets/m.fbx.meta", &model_meta(G, &extra)),
+        ("Assets/Remap.mat", &mat("Remap", [0.5, 0.5, 0.5])),
+        ("Assets/Remap.mat.meta", &guid_meta(remap)),
+        ("Assets/s.unity", &sc.text),
+    ]);
+    let r = report(&root, "Assets/s.unity");
+    assert!(r.soup.warnings.is_empty(), "{:?}", r.soup.warnings);
+    assert_eq!(r.material_origins[0][0].1, "remap Assets/Remap.mat");
+    assert_eq!(r.soup.materials[0].color, Vec3::splat(0.214_041_14));
+    std::fs::write(root.join("Assets/m.fbx.meta"), model_meta(G, "")).unwrap();
+    let r = report(&root, "Assets/s.unity");
+    assert!(r.soup.warnings.is_empty(), "{:?}", r.soup.warnings);
+    assert_eq!(r.material_origins[0][0].1, "default");
+}
