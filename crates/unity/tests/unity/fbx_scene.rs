@@ -264,7 +264,8 @@ fn model_materials_follow_remap_then_materials_folders_then_the_models_own() {
     // Assets/Art/Props/Materials/blue.mat (green (0, 1, 0) to tell it apart); "green"
     // is found one folder up, Assets/Art/Materials/green.mat ((1, 1, 0)), by Unity's
     // default Recursive-Up search; "plain" has no .mat: the file's own diffuse
-    // (0, 0.5, 1); slot 4 "over" is overridden by the instance with Blue.mat ((0, 0, 1)).
+    // (0, 0.5, 1), which Unity puts in the material's (sRGB) colour: linear
+    // (0, 0.21404114, 1); slot 4 "over" is overridden by the instance with Blue.mat ((0, 0, 1)).
     // Remap beats the folder: a Materials/red.mat next to the model is not used.
     let remap = "7e3a0000000000000000000000000000";
     let blue = "b1e00000000000000000000000000000";
@@ -340,7 +341,7 @@ fn model_materials_follow_remap_then_materials_folders_then_the_models_own() {
             Vec3::splat(grey),
             Vec3::Y,
             Vec3::new(1.0, 1.0, 0.0),
-            Vec3::new(0.0, 0.5, 1.0),
+            Vec3::new(0.0, grey, 1.0),
             Vec3::Z
         ]
     );
