@@ -1,5 +1,5 @@
 //! `unity2soup`'s library: reads a text-serialized Unity scene with its project (`.meta`
-//! GUIDs, `.prefab`, `.mat`, OBJ models) and produces the world-space, right-handed
+//! GUIDs, `.prefab`, `.mat`, OBJ and FBX models) and produces the world-space, right-handed
 //! triangle soup the renderer reads.
 //!
 //! Stages: [`docs`] splits files into documents, [`yaml`] parses the bodies it needs,
