@@ -542,3 +542,51 @@ fn legacy_material_with_repeated_data_keys() {
     assert!((m.color - want).abs().max_element() < 1e-6, "{}", m.color);
     assert_eq!(m.emission, Vec3::ZERO);
 }
+
+/// Every (soup material, origin) of the objects drawn from mesh `source`.
+fn origins_of<'a>(r: &'a unity::Report, source: &str) -> Vec<(&'a formats::Material, &'a str)> {
+    let mut out = Vec::new();
+    for (i, o) in r.soup.objects.iter().enumerate() {
+        if o.source == source {
+            for (m, origin) in &r.material_origins[i] {
+                out.push((&r.soup.materials[*m as usize], origin.as_str()));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn fbx_model_materials_in_the_corpus() {
+    let Some(root) = corpus() else { return };
+    // GDSJam-Reflection floor.FBX (legacy meta: no materialLocation, `materialName: 0`):
+    // its material's diffuse texture is basetile_basecolor, and Unity extracted
+    // Assets/Models/models/Materials/basetile_basecolor.mat next to the model; the
+    // instances without a material override use it.
+    let r = report(&root.join("Pjaerr__GDSJam-Reflection/Assets/Scenes/Tutorial.unity"));
+    let floor = origins_of(&r, "Assets/Models/models/floor.FBX#floor");
+    assert!(
+        floor
+            .iter()
+            .any(|(_, o)| *o
+                == "Materials folder Assets/Models/models/Materials/basetile_basecolor.mat"),
+        "{floor:?}"
+    );
+    // CreateWithVR2021 wall.fbx (ASCII, materialLocation 1, no remap): its own 'wood',
+    // whose text says `P: "DiffuseColor", "Color", "", "A",0.8962264,0.6015712,0.3931559`
+    // (Unity's sRGB material colour, linearised here).
+    let r = report(&root.join("thespeedyboy__CreateWithVR2021/Assets/Scenes/final.unity"));
+    let src = "Assets/_Course Library/models/FBX format-20250115T161328Z-001/FBX format/wall.fbx";
+    let wall = origins_of(&r, &format!("{src}#wall"));
+    let (wood, origin) = wall
+        .iter()
+        .find(|(m, _)| m.name == "wood")
+        .unwrap_or_else(|| panic!("{wall:?}"));
+    assert_eq!(*origin, format!("model's own {src}#wood"));
+    let want = Vec3::new(eotf(0.896_226_4), eotf(0.601_571_2), eotf(0.393_155_9));
+    assert!(
+        (wood.color - want).abs().max_element() < 1e-6,
+        "{}",
+        wood.color
+    );
+}
