@@ -125,6 +125,7 @@ pub fn class_name(class: u32) -> &'static str {
         docs::MATERIAL => "Material",
         docs::MESH_RENDERER => "MeshRenderer",
         docs::MESH_FILTER => "MeshFilter",
+        docs::SKINNED_MESH_RENDERER => "SkinnedMeshRenderer",
         docs::MESH => "Mesh",
         _ => "Object",
     }

@@ -511,13 +511,23 @@ const Z90: [f32; 4] = [
 #[test]
 fn skinned_instance_is_posed_by_its_moved_bone() {
     // The instance moves B1 (name-hashed `Type:Transform->B10`) to (0, 2, 0) and turns
-    // it 90° about Z.
+    // it 90° about Z, and gives the SkinnedMeshRenderer Unity made for Body
+    // (`Type:SkinnedMeshRenderer->Body0`) Blue.mat.
     let b1 = hash_id("Type:Transform->B10");
+    let smr = hash_id("Type:SkinnedMeshRenderer->Body0");
+    let blue = "b1e00000000000000000000000000000";
     let s = Z90[2].to_string();
     let mods = [
         modification(b1, G, "m_LocalPosition.y", "2", "{fileID: 0}"),
         modification(b1, G, "m_LocalRotation.z", &s, "{fileID: 0}"),
         modification(b1, G, "m_LocalRotation.w", &s, "{fileID: 0}"),
+        modification(
+            smr,
+            G,
+            "m_Materials.Array.data[0]",
+            "",
+            &format!("{{fileID: 2100000, guid: {blue}, type: 2}}"),
+        ),
     ]
     .concat();
     let mut sc = Scene::default();
@@ -526,10 +536,13 @@ fn skinned_instance_is_posed_by_its_moved_bone() {
     let (_d, root) = project(&[
         ("Assets/rig.fbx", &text_of(&skinned())),
         ("Assets/rig.fbx.meta", &model_meta(G, "")),
+        ("Assets/Blue.mat", &mat("Blue", [0.0, 0.0, 1.0])),
+        ("Assets/Blue.mat.meta", &guid_meta(blue)),
         ("Assets/s.unity", &sc.text),
     ]);
     let soup = report(&root, "Assets/s.unity").soup;
     assert!(soup.warnings.is_empty(), "{:?}", soup.warnings);
+    assert_eq!(soup.materials[soup.tri_material[0] as usize].color, Vec3::Z);
     let pts = object_points(&soup, "rig/Body");
     assert_eq!(pts.len(), 3);
     for p in POSED {
