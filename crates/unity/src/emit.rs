@@ -46,6 +46,9 @@ pub(crate) struct Emitter<'g, 'p> {
     /// Per soup object: each soup material it uses and where the slot's material came
     /// from.
     pub(crate) material_origins: Vec<Vec<(u32, String)>>,
+    /// (model, material name) → the extracted `.mat` found for it, if any: the search
+    /// walks folders, and every instance of a model asks again.
+    pub(crate) extracted: HashMap<(std::path::PathBuf, String), Option<std::path::PathBuf>>,
 }
 
 /// What [`emit`] produces.
@@ -72,6 +75,7 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
         meshes: HashMap::new(),
         materials: HashMap::new(),
         material_origins: Vec::new(),
+        extracted: HashMap::new(),
     };
     e.soup.warnings = g.warnings.clone();
     for (i, o) in g.objs.iter().enumerate() {

@@ -295,8 +295,17 @@ impl Emitter<'_, '_> {
                 return self.mat_file_origin(&mat, what, "remap");
             }
             if asset.meta.material_location != Some(1) {
-                let own = asset.model.material(name);
-                if let Some(mat) = self.extracted_material(path, asset, name, own) {
+                let key = (path.to_path_buf(), name.to_string());
+                let found = match self.extracted.get(&key) {
+                    Some(f) => f.clone(),
+                    None => {
+                        let own = asset.model.material(name);
+                        let f = self.extracted_material(path, asset, name, own);
+                        self.extracted.insert(key, f.clone());
+                        f
+                    }
+                };
+                if let Some(mat) = found {
                     return self.mat_file_origin(&mat, what, "Materials folder");
                 }
             }
