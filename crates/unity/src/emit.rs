@@ -1,6 +1,7 @@
 //! From the object graph to the soup: walks the active GameObjects and hands each
 //! component to the file of its Unity concept ([`crate::transform`],
-//! [`crate::renderer`], [`crate::mesh_source`], [`crate::material`], [`crate::light`],
+//! [`crate::renderer`], [`crate::skinned_renderer`], [`crate::mesh_source`],
+//! [`crate::material`], [`crate::light`],
 //! [`crate::camera`], [`crate::environment`]). The soup is right-handed: Unity's x is
 //! negated and every triangle's winding reversed.
 

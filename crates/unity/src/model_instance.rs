@@ -1,5 +1,6 @@
 //! A model as the scene sees it: the GameObject, Transform, MeshFilter and MeshRenderer
-//! Unity creates for every node of an imported [`crate::model::Model`], and the fileIDs
+//! (SkinnedMeshRenderer for a skinned mesh, its bones the model's own Transforms) Unity
+//! creates for every node of an imported [`crate::model::Model`], and the fileIDs
 //! under which the scene refers to them and to the model's meshes and materials.
 
 use crate::docs;

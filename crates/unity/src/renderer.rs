@@ -1,5 +1,6 @@
 //! MeshRenderer (class 23) with its MeshFilter (class 33): the mesh's triangles in world
-//! space, soup handedness, each with the material of its sub-mesh's slot.
+//! space, soup handedness, each with the material of its sub-mesh's slot. Skinned
+//! renderers draw their posed mesh through the same `draw`.
 
 use crate::emit::{flip, EmitError, Emitter};
 use crate::mesh::Mesh;
