@@ -1,6 +1,7 @@
 //! From the object graph to the soup: walks the active GameObjects and hands each
 //! component to the file of its Unity concept ([`crate::transform`],
-//! [`crate::renderer`], [`crate::mesh_source`], [`crate::material`], [`crate::light`],
+//! [`crate::renderer`], [`crate::skinned_renderer`], [`crate::mesh_source`],
+//! [`crate::material`], [`crate::light`],
 //! [`crate::camera`], [`crate::environment`]). The soup is right-handed: Unity's x is
 //! negated and every triangle's winding reversed.
 
@@ -43,10 +44,28 @@ pub(crate) struct Emitter<'g, 'p> {
     pub(crate) meshes: HashMap<String, Option<Arc<Mesh>>>,
     /// Material source key → soup material index.
     pub(crate) materials: HashMap<String, u32>,
+    /// Per soup object: each soup material it uses and where the slot's material came
+    /// from.
+    pub(crate) material_origins: Vec<Vec<(u32, String)>>,
+    /// (model, material name) → the extracted `.mat` found for it, if any: the search
+    /// walks folders, and every instance of a model asks again.
+    pub(crate) extracted: HashMap<(std::path::PathBuf, String), Option<std::path::PathBuf>>,
 }
 
-/// The soup, and how many enabled cameras on active objects the scene has.
-pub fn emit(g: &Graph, scene_rel: &str) -> Result<(Soup, usize), EmitError> {
+/// What [`emit`] produces.
+pub struct Emitted {
+    pub soup: Soup,
+    /// Enabled cameras on active objects (the soup keeps one).
+    pub cameras: usize,
+    /// Per soup object: each soup material it uses and where it came from (a renderer
+    /// override, a model importer remap, a `Materials/` folder, the model's own, or the
+    /// default).
+    pub material_origins: Vec<Vec<(u32, String)>>,
+}
+
+/// The soup, how many enabled cameras on active objects the scene has, and where the
+/// objects' materials came from.
+pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
     let mut e = Emitter {
         g,
         scene_rel,
@@ -56,6 +75,8 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<(Soup, usize), EmitError> {
         world: HashMap::new(),
         meshes: HashMap::new(),
         materials: HashMap::new(),
+        material_origins: Vec::new(),
+        extracted: HashMap::new(),
     };
     e.soup.warnings = g.warnings.clone();
     for (i, o) in g.objs.iter().enumerate() {
@@ -82,8 +103,7 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<(Soup, usize), EmitError> {
         }
         if let Some(smr) = class_of(docs::SKINNED_MESH_RENDERER) {
             if enabled(&g.objs[smr]) {
-                let w = e.describe(gi);
-                e.soup.warnings.push(format!("{w}: SkinnedMeshRenderer is not converted (skinned meshes need their rig); skipped"));
+                e.skinned_object(gi, smr)?;
             }
         }
         if class_of(docs::TERRAIN).is_some() {
@@ -110,7 +130,11 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<(Soup, usize), EmitError> {
         e.soup.environment.ambient = ambient;
     }
     e.soup.seal();
-    Ok((e.soup, cameras.len()))
+    Ok(Emitted {
+        soup: e.soup,
+        cameras: cameras.len(),
+        material_origins: e.material_origins,
+    })
 }
 
 /// A component's `m_Enabled` (on unless it says 0).

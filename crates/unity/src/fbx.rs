@@ -302,7 +302,9 @@ impl Importer {
             });
             model.materials.push(ModelMaterial {
                 name: m.element.name.to_string(),
-                color: Vec3::new(c.x as f32, c.y as f32, c.z as f32),
+                color: crate::material::linear_rgb(glam::Vec4::new(
+                    c.x as f32, c.y as f32, c.z as f32, 1.0,
+                )),
                 texture: texture.filter(|t| !t.is_empty()),
             });
         }

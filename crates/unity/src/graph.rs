@@ -33,6 +33,9 @@ pub struct Obj {
     pub mesh: Ref,
     /// A renderer's `m_Materials`, one per sub-mesh slot.
     pub materials: Vec<Ref>,
+    /// A SkinnedMeshRenderer's `m_Bones`, resolved to Transforms (`None`: a reference
+    /// that names no Transform of its file).
+    pub bones: Vec<Option<usize>>,
 }
 
 pub struct FileCtx {
@@ -160,6 +163,7 @@ impl<'p> Graph<'p> {
             go: None,
             father: None,
             removed: false,
+            bones: Vec::new(),
         });
         self.objs.len() - 1
     }
@@ -380,6 +384,22 @@ impl<'p> Graph<'p> {
         for &idx in &f.own {
             let (go, _) = fref(self.objs[idx].body.get("m_GameObject"));
             self.objs[idx].go = f.map.get(&go).copied();
+            if self.objs[idx].class == docs::SKINNED_MESH_RENDERER {
+                let bones = self.objs[idx]
+                    .body
+                    .get("m_Bones")
+                    .map(Node::as_seq)
+                    .unwrap_or(&[])
+                    .iter()
+                    .map(|b| {
+                        f.map
+                            .get(&fref(Some(b)).0)
+                            .copied()
+                            .filter(|&t| is_transform(self.objs[t].class))
+                    })
+                    .collect();
+                self.objs[idx].bones = bones;
+            }
             if is_transform(self.objs[idx].class) {
                 let (father, _) = fref(self.objs[idx].body.get("m_Father"));
                 self.objs[idx].father = f.map.get(&father).copied();

@@ -1,5 +1,5 @@
 //! `unity2soup`'s library: reads a text-serialized Unity scene with its project (`.meta`
-//! GUIDs, `.prefab`, `.mat`, OBJ models) and produces the world-space, right-handed
+//! GUIDs, `.prefab`, `.mat`, OBJ and FBX models) and produces the world-space, right-handed
 //! triangle soup the renderer reads.
 //!
 //! Stages: [`docs`] splits files into documents, [`yaml`] parses the bodies it needs,
@@ -28,6 +28,7 @@ pub mod primitives;
 pub mod project;
 pub mod reference;
 pub mod renderer;
+pub mod skinned_renderer;
 pub mod transform;
 pub mod yaml;
 
@@ -60,6 +61,8 @@ pub struct Report {
     pub soup: Soup,
     /// Enabled cameras on active objects (the soup keeps one).
     pub cameras: usize,
+    /// Per soup object: each soup material it uses and where the material came from.
+    pub material_origins: Vec<Vec<(u32, String)>>,
 }
 
 /// Convert a scene into a sealed soup.
@@ -84,7 +87,11 @@ pub fn convert_report(scene: &Path, opts: &Options) -> Result<Report, ConvertErr
     g.warnings.extend(project.guids.warnings.iter().cloned());
     g.load_scene(scene, text);
     let scene_rel = project.rel(scene);
-    let (mut soup, cameras) = emit::emit(&g, &scene_rel)?;
+    let emit::Emitted {
+        mut soup,
+        cameras,
+        material_origins,
+    } = emit::emit(&g, &scene_rel)?;
     // Model-level warnings (missing .mtl …), once per model used.
     let mut model_warnings: Vec<String> = Vec::new();
     for f in soup
@@ -108,5 +115,9 @@ pub fn convert_report(scene: &Path, opts: &Options) -> Result<Report, ConvertErr
             first: soup.warnings[0].clone(),
         });
     }
-    Ok(Report { soup, cameras })
+    Ok(Report {
+        soup,
+        cameras,
+        material_origins,
+    })
 }

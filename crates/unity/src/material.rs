@@ -158,12 +158,16 @@ impl Emitter<'_, '_> {
         self.default_material()
     }
 
-    /// A material slot's soup material index (deduplicated by source); `what` names
-    /// the object in messages.
-    pub(crate) fn material(&mut self, r: &Ref, what: &str) -> u32 {
+    /// A material slot's soup material index (deduplicated by source) and where the
+    /// slot's material came from; `what` names the object in messages.
+    pub(crate) fn material(&mut self, r: &Ref, what: &str) -> (u32, String) {
         let id = r.file_id;
+        let default = || "default".to_string();
         if id == 0 {
-            return self.warn_default(what, "material slot is empty".into());
+            return (
+                self.warn_default(what, "material slot is empty".into()),
+                default(),
+            );
         }
         let Some(guid) = r.guid.as_deref() else {
             return self.embedded_material(id, r.file, what);
@@ -174,41 +178,56 @@ impl Emitter<'_, '_> {
                     "{what}: built-in material {id} approximated by Default-Material"
                 ));
             }
-            return self.default_material();
+            return (self.default_material(), default());
         }
         let project = self.g.project;
         let Some(path) = project.resolve(guid).cloned() else {
-            return self.warn_default(
-                what,
-                format!("material GUID {guid} is not in the project (a package or deleted asset)"),
-            );
+            let why =
+                format!("material GUID {guid} is not in the project (a package or deleted asset)");
+            return (self.warn_default(what, why), default());
         };
         if crate::project::ext(&path) == "mat" {
-            self.mat_file(&path, what)
+            self.mat_file_origin(&path, what, "override")
         } else {
             self.model_material(id, &path, what)
         }
     }
 
+    /// A `.mat` file's material with `origin`, or the default when it holds none.
+    fn mat_file_origin(&mut self, path: &Path, what: &str, origin: &str) -> (u32, String) {
+        let before = self.soup.warnings.len();
+        let i = self.mat_file(path, what);
+        let fell_back = self.soup.warnings[before..]
+            .iter()
+            .any(|w| w.ends_with("Unity's default material used"));
+        let origin = if fell_back {
+            "default".to_string()
+        } else {
+            format!("{origin} {}", self.g.project.rel(path))
+        };
+        (i, origin)
+    }
+
     /// A Material document of file `file` (guid-less reference).
-    fn embedded_material(&mut self, id: i64, file: usize, what: &str) -> u32 {
+    fn embedded_material(&mut self, id: i64, file: usize, what: &str) -> (u32, String) {
         let key = format!("local:{file}:{id}");
-        if let Some(&i) = self.materials.get(&key) {
-            return i;
-        }
         let project = self.g.project;
         let Some(f) = self.g.files.get(file) else {
-            return self.warn_default(what, format!("local material {id} not found"));
+            let why = format!("local material {id} not found");
+            return (self.warn_default(what, why), "default".into());
         };
+        let src = format!("{}#{id}", project.rel(&f.path));
+        if let Some(&i) = self.materials.get(&key) {
+            return (i, format!("override {src}"));
+        }
         match f.doc(id) {
             Some((docs::MATERIAL, body)) => {
-                let src = format!("{}#{id}", project.rel(&f.path));
                 let (m, _notes) = convert(&body, &src);
-                self.add_material(key, || m)
+                (self.add_material(key, || m), format!("override {src}"))
             }
             _ => {
                 let why = format!("material fileID {id} is not in {}", project.rel(&f.path));
-                self.warn_default(what, why)
+                (self.warn_default(what, why), "default".into())
             }
         }
     }
@@ -234,49 +253,176 @@ impl Emitter<'_, '_> {
         }
     }
 
-    /// The model's own material whose fileID is `id`.
-    fn model_material(&mut self, id: i64, path: &Path, what: &str) -> u32 {
+    /// The material Unity puts in a model's slot whose fileID is `id`, in the importer's
+    /// precedence: an `externalObjects` remap, then (FBX models whose meta does not keep
+    /// materials inside the model) an extracted `.mat` found by name in a `Materials/`
+    /// folder, then the model's own material.
+    fn model_material(&mut self, id: i64, path: &Path, what: &str) -> (u32, String) {
         let rel = self.g.project.rel(path);
         let loaded = self.g.project.model(path);
         let asset = match loaded.as_ref() {
             Ok(a) => a,
-            Err(ModelError::Unsupported(ext)) => {
-                return self.warn_default(what, format!("{rel} is a .{ext}, not a material"))
+            Err(ModelError::Unsupported(ext) | ModelError::Authoring(ext, _)) => {
+                let why = format!("{rel} is a .{ext}, not a material");
+                return (self.warn_default(what, why), "default".into());
             }
             Err(ModelError::Read(_)) => {
-                return self.warn_default(what, format!("{rel} could not be read"))
+                let why = format!("{rel} could not be read");
+                return (self.warn_default(what, why), "default".into());
             }
         };
         let name = asset
             .material_names()
             .find(|n| asset.material_ids(n).contains(&id));
         let Some(name) = name else {
-            return self.warn_default(
-                what,
-                format!("material fileID {id} names no material of {rel}"),
-            );
+            let why = format!("material fileID {id} names no material of {rel}");
+            return (self.warn_default(what, why), "default".into());
         };
-        let key = format!("objmat:{rel}:{name}");
-        if let Some(&i) = self.materials.get(&key) {
-            return i;
+        let fbx = crate::project::ext(path) == "fbx";
+        if fbx {
+            let remap = asset
+                .meta
+                .external_objects
+                .iter()
+                .find(|(ty, n, _)| ty == "UnityEngine:Material" && n == name);
+            if let Some((_, _, guid)) = remap {
+                let Some(mat) = self.g.project.resolve(guid).cloned() else {
+                    let why = format!(
+                        "{rel}: material '{name}' is remapped to GUID {guid}, which is not in the project"
+                    );
+                    return (self.warn_default(what, why), "default".into());
+                };
+                return self.mat_file_origin(&mat, what, "remap");
+            }
+            if asset.meta.material_location != Some(1) {
+                let key = (path.to_path_buf(), name.to_string());
+                let found = match self.extracted.get(&key) {
+                    Some(f) => f.clone(),
+                    None => {
+                        let own = asset.model.material(name);
+                        let f = self.extracted_material(path, asset, name, own);
+                        self.extracted.insert(key, f.clone());
+                        f
+                    }
+                };
+                if let Some(mat) = found {
+                    return self.mat_file_origin(&mat, what, "Materials folder");
+                }
+            }
         }
-        match asset.model.material(name) {
+        let key = format!("objmat:{rel}:{name}");
+        let own = asset.model.material(name);
+        let origin = match own.and_then(|m| m.texture.as_deref()) {
+            Some(t) => format!("model's own {rel}#{name}, texture {t}"),
+            None => format!("model's own {rel}#{name}"),
+        };
+        if let Some(&i) = self.materials.get(&key) {
+            return (i, origin);
+        }
+        match own {
             Some(own) => {
                 let mut m = Material::unity_default();
                 m.name = name.to_string();
                 m.source = format!("{rel}#{name}");
                 m.color = own.color;
-                self.add_material(key, || m)
+                (self.add_material(key, || m), origin)
             }
             // A sub-mesh without a material name: Unity's importer gives it its default
             // material.
-            None if name == Model::UNNAMED_MATERIAL => self.default_material(),
+            None if name == Model::UNNAMED_MATERIAL
+                || (fbx && name == Model::FBX_UNNAMED_MATERIAL) =>
+            {
+                (self.default_material(), "default".into())
+            }
+            None if fbx => {
+                let why = format!("{rel}: material '{name}' is not defined in the file");
+                (self.warn_default(what, why), "default".into())
+            }
             None => {
                 let why = format!("{rel}: material '{name}' has no Kd in a .mtl");
-                self.warn_default(what, why)
+                (self.warn_default(what, why), "default".into())
             }
         }
     }
+
+    /// The `.mat` Unity's legacy import (materials extracted next to the model) gives
+    /// the model's material `name`: named as the meta's `materialName` says and looked
+    /// for in `Materials/` folders as its `materialSearch` says.
+    fn extracted_material(
+        &self,
+        model_path: &Path,
+        asset: &crate::project::ModelAsset,
+        name: &str,
+        own: Option<&crate::model::ModelMaterial>,
+    ) -> Option<std::path::PathBuf> {
+        let stem = model_path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let texture = own
+            .and_then(|m| m.texture.as_deref())
+            .and_then(|t| t.rsplit(['/', '\\']).next())
+            .and_then(|t| Path::new(t).file_stem())
+            .map(|s| s.to_string_lossy().into_owned())
+            .filter(|t| !t.is_empty());
+        let by_model = format!("{stem}-{name}");
+        let file = match asset.meta.material_name {
+            0 => texture.unwrap_or_else(|| name.to_string()),
+            1 => name.to_string(),
+            3 => texture.unwrap_or(by_model),
+            _ => by_model,
+        };
+        let file = format!("{}.mat", sanitize(&file));
+        let assets = self.g.project.assets.canonicalize().ok()?;
+        let mut dir = model_path.parent()?.canonicalize().ok()?;
+        loop {
+            if let Some(p) = file_in(&dir.join("Materials"), &file) {
+                return Some(p);
+            }
+            if asset.meta.material_search == 0 || dir == assets || !dir.pop() {
+                break;
+            }
+            if !dir.starts_with(&assets) {
+                break;
+            }
+        }
+        if asset.meta.material_search == 2 {
+            return self.g.project.find_by_name(&file).cloned();
+        }
+        None
+    }
+}
+
+/// A material name as Unity writes it into a file name: characters no file system
+/// allows become `_`.
+fn sanitize(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if matches!(c, '/' | '\\' | ':' | '*' | '?' | '"' | '<' | '>' | '|') {
+                '_'
+            } else {
+                c
+            }
+        })
+        .collect()
+}
+
+/// The file `name` in `dir`, ASCII case ignored (projects made on Windows or macOS do
+/// not keep case).
+fn file_in(dir: &Path, name: &str) -> Option<std::path::PathBuf> {
+    let exact = dir.join(name);
+    if exact.is_file() {
+        return Some(exact);
+    }
+    std::fs::read_dir(dir)
+        .ok()?
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .find(|p| {
+            p.is_file()
+                && p.file_name()
+                    .is_some_and(|f| f.to_string_lossy().eq_ignore_ascii_case(name))
+        })
 }
 
 #[cfg(test)]

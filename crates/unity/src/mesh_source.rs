@@ -6,8 +6,9 @@ use crate::docs;
 use crate::embedded;
 use crate::emit::Emitter;
 use crate::mesh::Mesh;
+use crate::model::Skin;
 use crate::primitives::{self, BUILTIN_MESH_GUID};
-use crate::project::ModelError;
+use crate::project::{ModelAsset, ModelError};
 use crate::reference::Ref;
 use std::sync::Arc;
 
@@ -72,12 +73,13 @@ impl Emitter<'_, '_> {
         let loaded = project.model(&path);
         let asset = match loaded.as_ref() {
             Ok(a) => a,
-            Err(e @ ModelError::Unsupported(_)) => return Err(format!("mesh is in {rel}, {e}")),
+            Err(e @ (ModelError::Unsupported(_) | ModelError::Authoring(..))) => {
+                return Err(format!("mesh is in {rel}, {e}"))
+            }
             Err(e) => return Err(e.to_string()),
         };
         let meshes = &asset.model.meshes;
-        let index = asset.mesh_ids().iter().position(|ids| ids.contains(&id));
-        let index = match index {
+        let index = match mesh_index(asset, id) {
             Some(i) => i,
             None if meshes.len() == 1 => {
                 self.soup.warnings.push(format!(
@@ -96,6 +98,16 @@ impl Emitter<'_, '_> {
             .clone()
             .ok_or("mesh missing")?;
         Ok((m, format!("{rel}#{}", mesh.name)))
+    }
+
+    /// The skin of the model mesh `r` names, if it has one.
+    pub(crate) fn model_skin(&self, r: &Ref) -> Option<Skin> {
+        let path = self.g.project.resolve(r.guid.as_deref()?)?;
+        let loaded = self.g.project.model(path);
+        let asset = loaded.as_ref().as_ref().ok()?;
+        let meshes = &asset.model.meshes;
+        let index = mesh_index(asset, r.file_id).or((meshes.len() == 1).then_some(0))?;
+        meshes[index].skin.clone()
     }
 
     /// `<GameObject name>.obj` anywhere under the assets folder, all its meshes as one: a
@@ -129,4 +141,9 @@ impl Emitter<'_, '_> {
         ));
         Ok((Arc::new(all), rel))
     }
+}
+
+/// The index of the model's mesh whose fileID is `id`.
+fn mesh_index(asset: &ModelAsset, id: i64) -> Option<usize> {
+    asset.mesh_ids().iter().position(|ids| ids.contains(&id))
 }

@@ -125,6 +125,7 @@ pub fn class_name(class: u32) -> &'static str {
         docs::MATERIAL => "Material",
         docs::MESH_RENDERER => "MeshRenderer",
         docs::MESH_FILTER => "MeshFilter",
+        docs::SKINNED_MESH_RENDERER => "SkinnedMeshRenderer",
         docs::MESH => "Mesh",
         _ => "Object",
     }
@@ -150,6 +151,14 @@ pub struct ModelMeta {
     /// `materials.materialLocation`: 0 extracted `.mat` files found by name, 1 sub-assets
     /// of the model; `None` when the meta does not say.
     pub material_location: Option<i64>,
+    /// `materials.materialName`: how an extracted `.mat` is named: 0 after the diffuse
+    /// texture's file (the material's name when it has none; Unity's default), 1 after
+    /// the material, 2 `<model>-<material>`, 3 the texture's, else `<model>-<material>`.
+    pub material_name: i64,
+    /// `materials.materialSearch`: where an extracted `.mat` is looked for: 0 the
+    /// `Materials/` folder next to the model, 1 (Unity's default) that and each parent
+    /// folder's `Materials/` up to `Assets`, 2 also anywhere in the project.
+    pub material_search: i64,
     /// `externalObjects` remaps: (type, name, guid), e.g.
     /// (`UnityEngine:Material`, FBX material name, `.mat` guid).
     pub external_objects: Vec<(String, String, String)>,
@@ -217,6 +226,14 @@ impl ModelMeta {
         m.material_location = imp
             .path(&["materials", "materialLocation"])
             .and_then(Node::as_i64);
+        m.material_name = imp
+            .path(&["materials", "materialName"])
+            .and_then(Node::as_i64)
+            .unwrap_or(0);
+        m.material_search = imp
+            .path(&["materials", "materialSearch"])
+            .and_then(Node::as_i64)
+            .unwrap_or(1);
         for e in imp.get("externalObjects").map(Node::as_seq).unwrap_or(&[]) {
             let (Some(first), Some(guid)) = (e.get("first"), e.path(&["second", "guid"])) else {
                 continue;

@@ -92,6 +92,11 @@ impl Model {
     /// The name Unity gives the material of a sub-mesh whose file names none.
     pub const UNNAMED_MATERIAL: &'static str = "defaultMat";
 
+    /// The name Unity's FBX importer gives the material of a mesh that has none (the
+    /// legacy tables, `externalObjects` remaps and extracted `No Name.mat` files of real
+    /// projects all use it).
+    pub const FBX_UNNAMED_MATERIAL: &'static str = "No Name";
+
     /// The name of the material Unity imports for a sub-mesh's own material name.
     pub fn material_name(own: &str) -> &str {
         if own.is_empty() {

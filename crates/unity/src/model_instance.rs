@@ -1,5 +1,6 @@
 //! A model as the scene sees it: the GameObject, Transform, MeshFilter and MeshRenderer
-//! Unity creates for every node of an imported [`crate::model::Model`], and the fileIDs
+//! (SkinnedMeshRenderer for a skinned mesh, its bones the model's own Transforms) Unity
+//! creates for every node of an imported [`crate::model::Model`], and the fileIDs
 //! under which the scene refers to them and to the model's meshes and materials.
 
 use crate::docs;
@@ -52,6 +53,8 @@ impl Graph<'_> {
         let mut counter = IdCounter::default();
         let mut map = IdMap::new();
         let mut transforms: Vec<usize> = Vec::with_capacity(model.nodes.len());
+        // (SkinnedMeshRenderer, mesh): bones are named nodes, which may come later.
+        let mut skinned: Vec<(usize, usize)> = Vec::new();
         for (i, node) in model.nodes.iter().enumerate() {
             let name = if node.parent.is_some() {
                 node.name.as_str()
@@ -73,29 +76,57 @@ impl Graph<'_> {
             parts.push((docs::TRANSFORM, tf, format!("{path}/Transform")));
             if let Some(mi) = node.mesh {
                 let mesh = &model.meshes[mi];
-                let mf = self.push(docs::MESH_FILTER, Node::Map(vec![]), 0, NO_FILE);
-                self.objs[mf].mesh = Ref::asset(mesh_ids[mi][0], guid);
-                let mr = self.push(
-                    docs::MESH_RENDERER,
-                    Node::Map(vec![("m_Enabled".into(), Node::Scalar("1".into()))]),
-                    0,
-                    NO_FILE,
-                );
-                self.objs[mr].materials = mesh
+                let materials: Vec<Ref> = mesh
                     .materials
                     .iter()
                     .map(|m| Ref::asset(asset.material_ids(Model::material_name(m))[0], guid))
                     .collect();
-                self.objs[mf].go = Some(go);
-                self.objs[mr].go = Some(go);
-                parts.push((docs::MESH_FILTER, mf, format!("{path}/MeshFilter")));
-                parts.push((docs::MESH_RENDERER, mr, format!("{path}/MeshRenderer")));
+                let enabled = Node::Map(vec![("m_Enabled".into(), Node::Scalar("1".into()))]);
+                if mesh.skin.is_some() {
+                    // Unity gives a skinned mesh a SkinnedMeshRenderer (which holds the
+                    // mesh itself) instead of a MeshFilter and MeshRenderer.
+                    let smr = self.push(docs::SKINNED_MESH_RENDERER, enabled, 0, NO_FILE);
+                    self.objs[smr].mesh = Ref::asset(mesh_ids[mi][0], guid);
+                    self.objs[smr].materials = materials;
+                    self.objs[smr].go = Some(go);
+                    skinned.push((smr, mi));
+                    parts.push((
+                        docs::SKINNED_MESH_RENDERER,
+                        smr,
+                        format!("{path}/SkinnedMeshRenderer"),
+                    ));
+                } else {
+                    let mf = self.push(docs::MESH_FILTER, Node::Map(vec![]), 0, NO_FILE);
+                    self.objs[mf].mesh = Ref::asset(mesh_ids[mi][0], guid);
+                    let mr = self.push(docs::MESH_RENDERER, enabled, 0, NO_FILE);
+                    self.objs[mr].materials = materials;
+                    self.objs[mf].go = Some(go);
+                    self.objs[mr].go = Some(go);
+                    parts.push((docs::MESH_FILTER, mf, format!("{path}/MeshFilter")));
+                    parts.push((docs::MESH_RENDERER, mr, format!("{path}/MeshRenderer")));
+                }
             }
             for (class, idx, path) in parts {
                 for id in counter.ids(meta, class, name, &path) {
                     map.entry(id).or_insert(idx);
                 }
             }
+        }
+        for (smr, mi) in skinned {
+            let Some(skin) = &model.meshes[mi].skin else {
+                continue;
+            };
+            self.objs[smr].bones = skin
+                .bones
+                .iter()
+                .map(|b| {
+                    let node = model
+                        .nodes
+                        .iter()
+                        .position(|n| !b.is_empty() && n.name == *b);
+                    node.and_then(|n| transforms.get(n).copied())
+                })
+                .collect();
         }
         (map, transforms.first().copied().into_iter().collect())
     }

@@ -92,10 +92,16 @@ impl Graph<'_> {
                 }
                 self.add_model(asset, guid)
             }
-            Err(ModelError::Unsupported(ext)) => {
-                let kind = if ext.is_empty() { "unknown" } else { ext };
+            Err(ModelError::Unsupported(ext)) if ext.is_empty() => {
                 self.warnings.push(format!(
-                    "{what}: source {} is a .{kind} model, which is not converted (only OBJ models are); skipped",
+                    "{what}: source {} is a .unknown model, which is not converted (only OBJ and FBX models are); skipped",
+                    self.project.rel(path)
+                ));
+                Default::default()
+            }
+            Err(e @ (ModelError::Unsupported(_) | ModelError::Authoring(..))) => {
+                self.warnings.push(format!(
+                    "{what}: source {} is {e}; skipped",
                     self.project.rel(path)
                 ));
                 Default::default()

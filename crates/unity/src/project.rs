@@ -4,6 +4,7 @@
 //! reach are loaded in parallel before the scene is walked.
 
 use crate::docs;
+use crate::fbx;
 use crate::meta::{GuidIndex, ModelMeta};
 use crate::model::Model;
 use crate::obj;
@@ -23,8 +24,12 @@ pub struct ModelAsset {
 #[derive(Clone, Debug, thiserror::Error)]
 pub enum ModelError {
     /// A model format this converter has no reader for (the lower-case extension).
-    #[error("a .{0} model, which is not converted (only OBJ models are)")]
+    #[error("a .{0} model, which is not converted (only OBJ and FBX models are)")]
     Unsupported(String),
+    /// An authoring tool's own file, which Unity imports by running that tool: the
+    /// lower-case extension and the tool.
+    #[error("a .{0} file; Unity imports it through {1}; export it as FBX")]
+    Authoring(String, &'static str),
     /// The reader refused the file (the message names it relative to the project).
     #[error("{0}")]
     Read(String),
@@ -188,16 +193,34 @@ impl Project {
     }
 
     /// The one place a model file's format picks its reader. Every model is scaled by
-    /// its importer's `globalScale`.
+    /// its importer's `globalScale` (the FBX reader folds it into the file's unit scale).
     fn load_model(&self, path: &Path) -> Result<ModelAsset, ModelError> {
-        let mut model = match ext(path).as_str() {
-            "obj" => obj::load_in(path, &self.root)
-                .map_err(|e| self.read_error(path, &e))?
-                .to_model(),
-            other => return Err(ModelError::Unsupported(other.to_string())),
-        };
+        let format = ext(path);
+        if !matches!(format.as_str(), "obj" | "fbx") {
+            return Err(match authoring_tool(&format) {
+                Some(tool) => ModelError::Authoring(format, tool),
+                None => ModelError::Unsupported(format),
+            });
+        }
         let meta = ModelMeta::read(path);
-        model.scale(meta.global_scale);
+        let model = match format.as_str() {
+            "obj" => {
+                let mut m = obj::load_in(path, &self.root)
+                    .map_err(|e| self.read_error(path, &e))?
+                    .to_model();
+                m.scale(meta.global_scale);
+                m
+            }
+            _ => {
+                let mut m = fbx::load(path, &meta).map_err(|e| self.read_error(path, &e))?;
+                for name in m.meshes.iter_mut().flat_map(|x| &mut x.materials) {
+                    if name.is_empty() {
+                        *name = Model::FBX_UNNAMED_MATERIAL.to_string();
+                    }
+                }
+                m
+            }
+        };
         Ok(ModelAsset { model, meta })
     }
 
@@ -208,6 +231,17 @@ impl Project {
             e.to_string()
                 .replace(&path.display().to_string(), &self.rel(path)),
         )
+    }
+}
+
+/// The application Unity runs to import an authoring tool's own scene file (it needs
+/// that tool installed; the converter has no such route).
+fn authoring_tool(ext: &str) -> Option<&'static str> {
+    match ext {
+        "blend" => Some("Blender"),
+        "mb" | "ma" => Some("Maya"),
+        "max" => Some("3ds Max"),
+        _ => None,
     }
 }
 

@@ -1,9 +1,11 @@
 //! MeshRenderer (class 23) with its MeshFilter (class 33): the mesh's triangles in world
-//! space, soup handedness, each with the material of its sub-mesh's slot.
+//! space, soup handedness, each with the material of its sub-mesh's slot. Skinned
+//! renderers draw their posed mesh through the same `draw`.
 
 use crate::emit::{flip, EmitError, Emitter};
+use crate::mesh::Mesh;
 use formats::Object;
-use glam::{Mat3, Vec3};
+use glam::{Mat3, Mat4, Vec3};
 
 impl Emitter<'_, '_> {
     /// Draw the mesh of MeshFilter `mf` with the materials of MeshRenderer `mr`, both on
@@ -20,18 +22,34 @@ impl Emitter<'_, '_> {
                 return Ok(());
             }
         };
+        let world = self.checked_world(go)?;
+        self.draw(go, &mesh, source, world, mr)
+    }
+
+    /// Draw `mesh` placed by `world` (Unity space) with the material slots of renderer
+    /// `renderer` on GameObject `go`.
+    pub(crate) fn draw(
+        &mut self,
+        go: usize,
+        mesh: &Mesh,
+        source: String,
+        world: Mat4,
+        renderer: usize,
+    ) -> Result<(), EmitError> {
+        let g = self.g;
+        let what = self.describe(go);
         if mesh.positions.iter().any(|p| !p.is_finite()) {
             return Err(self.non_finite(go, format!("mesh {source} has a NaN or infinite vertex")));
         }
-        let world = self.checked_world(go)?;
         let normal_m = Mat3::from_mat4(world).inverse().transpose();
         let flip_winding = world.determinant() < 0.0;
-        let slots = &g.objs[mr].materials;
+        let slots = &g.objs[renderer].materials;
         let obj_index = self.soup.objects.len() as u32;
         self.soup.objects.push(Object {
             name: self.path(go),
             source,
         });
+        let mut origins: Vec<(u32, String)> = Vec::new();
         let mut emitted = 0usize;
         for (si, tris) in mesh.submeshes.iter().enumerate() {
             if tris.is_empty() {
@@ -43,7 +61,10 @@ impl Emitter<'_, '_> {
                 ));
                 continue;
             };
-            let mat = self.material(slot, &what);
+            let (mat, origin) = self.material(slot, &what);
+            if !origins.iter().any(|(m, _)| *m == mat) {
+                origins.push((mat, origin));
+            }
             for t in tris {
                 let p = t.map(|i| flip(world.transform_point3(mesh.positions[i as usize])));
                 let n = t.map(|i| {
@@ -75,6 +96,8 @@ impl Emitter<'_, '_> {
         if emitted == 0 {
             // Keep object indices dense in what renders: drop an object without triangles.
             self.soup.objects.pop();
+        } else {
+            self.material_origins.push(origins);
         }
         Ok(())
     }

@@ -89,7 +89,7 @@ impl Emitter<'_, '_> {
     }
 
     /// Local-to-world of a Transform as a full matrix (parent·T·R·S).
-    fn world(&mut self, t: usize) -> Mat4 {
+    pub(crate) fn world(&mut self, t: usize) -> Mat4 {
         if let Some(m) = self.world.get(&t) {
             return *m;
         }

@@ -41,7 +41,8 @@ fn run(args: &Args) -> anyhow::Result<()> {
         project: args.assets.clone(),
         strict: args.strict,
     };
-    let soup = unity::convert(&args.scene, &opts)?;
+    let report = unity::convert_report(&args.scene, &opts)?;
+    let soup = &report.soup;
     soup.write(&args.output)
         .with_context(|| format!("writing {}", args.output.display()))?;
     let secs = t0.elapsed().as_secs_f64();
@@ -57,7 +58,7 @@ fn run(args: &Args) -> anyhow::Result<()> {
         );
     }
     if args.list {
-        list(&soup);
+        list(&report);
     }
     eprintln!(
         "{}: {} objects, {} triangles, {} lights, {} materials, {} warnings, {} degenerate dropped, {:.3} s",
@@ -86,7 +87,8 @@ fn run(args: &Args) -> anyhow::Result<()> {
 }
 
 /// One line per object and light, for checking a conversion by eye.
-fn list(soup: &formats::Soup) {
+fn list(report: &unity::Report) {
+    let soup = &report.soup;
     let mut tris = vec![0usize; soup.objects.len()];
     let mut mats: Vec<Vec<u32>> = vec![Vec::new(); soup.objects.len()];
     for (&o, &m) in soup.tri_object.iter().zip(&soup.tri_material) {
@@ -96,12 +98,17 @@ fn list(soup: &formats::Soup) {
         }
     }
     for (i, o) in soup.objects.iter().enumerate() {
+        let origins = report.material_origins.get(i);
         let names: Vec<String> = mats[i]
             .iter()
-            .map(|&m| {
-                let m = &soup.materials[m as usize];
+            .map(|&mi| {
+                let m = &soup.materials[mi as usize];
+                let origin = origins
+                    .and_then(|os| os.iter().find(|(x, _)| *x == mi))
+                    .map(|(_, o)| o.as_str())
+                    .unwrap_or("?");
                 format!(
-                    "{} rgb({:.3},{:.3},{:.3})",
+                    "{} rgb({:.3},{:.3},{:.3}) from {origin}",
                     m.name, m.color.x, m.color.y, m.color.z
                 )
             })

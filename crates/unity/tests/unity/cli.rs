@@ -111,3 +111,22 @@ fn errors_exit_1_with_one_line_and_bad_usage_exits_2() {
     assert_eq!(o.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&o.stderr).contains("none.soup"));
 }
+
+#[test]
+fn unity2soup_list_says_where_each_material_came_from() {
+    // Both primitives' slots name Unity's built-in Default-Material.
+    let (d, scene) = scene();
+    let o = Command::new(env!("CARGO_BIN_EXE_unity2soup"))
+        .arg(&scene)
+        .arg("-o")
+        .arg(d.path().join("s.soup"))
+        .arg("--list")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        stderr.contains("object \"Box A\": 12 triangles from builtin:Cube [Default-Material rgb(1.000,1.000,1.000) from default]"),
+        "{stderr}"
+    );
+}

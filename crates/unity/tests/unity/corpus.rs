@@ -10,11 +10,17 @@
 //!   active (`m_IsActive`), whose renderer is enabled and has a material slot, and whose
 //!   mesh resolves (built-in, or an OBJ in the project); a multi-group OBJ model gives one
 //!   object per `g` group that has faces.
+//! * FBX: each soup object drawn from an FBX mesh has that mesh's Σ (corners − 2) over
+//!   the file's faces (ufbx's face sizes, no triangulation), less the zero-area triangles
+//!   the soup drops; [`every_fbx_object_has_its_meshs_own_face_count`] checks this per
+//!   object and per scene, so a scene's FBX total below is the sum of those face counts
+//!   minus the scene's `dropped_degenerate`.
 //! * Lights: enabled Light components of type 0–2 on active objects. Cameras: enabled
 //!   Camera components on active objects.
 
 use crate::support::bounds;
 use glam::Vec3;
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 const CUBE: usize = 12;
@@ -70,14 +76,16 @@ fn expectations() -> Vec<Expect> {
         // MeshFilters: key.obj (472) and InteriorDoor.obj groups 4300000/4300002 (30 for
         // both). OBJ prefab instances: table.obj ×2 (68 each, group polySurface27 only),
         // InteriorDoor.obj (2 groups, 30), TV.obj (264), blocc.obj (794, 9 n-gons),
-        // Toilet.obj (294). remote.FBX meshes and FBX prefab sources are missing.
-        // Cameras: "Main Camera" is on; the second scene camera has m_Enabled 0 and the
-        // FPSController instance is deactivated by an m_IsActive modification.
-        // Objects: 33 + 19 + 57 + 1 + 2 + 2 + 2 + 1 + 1 + 1 = 119.
-        Expect { scene: "Astraela__Escape-The-Room/Assets/Scenes/Game.unity", objects: 119,
-                 triangles: 33 * CUBE + 19 * SPHERE + 57 * PLANE + 472 + 30 + 2 * 68 + 30 + 264 + 794 + 294,
+        // Toilet.obj (294). Cameras: "Main Camera" is on; the second scene camera has
+        // m_Enabled 0 and the FPSController instance is deactivated by an m_IsActive
+        // modification. Objects without FBX: 33 + 19 + 57 + 1 + 2 + 2 + 2 + 1 + 1 + 1 =
+        // 119. FBX: 237 objects (12 models, Book ×100, remote.FBX's 7 MeshFilters), their
+        // faces 114546 triangles, 175 of them zero-area (door.FBX Box002 has 79).
+        Expect { scene: "Astraela__Escape-The-Room/Assets/Scenes/Game.unity", objects: 119 + 237,
+                 triangles: 33 * CUBE + 19 * SPHERE + 57 * PLANE + 472 + 30 + 2 * 68 + 30 + 264 + 794 + 294
+                     + 114546 - 175,
                  lights: 1, cameras: 1,
-                 warns: &["'Remote'", "no material slot", "is not in the project"] },
+                 warns: &["no material slot", "Mat_3", "table.mtl not found"] },
         // 5 Cubes + 1 Sphere.
         Expect { scene: "Ayinzhang__Rigidbody-Fracture/Assets/Scenes/RigidbodyFracture.unity", objects: 6,
                  triangles: 5 * CUBE + SPHERE, lights: 1, cameras: 1, warns: &[] },
@@ -95,11 +103,36 @@ fn expectations() -> Vec<Expect> {
         // One Capsule; 1 directional + 4 point lights.
         Expect { scene: "IceMiaoMiao__Unity-Shader-Study-Projects/Assets/Scenes/Scene_9_2_2.unity", objects: 1,
                  triangles: CAPSULE, lights: 5, cameras: 1, warns: &[] },
-        // Only the built-in Plane resolves: every other mesh is in an FBX/.mb file that
-        // is not in the corpus.
-        Expect { scene: "Pjaerr__GDSJam-Reflection/Assets/Scenes/Tutorial.unity", objects: 1,
-                 triangles: PLANE, lights: 1, cameras: 1,
-                 warns: &["SkinnedMeshRenderer", "prefab instance 'side (1)'"] },
+        // The built-in Plane and 82 FBX objects (11 models, 58 legacy instances), their
+        // faces 18836 triangles, none zero-area. Left out: the Player prefab's skinned
+        // mesh (its .mb model is not in the corpus) and one instance whose source GUID
+        // is not in the project.
+        Expect { scene: "Pjaerr__GDSJam-Reflection/Assets/Scenes/Tutorial.unity", objects: 1 + 82,
+                 triangles: PLANE + 18836, lights: 1, cameras: 1,
+                 warns: &["SkinnedMeshRenderer: mesh GUID", "source GUID 4b40042732c5264439ac0f044a5fe854"] },
+        // 70 Cubes, 2 Quads, 1 Sphere, Ramp.obj (8, its .mtl missing), and 50 FBX objects
+        // (nested prefabs of walls, floors and furniture), their faces 13743 triangles,
+        // 8 zero-area.
+        Expect { scene: "notenoughbees__Unity-Essentials-Project-Unity-6/Assets/_Unity Essentials/Scenes/2_KidsRoom_3D_Scene.unity",
+                 objects: 70 + 2 + 1 + 1 + 50, triangles: 70 * CUBE + 2 * QUAD + SPHERE + 8 + 13743 - 8,
+                 lights: 1, cameras: 1, warns: &["Ramp.mtl not found"] },
+        // 2 Cubes, 1 Plane, 1 Sphere and 56 FBX objects, their faces 13947 triangles,
+        // 8 zero-area. Foreground_Buildings' mesh GUID is not in the project. One camera
+        // is the scene's, the other comes with a prefab instance.
+        Expect { scene: "thespeedyboy__CreateWithVR2021/Assets/Scenes/TravisRoom.unity",
+                 objects: 4 + 56, triangles: 2 * CUBE + PLANE + SPHERE + 13947 - 8,
+                 lights: 6, cameras: 2, warns: &["Foreground_Buildings", "31321ba15b8f8eb4c954353edc038b1d"] },
+        // 6 Cubes and 41 FBX objects (the ASCII wall kit ×18 with the models' own
+        // materials, guns), their faces 5391 triangles, 142 zero-area (9mm.pistol base
+        // 132).
+        Expect { scene: "thespeedyboy__CreateWithVR2021/Assets/Scenes/final.unity",
+                 objects: 6 + 41, triangles: 6 * CUBE + 5391 - 142,
+                 lights: 1, cameras: 1, warns: &["31321ba15b8f8eb4c954353edc038b1d"] },
+        // A Sphere (the player) and 5 FBX objects: the island (148) and SkyDome.fbx's
+        // four meshes (160 + 18 + 66 + 20), from their faces, none zero-area.
+        Expect { scene: "DarthTekin__Prototype4_CreateWithCode2_UnityLearn_05.04.2023/Assets/Scenes/Prototype 4.unity",
+                 objects: 1 + 5, triangles: SPHERE + 148 + 160 + 18 + 66 + 20,
+                 lights: 1, cameras: 1, warns: &[] },
         // multcoloredcube2.obj: 6 groups of 2 triangles.
         Expect { scene: "VidarUre__MeshToSvgConverter/Assets/Scenes/cubescene.unity", objects: 6,
                  triangles: 12, lights: 1, cameras: 1, warns: &[] },
@@ -163,6 +196,108 @@ fn every_text_scene_converts_to_the_hand_derived_counts() {
                 ));
             }
         }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// Σ (corners − 2) over the faces of each mesh node of an FBX file, by node name (the
+/// name of the Mesh Unity imports; several nodes may share one), from ufbx's face sizes:
+/// no triangulation involved.
+fn fbx_face_triangles(path: &Path) -> HashMap<String, Vec<usize>> {
+    let scene = ufbx::load_file(&path.to_string_lossy(), ufbx::LoadOpts::default())
+        .unwrap_or_else(|e| panic!("{}: {}", path.display(), e.description));
+    let mut out = HashMap::new();
+    for n in scene.nodes.iter() {
+        if let Some(m) = n.mesh.as_ref() {
+            let t: usize = m
+                .faces
+                .iter()
+                .map(|f| (f.num_indices as usize).saturating_sub(2))
+                .sum();
+            out.entry(n.element.name.to_string())
+                .or_insert_with(Vec::new)
+                .push(t);
+        }
+    }
+    out
+}
+
+/// Scenes whose active renderers reference FBX models.
+const FBX_SCENES: [&str; 6] = [
+    "Astraela__Escape-The-Room/Assets/Scenes/Game.unity",
+    "DarthTekin__Prototype4_CreateWithCode2_UnityLearn_05.04.2023/Assets/Scenes/Prototype 4.unity",
+    "Pjaerr__GDSJam-Reflection/Assets/Scenes/Tutorial.unity",
+    "notenoughbees__Unity-Essentials-Project-Unity-6/Assets/_Unity Essentials/Scenes/2_KidsRoom_3D_Scene.unity",
+    "thespeedyboy__CreateWithVR2021/Assets/Scenes/TravisRoom.unity",
+    "thespeedyboy__CreateWithVR2021/Assets/Scenes/final.unity",
+];
+
+#[test]
+fn every_fbx_object_has_its_meshs_own_face_count() {
+    // Each soup object drawn from an FBX mesh (source `<file>#<mesh>`) holds that mesh's
+    // Σ (corners − 2) from the file's faces, less the zero-area triangles the soup drops:
+    // per object at most the face count, and over the scene the face counts of all
+    // objects (with the known counts of OBJ and built-in meshes) are exactly the soup's
+    // triangles plus those dropped.
+    let Some(root) = corpus() else { return };
+    let mut failures = Vec::new();
+    for scene in FBX_SCENES {
+        let project = root.join(scene.split("/Assets/").next().unwrap());
+        let r = report(&root.join(scene));
+        let soup = &r.soup;
+        let mut per_object = vec![0usize; soup.objects.len()];
+        for &o in &soup.tri_object {
+            per_object[o as usize] += 1;
+        }
+        let mut files: HashMap<String, HashMap<String, Vec<usize>>> = HashMap::new();
+        let (mut fbx_objects, mut expected_fbx, mut got_fbx) = (0, 0, 0);
+        for (o, &got) in soup.objects.iter().zip(&per_object) {
+            let Some((file, mesh)) = o.source.split_once('#') else {
+                continue;
+            };
+            if !file.to_ascii_lowercase().ends_with(".fbx") {
+                continue;
+            }
+            let counts = files
+                .entry(file.to_string())
+                .or_insert_with(|| fbx_face_triangles(&project.join(file)));
+            let Some(candidates) = counts.get(mesh) else {
+                failures.push(format!(
+                    "{scene}: {}: no mesh node {mesh} in {file}",
+                    o.name
+                ));
+                continue;
+            };
+            // Meshes sharing a name are told apart by their ids, not by the soup's
+            // source: the object is one of them, the smallest that can hold it.
+            let want = candidates
+                .iter()
+                .copied()
+                .filter(|&c| c >= got)
+                .min()
+                .unwrap_or(candidates[0]);
+            fbx_objects += 1;
+            expected_fbx += want;
+            got_fbx += got;
+            if got > want || got == 0 {
+                failures.push(format!(
+                    "{scene}: {}: {got} triangles, the file's faces give {want}",
+                    o.name
+                ));
+            }
+        }
+        assert!(fbx_objects > 0, "{scene}: no FBX object");
+        // In these scenes only FBX meshes have zero-area triangles.
+        if (expected_fbx - got_fbx) as u64 != soup.dropped_degenerate {
+            failures.push(format!(
+                "{scene}: FBX objects have {got_fbx} triangles, their faces {expected_fbx}, but {} were dropped as degenerate",
+                soup.dropped_degenerate
+            ));
+        }
+        println!(
+            "{scene}: {fbx_objects} FBX objects, {got_fbx} triangles (faces {expected_fbx}, {} degenerate dropped in the scene)",
+            soup.dropped_degenerate
+        );
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
@@ -406,4 +541,52 @@ fn legacy_material_with_repeated_data_keys() {
     let want = Vec3::new(eotf(0.882_352_95), eotf(0.946_450_3), 1.0);
     assert!((m.color - want).abs().max_element() < 1e-6, "{}", m.color);
     assert_eq!(m.emission, Vec3::ZERO);
+}
+
+/// Every (soup material, origin) of the objects drawn from mesh `source`.
+fn origins_of<'a>(r: &'a unity::Report, source: &str) -> Vec<(&'a formats::Material, &'a str)> {
+    let mut out = Vec::new();
+    for (i, o) in r.soup.objects.iter().enumerate() {
+        if o.source == source {
+            for (m, origin) in &r.material_origins[i] {
+                out.push((&r.soup.materials[*m as usize], origin.as_str()));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn fbx_model_materials_in_the_corpus() {
+    let Some(root) = corpus() else { return };
+    // GDSJam-Reflection floor.FBX (legacy meta: no materialLocation, `materialName: 0`):
+    // its material's diffuse texture is basetile_basecolor, and Unity extracted
+    // Assets/Models/models/Materials/basetile_basecolor.mat next to the model; the
+    // instances without a material override use it.
+    let r = report(&root.join("Pjaerr__GDSJam-Reflection/Assets/Scenes/Tutorial.unity"));
+    let floor = origins_of(&r, "Assets/Models/models/floor.FBX#floor");
+    assert!(
+        floor
+            .iter()
+            .any(|(_, o)| *o
+                == "Materials folder Assets/Models/models/Materials/basetile_basecolor.mat"),
+        "{floor:?}"
+    );
+    // CreateWithVR2021 wall.fbx (ASCII, materialLocation 1, no remap): its own 'wood',
+    // whose text says `P: "DiffuseColor", "Color", "", "A",0.8962264,0.6015712,0.3931559`
+    // (Unity's sRGB material colour, linearised here).
+    let r = report(&root.join("thespeedyboy__CreateWithVR2021/Assets/Scenes/final.unity"));
+    let src = "Assets/_Course Library/models/FBX format-20250115T161328Z-001/FBX format/wall.fbx";
+    let wall = origins_of(&r, &format!("{src}#wall"));
+    let (wood, origin) = wall
+        .iter()
+        .find(|(m, _)| m.name == "wood")
+        .unwrap_or_else(|| panic!("{wall:?}"));
+    assert_eq!(*origin, format!("model's own {src}#wood"));
+    let want = Vec3::new(eotf(0.896_226_4), eotf(0.601_571_2), eotf(0.393_155_9));
+    assert!(
+        (wood.color - want).abs().max_element() < 1e-6,
+        "{}",
+        wood.color
+    );
 }

@@ -8,4 +8,5 @@ mod corpus;
 mod fbx;
 mod fbx_ascii;
 mod fbx_corpus;
+mod fbx_scene;
 mod support;
