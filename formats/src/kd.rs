@@ -150,6 +150,20 @@ pub struct KdFile {
 }
 
 impl KdFile {
+    /// Levels of interior nodes above the deepest leaf (0 for a lone leaf). Call it on a
+    /// validated tree: children always follow their parent, so one pass from the back
+    /// computes it, even for a file whose nodes share children.
+    pub fn height(&self) -> u32 {
+        let mut height = vec![0u32; self.nodes.len()];
+        for i in (0..self.nodes.len()).rev() {
+            let n = self.nodes[i];
+            if !n.is_leaf() {
+                height[i] = 1 + height[i + 1].max(height[n.above_child() as usize]);
+            }
+        }
+        height.first().copied().unwrap_or(0)
+    }
+
     /// Check that every node reference stays inside the arrays, naming the first bad one.
     pub fn validate(&self) -> Result<(), String> {
         let n = self.nodes.len();

@@ -49,15 +49,8 @@ impl PlainAccel {
                 triangles.len()
             ));
         }
-        let mut height = vec![0u32; kd.nodes.len()];
-        for i in (0..kd.nodes.len()).rev() {
-            let n = kd.nodes[i];
-            if !n.is_leaf() {
-                height[i] = 1 + height[i + 1].max(height[n.above_child() as usize]);
-            }
-        }
-        if height[0] as usize >= STACK {
-            return Err(format!("the tree is {} levels deep", height[0]));
+        if kd.height() as usize >= STACK {
+            return Err(format!("the tree is {} levels deep", kd.height()));
         }
         let kdtree::Renumbered {
             tris,

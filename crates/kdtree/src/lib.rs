@@ -117,21 +117,10 @@ impl Accel {
                 ),
             });
         }
-        // Children always follow their parent (validate checks it), so depth can be
-        // computed back to front in one pass, even for a hostile file with shared nodes.
-        let mut height = vec![0u32; kd.nodes.len()];
-        for i in (0..kd.nodes.len()).rev() {
-            let n = kd.nodes[i];
-            if !n.is_leaf() {
-                height[i] = 1 + height[i + 1].max(height[n.above_child() as usize]);
-            }
-        }
+        let height = kd.height();
         let max = (traverse::STACK - 1) as u32;
-        if height[0] > max {
-            return Err(AccelError::TooDeep {
-                depth: height[0],
-                max,
-            });
+        if height > max {
+            return Err(AccelError::TooDeep { depth: height, max });
         }
         let Renumbered {
             tris,

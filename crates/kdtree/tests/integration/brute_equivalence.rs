@@ -103,6 +103,24 @@ fn params() -> impl Strategy<Value = BuildParams> {
     })
 }
 
+/// A flat 4 × 4 grid of `n` × `n` cells at y = 0, then one right-triangle wall per entry
+/// `(axis, c, a, b)`: in the plane `axis` = c, legs of length 1 from (a, b) in the next two
+/// axes' coordinates.
+fn grid_with_walls(n: usize, walls: &[(usize, f32, f32, f32)]) -> Vec<[Vec3; 3]> {
+    let mut tris = testkit::grid(n, 4.0, 0.0);
+    for &(axis, c, a, b) in walls {
+        let p = |u: f32, w: f32| {
+            let mut v = [0.0; 3];
+            v[axis] = c;
+            v[(axis + 1) % 3] = u;
+            v[(axis + 2) % 3] = w;
+            Vec3::from(v)
+        };
+        tris.push([p(a, b), p(a + 1.0, b), p(a, b + 1.0)]);
+    }
+    tris
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(256))]
 
@@ -147,17 +165,7 @@ proptest! {
         walls in prop::collection::vec((0usize..3, lattice(), lattice(), lattice()), 0..12),
         targets in prop::collection::vec((0usize..9, 0usize..9, 0usize..3, free_vec()), 48),
     ) {
-        let mut tris = testkit::grid(n, 4.0, 0.0);
-        for &(axis, c, a, b) in &walls {
-            let p = |u: f32, w: f32| {
-                let mut v = [0.0; 3];
-                v[axis] = c;
-                v[(axis + 1) % 3] = u;
-                v[(axis + 2) % 3] = w;
-                Vec3::from(v)
-            };
-            tris.push([p(a, b), p(a + 1.0, b), p(a, b + 1.0)]);
-        }
+        let tris = grid_with_walls(n, &walls);
         let accel = Accel::build(&tris, &BuildParams::default());
         let step = 4.0 / n as f32;
         for &(i, k, kind, o) in &targets {
@@ -255,23 +263,13 @@ fn nan_and_infinite_rays_miss() {
 /// wall's corner at t = 0.5 (found by `shared_edges_and_split_planes`).
 #[test]
 fn a_ray_in_two_split_planes_finds_the_nearer_corner() {
-    let mut tris = testkit::grid(4, 4.0, 0.0);
     let walls = [
         (1, 0.5, 1.0, 2.0),
         (0, 0.0, 0.0, -3.5),
         (2, 0.0, 0.0, -0.5),
         (1, -2.5, 1.0, 0.0),
     ];
-    for (axis, c, a, b) in walls {
-        let p = |u: f32, w: f32| {
-            let mut v = [0.0; 3];
-            v[axis] = c;
-            v[(axis + 1) % 3] = u;
-            v[(axis + 2) % 3] = w;
-            Vec3::from(v)
-        };
-        tris.push([p(a, b), p(a + 1.0, b), p(a, b + 1.0)]);
-    }
+    let tris = grid_with_walls(4, &walls);
     let accel = Accel::build(&tris, &BuildParams::default());
     let ray = Ray::new(Vec3::new(2.0, 1.0, 1.0), Vec3::NEG_Y, 0.0, f32::INFINITY);
     let hit = accel.intersect(&ray).expect("the wall's corner is hit");
