@@ -23,6 +23,7 @@ use crate::mesh::{smooth_normals, Mesh, EAR_CLIP_MAX};
 use crate::meta::ModelMeta;
 use crate::model::{Model, ModelMaterial, ModelMesh, ModelNode, Skin};
 use glam::{DMat3, DMat4, DQuat, DVec3, Mat4, Vec3};
+use rayon::prelude::*;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -38,6 +39,74 @@ pub enum FbxError {
     LfsPointer(PathBuf),
     #[error("{path}: not a readable FBX file: {detail}")]
     Corrupt { path: PathBuf, detail: String },
+}
+
+/// Unity welds the corners that share a source vertex and a normal (bit for bit) into
+/// one vertex, numbered in the order corners first use them. Each source vertex keeps a
+/// short chain of the vertices made from it, so the common case is a walk of one or two
+/// entries and no hashing; a vertex with more distinct normals than a chain holds (a fan
+/// of flat faces) spills into a hash map, which keeps a pathological file linear.
+struct Weld {
+    /// Per source vertex: the newest output vertex made from it (`NONE` if none).
+    head: Vec<u32>,
+    /// Per source vertex: how many outputs its chain holds.
+    len: Vec<u8>,
+    /// Per output vertex: the next older output of the same source vertex.
+    next: Vec<u32>,
+    overflow: HashMap<(u32, [u32; 3]), u32>,
+}
+
+const NONE: u32 = u32::MAX;
+const CHAIN: u8 = 16;
+
+impl Weld {
+    fn new(vertices: usize, corners: usize) -> Weld {
+        Weld {
+            head: vec![NONE; vertices],
+            len: vec![0; vertices],
+            next: Vec::with_capacity(corners.min(vertices * 2)),
+            overflow: HashMap::new(),
+        }
+    }
+
+    /// The output vertex of (`v`, `normal`); `add` appends it to `mesh` when it is new.
+    fn vertex(
+        &mut self,
+        v: u32,
+        normal: Vec3,
+        add: impl FnOnce(&mut Mesh),
+        mesh: &mut Mesh,
+    ) -> u32 {
+        let bits = normal.to_array().map(f32::to_bits);
+        let vi = v as usize;
+        if vi >= self.head.len() {
+            // Callers clamp `v`; stay total anyway.
+            return 0;
+        }
+        let mut o = self.head[vi];
+        while o != NONE {
+            if mesh.normals[o as usize].to_array().map(f32::to_bits) == bits {
+                return o;
+            }
+            o = self.next[o as usize];
+        }
+        if self.len[vi] >= CHAIN {
+            if let Some(&o) = self.overflow.get(&(v, bits)) {
+                return o;
+            }
+        }
+        let o = mesh.positions.len() as u32;
+        add(mesh);
+        if self.len[vi] < CHAIN {
+            self.next.push(self.head[vi]);
+            self.head[vi] = o;
+            self.len[vi] += 1;
+        } else {
+            self.next.push(NONE);
+            self.overflow.insert((v, bits), o);
+        }
+        o
+    }
 }
 
 /// Deepest node hierarchy accepted (real files stay far below; a corrupt one could nest
@@ -230,7 +299,7 @@ impl Importer {
         mirror_m(m)
     }
 
-    fn model(mut self, scene: &ufbx::Scene, stem: String) -> Model {
+    fn model(mut self, scene: &ufbx::SceneRoot, stem: String) -> Model {
         let mut model = Model::default();
         let root = &scene.root_node;
         // Without baking, the axis conversion is a rotation on each node directly under
@@ -245,6 +314,8 @@ impl Importer {
         };
         // (ufbx node, parent index, directly under the file's root) in depth-first order.
         let mut stack: Vec<(&ufbx::Node, Option<usize>, bool)> = Vec::new();
+        // (model node index, ufbx node id) of every node with a mesh, in order.
+        let mut mesh_nodes: Vec<(usize, u32)> = Vec::new();
         if root.children.len() == 1 {
             stack.push((&root.children[0], None, true));
         } else {
@@ -270,18 +341,16 @@ impl Importer {
                 node.element.name.to_string()
             };
             let index = model.nodes.len();
-            let mesh = node.mesh.as_ref().and_then(|m| {
-                let built = self.mesh(node, m)?;
-                model.meshes.push(built);
-                Some(model.meshes.len() - 1)
-            });
+            if node.mesh.is_some() {
+                mesh_nodes.push((index, node.element.typed_id));
+            }
             model.nodes.push(ModelNode {
                 name,
                 parent,
                 translation: t.as_vec3(),
                 rotation: q.as_quat(),
                 scale: s.as_vec3(),
-                mesh,
+                mesh: None,
             });
             stack.extend(
                 node.children
@@ -289,6 +358,25 @@ impl Importer {
                     .rev()
                     .map(|c| (&**c, Some(index), false)),
             );
+        }
+        // Meshes are independent: converted in parallel, numbered in depth-first order.
+        let importer = &self;
+        let built: Vec<(Option<ModelMesh>, Vec<String>)> = mesh_nodes
+            .par_iter()
+            .map(|&(_, id)| {
+                let node = &scene.nodes[id as usize];
+                match node.mesh.as_ref() {
+                    Some(m) => importer.mesh(node, m),
+                    None => (None, Vec::new()),
+                }
+            })
+            .collect();
+        for (&(index, _), (mesh, warnings)) in mesh_nodes.iter().zip(built) {
+            self.warnings.extend(warnings);
+            if let Some(mesh) = mesh {
+                model.meshes.push(mesh);
+                model.nodes[index].mesh = Some(model.meshes.len() - 1);
+            }
         }
         for m in scene.materials.iter() {
             let diffuse = &m.fbx.diffuse_color;
@@ -310,8 +398,20 @@ impl Importer {
         model
     }
 
-    /// The Mesh Unity makes for `node`; `None` when it has no polygon.
-    fn mesh(&mut self, node: &ufbx::Node, m: &ufbx::Mesh) -> Option<ModelMesh> {
+    /// The Mesh Unity makes for `node` (`None` when it has no polygon), and what it could
+    /// not honour.
+    fn mesh(&self, node: &ufbx::Node, m: &ufbx::Mesh) -> (Option<ModelMesh>, Vec<String>) {
+        let mut warnings = Vec::new();
+        let mesh = self.mesh_into(node, m, &mut warnings);
+        (mesh, warnings)
+    }
+
+    fn mesh_into(
+        &self,
+        node: &ufbx::Node,
+        m: &ufbx::Mesh,
+        warnings: &mut Vec<String>,
+    ) -> Option<ModelMesh> {
         let name = node.element.name.to_string();
         let g2m = self.geometry_to_mesh(node);
         let normal_m = DMat3::from_mat4(g2m).inverse().transpose();
@@ -397,54 +497,73 @@ impl Importer {
                 .collect();
             smooth_normals(&positions, &tris, self.smoothing_angle)
         };
-        let mut mesh = Mesh::default();
-        let mut src_vertex: Vec<u32> = Vec::new();
-        let mut vmap: HashMap<(u32, [u32; 3]), u32> = HashMap::new();
+        // Each normal value once in the mesh's frame (files index them per corner).
+        let normal_values: Vec<Vec3> = if file_normals {
+            m.vertex_normal
+                .values
+                .iter()
+                .map(|&n| {
+                    let n = (normal_m * v3(n)).normalize_or_zero().as_vec3();
+                    if n.is_finite() {
+                        n
+                    } else {
+                        Vec3::ZERO
+                    }
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let corners: usize = subs.iter().map(|t| 3 * t.len()).sum();
+        let mut mesh = Mesh {
+            positions: Vec::with_capacity(positions.len()),
+            normals: Vec::with_capacity(positions.len()),
+            submeshes: Vec::with_capacity(subs.len()),
+        };
+        let mut src_vertex: Vec<u32> = Vec::with_capacity(positions.len());
+        let mut weld = Weld::new(positions.len().max(1), corners);
         let mut k = 0usize;
-        for tris in subs {
-            let mut out = Vec::with_capacity(tris.len());
-            for t in tris {
+        // Corners are replaced by output vertices in place: the sub-mesh lists become
+        // the Mesh's.
+        for mut tris in subs {
+            for t in tris.iter_mut() {
                 let mut corners = [0u32; 3];
                 for (j, &ix) in t.iter().enumerate() {
                     let v = vertex_of(ix).unwrap_or(0);
                     let jj = if reverse { [0, 2, 1][j] } else { j };
                     let normal = if file_normals {
-                        let n = m
-                            .vertex_normal
+                        m.vertex_normal
                             .indices
                             .get(ix as usize)
-                            .and_then(|&i| m.vertex_normal.values.get(i as usize))
-                            .map(|&n| (normal_m * v3(n)).normalize_or_zero().as_vec3())
-                            .unwrap_or(Vec3::ZERO);
-                        if n.is_finite() {
-                            n
-                        } else {
-                            Vec3::ZERO
-                        }
+                            .and_then(|&i| normal_values.get(i as usize))
+                            .copied()
+                            .unwrap_or(Vec3::ZERO)
                     } else {
                         smooth[k][jj]
                     };
-                    let key = (v, normal.to_array().map(f32::to_bits));
-                    corners[jj] = *vmap.entry(key).or_insert_with(|| {
-                        mesh.positions
-                            .push(positions.get(v as usize).copied().unwrap_or_default());
-                        mesh.normals.push(normal);
-                        src_vertex.push(v);
-                        (mesh.positions.len() - 1) as u32
-                    });
+                    corners[jj] = weld.vertex(
+                        v,
+                        normal,
+                        |o| {
+                            o.positions
+                                .push(positions.get(v as usize).copied().unwrap_or_default());
+                            o.normals.push(normal);
+                            src_vertex.push(v);
+                        },
+                        &mut mesh,
+                    );
                 }
-                out.push(corners);
+                *t = corners;
                 k += 1;
             }
-            mesh.submeshes.push(out);
+            mesh.submeshes.push(tris);
         }
         if !m.blend_deformers.is_empty() {
-            self.warnings
-                .push(format!("mesh {name}: blend shapes ignored"));
+            warnings.push(format!("mesh {name}: blend shapes ignored"));
         }
         let skin = m.skin_deformers.first().map(|sk| {
             if m.skin_deformers.len() > 1 {
-                self.warnings.push(format!(
+                warnings.push(format!(
                     "mesh {name}: {} skin deformers; only the first is used",
                     m.skin_deformers.len()
                 ));
