@@ -19,6 +19,7 @@
 //! The root node is named after the file (Unity's `//RootNode`); when the file's root
 //! has a single child, that child is the root.
 
+use crate::fbx_pool::{thread_opts, Pool};
 use crate::mesh::{smooth_normals, Mesh, EAR_CLIP_MAX};
 use crate::meta::ModelMeta;
 use crate::model::{Model, ModelMaterial, ModelMesh, ModelNode, Skin};
@@ -26,6 +27,7 @@ use glam::{DMat3, DMat4, DQuat, DVec3, Mat4, Vec3};
 use rayon::prelude::*;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 #[derive(Debug, thiserror::Error)]
 pub enum FbxError {
@@ -128,8 +130,9 @@ pub fn load_bytes(bytes: &[u8], path: &Path, meta: &ModelMeta) -> Result<Model, 
     if bytes.starts_with(b"version https://git-lfs.github.com/spec") {
         return Err(FbxError::LfsPointer(path.to_path_buf()));
     }
+    let pool = Arc::new(Pool::default());
     let scene =
-        ufbx::load_memory(bytes, load_opts(bytes.len())).map_err(|e| FbxError::Corrupt {
+        ufbx::load_memory(bytes, load_opts(bytes.len(), &pool)).map_err(|e| FbxError::Corrupt {
             path: path.to_path_buf(),
             detail: e.description.to_string(),
         })?;
@@ -140,7 +143,7 @@ pub fn load_bytes(bytes: &[u8], path: &Path, meta: &ModelMeta) -> Result<Model, 
     Ok(Importer::new(&scene, meta).model(&scene, stem))
 }
 
-fn load_opts(file_len: usize) -> ufbx::LoadOpts<'static> {
+fn load_opts(file_len: usize, pool: &Arc<Pool>) -> ufbx::LoadOpts<'static> {
     // Compressed binary arrays legitimately inflate a file many times over; a bound
     // proportional to the file keeps a corrupt header from asking for gigabytes.
     let limit = file_len.saturating_mul(256).clamp(64 << 20, 2 << 30);
@@ -151,6 +154,7 @@ fn load_opts(file_len: usize) -> ufbx::LoadOpts<'static> {
     ufbx::LoadOpts {
         temp_allocator: alloc(),
         result_allocator: alloc(),
+        thread_opts: thread_opts(pool),
         ignore_animation: true,
         ignore_embedded: true,
         load_external_files: false,
