@@ -4,7 +4,9 @@
 //!
 //! The files are read into memory before the clock starts, so the time is the reader's
 //! (ufbx's parse and our conversion to Unity's meshes), not the disk's. Each run prints
-//! one line; the best run is the last line.
+//! one line; the best run is the last line, with the CPU time the runs took on average
+//! (all threads, user and system, from `/proc/self/stat`): on a shared machine the wall
+//! time depends on the load, the CPU time much less.
 
 use anyhow::{bail, Context, Result};
 use clap::Parser;
@@ -56,6 +58,17 @@ fn collect(path: &Path, out: &mut Vec<PathBuf>) -> Result<()> {
     Ok(())
 }
 
+/// User plus system time of the whole process so far (Linux; `None` elsewhere).
+fn cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the parenthesised command name; utime and stime are the 12th and
+    // 13th of those, in clock ticks (100 per second on Linux).
+    let rest = stat.rsplit_once(')')?.1;
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: f64 = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
+    Some(ticks / 100.0)
+}
+
 struct Input {
     path: PathBuf,
     bytes: Vec<u8>,
@@ -85,7 +98,9 @@ fn run() -> Result<()> {
     let mut best = f64::INFINITY;
     let mut summary = (0, 0, 0);
     let mut per_file = Vec::new();
-    for run in 0..args.runs.max(1) {
+    let runs = args.runs.max(1);
+    let cpu_start = cpu_seconds();
+    for run in 0..runs {
         let start = Instant::now();
         let results: Vec<(usize, usize, f64)> = inputs
             .par_iter()
@@ -111,11 +126,18 @@ fn run() -> Result<()> {
             per_file = results;
         }
     }
+    let cpu = cpu_seconds()
+        .zip(cpu_start)
+        .map(|(b, a)| (b - a) / runs as f64);
     let (n, tris, failed) = summary;
     println!(
-        "best: {n} files ({mb:.1} MB, {failed} unreadable), {tris} triangles, {best:.4} s, {:.2} M tri/s, {} threads",
+        "best: {n} files ({mb:.1} MB, {failed} unreadable), {tris} triangles, {best:.4} s, {:.2} M tri/s, {} threads{}",
         tris as f64 / best / 1e6,
-        rayon::current_num_threads()
+        rayon::current_num_threads(),
+        match cpu {
+            Some(c) => format!(", {c:.4} CPU s per run ({:.2} M tri per CPU s)", tris as f64 / c / 1e6),
+            None => String::new(),
+        }
     );
     if args.per_file {
         for (i, r) in inputs.iter().zip(&per_file) {
