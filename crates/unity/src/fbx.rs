@@ -632,3 +632,56 @@ impl Importer {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The welding Unity does, written the obvious way: first use of (vertex, normal
+    /// bits) makes the next output vertex.
+    fn weld_by_map(corners: &[(u32, Vec3)]) -> Vec<u32> {
+        let mut map = HashMap::new();
+        corners
+            .iter()
+            .map(|&(v, n)| {
+                let next = map.len() as u32;
+                *map.entry((v, n.to_array().map(f32::to_bits)))
+                    .or_insert(next)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn weld_numbers_vertices_as_a_map_would_past_the_chain_length() {
+        // Vertex 0 is a fan with 40 distinct normals (past the 16 a chain holds), each
+        // used twice; vertices 1..8 have a few normals, interleaved; −0 and 0 differ.
+        let mut corners = Vec::new();
+        for round in 0..2 {
+            for k in 0..40u32 {
+                corners.push((0, Vec3::new(k as f32, 1.0, 0.0)));
+                corners.push((1 + k % 8, Vec3::new(0.0, (k % 3) as f32, 1.0)));
+            }
+            corners.push((2, Vec3::new(if round == 0 { 0.0 } else { -0.0 }, 0.0, 1.0)));
+        }
+        let mut mesh = Mesh::default();
+        let mut weld = Weld::new(9, corners.len());
+        let got: Vec<u32> = corners
+            .iter()
+            .map(|&(v, n)| {
+                weld.vertex(
+                    v,
+                    n,
+                    |o| {
+                        o.positions.push(Vec3::splat(v as f32));
+                        o.normals.push(n);
+                    },
+                    &mut mesh,
+                )
+            })
+            .collect();
+        let want = weld_by_map(&corners);
+        assert_eq!(got, want);
+        assert_eq!(mesh.positions.len(), 40 + 8 * 3 + 1);
+        assert_eq!(mesh.normals.len(), mesh.positions.len());
+    }
+}
