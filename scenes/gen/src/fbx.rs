@@ -7,7 +7,8 @@
 //! node records — u32 offset of the record's end, u32 property count, u32 byte length of
 //! the property list, u8 name length, the name, the properties, the nested records and,
 //! when there are any, a 13-byte null record — and a null record and footer at the end.
-//! Array properties are written uncompressed (encoding 0).
+//! Array properties are written raw (encoding 0) or, as exporters do, zlib-compressed
+//! (encoding 1).
 
 use glam::Vec3;
 
@@ -42,6 +43,8 @@ pub struct File<'a> {
     pub parts: &'a [Part],
     pub material: &'a str,
     pub color: [f32; 3],
+    /// Deflate the arrays (what the FBX SDK writes), so a reader inflates them.
+    pub compress: bool,
 }
 
 enum Prop {
@@ -95,7 +98,7 @@ fn p_vec(name: &str, ty: &str, v: [f64; 3]) -> Node {
     p(name, ty, "", "A", v.map(Prop::F64).into())
 }
 
-fn write_prop(out: &mut Vec<u8>, prop: &Prop) {
+fn write_prop(out: &mut Vec<u8>, prop: &Prop, compress: bool) {
     match prop {
         Prop::I32(v) => {
             out.push(b'I');
@@ -115,42 +118,46 @@ fn write_prop(out: &mut Vec<u8>, prop: &Prop) {
             out.extend_from_slice(b);
         }
         Prop::F64s(v) => {
-            array_head(out, b'd', v.len(), 8);
-            for x in v {
-                out.extend_from_slice(&x.to_le_bytes());
-            }
+            let raw: Vec<u8> = v.iter().flat_map(|x| x.to_le_bytes()).collect();
+            array(out, b'd', v.len(), &raw, compress);
         }
         Prop::I32s(v) => {
-            array_head(out, b'i', v.len(), 4);
-            for x in v {
-                out.extend_from_slice(&x.to_le_bytes());
-            }
+            let raw: Vec<u8> = v.iter().flat_map(|x| x.to_le_bytes()).collect();
+            array(out, b'i', v.len(), &raw, compress);
         }
     }
 }
 
-/// Type code, u32 element count, u32 encoding (0: raw), u32 byte length.
-fn array_head(out: &mut Vec<u8>, code: u8, len: usize, size: usize) {
+/// Type code, u32 element count, u32 encoding (0 raw, 1 zlib), u32 byte length, data.
+fn array(out: &mut Vec<u8>, code: u8, len: usize, raw: &[u8], compress: bool) {
+    let zipped;
+    let (encoding, data) = if compress {
+        zipped = miniz_oxide::deflate::compress_to_vec_zlib(raw, 6);
+        (1u32, zipped.as_slice())
+    } else {
+        (0u32, raw)
+    };
     out.push(code);
     out.extend_from_slice(&(len as u32).to_le_bytes());
-    out.extend_from_slice(&0u32.to_le_bytes());
-    out.extend_from_slice(&((len * size) as u32).to_le_bytes());
+    out.extend_from_slice(&encoding.to_le_bytes());
+    out.extend_from_slice(&(data.len() as u32).to_le_bytes());
+    out.extend_from_slice(data);
 }
 
 const NULL_RECORD: [u8; 13] = [0; 13];
 
-fn write_node(out: &mut Vec<u8>, n: &Node) {
+fn write_node(out: &mut Vec<u8>, n: &Node, compress: bool) {
     let start = out.len();
     out.extend_from_slice(&[0; 12]);
     out.push(n.name.len() as u8);
     out.extend_from_slice(n.name.as_bytes());
     let props_start = out.len();
     for prop in &n.props {
-        write_prop(out, prop);
+        write_prop(out, prop, compress);
     }
     let props_len = (out.len() - props_start) as u32;
     for c in &n.children {
-        write_node(out, c);
+        write_node(out, c, compress);
     }
     // The SDK ends a nested list with a null record, and marks an empty node with one.
     if !n.children.is_empty() || n.props.is_empty() {
@@ -360,7 +367,7 @@ pub fn write(file: &File) -> Vec<u8> {
     out.extend_from_slice(b"Kaydara FBX Binary  \0\x1a\x00");
     out.extend_from_slice(&VERSION.to_le_bytes());
     for n in &top {
-        write_node(&mut out, n);
+        write_node(&mut out, n, file.compress);
     }
     out.extend_from_slice(&NULL_RECORD);
     footer(&mut out);
@@ -406,6 +413,15 @@ mod tests {
 
     #[test]
     fn ufbx_reads_back_what_is_written() {
+        read_back(false);
+    }
+
+    #[test]
+    fn ufbx_reads_back_what_is_written_compressed() {
+        read_back(true);
+    }
+
+    fn read_back(compress: bool) {
         let parts = [
             square("Quad", Vec3::new(1.0, 2.0, 3.0), vec![vec![0, 1, 2, 3]]),
             square(
@@ -418,6 +434,7 @@ mod tests {
             parts: &parts,
             material: "Paint",
             color: [0.25, 0.5, 0.75],
+            compress,
         });
         assert!(bytes.starts_with(b"Kaydara FBX Binary  \0\x1a\x00"));
         assert_eq!(bytes[23..27], 7400u32.to_le_bytes());

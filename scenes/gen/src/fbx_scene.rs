@@ -2,7 +2,8 @@
 //! parts, wavy tori of different proportions, half written as quads and half as
 //! triangles), every model placed twice as a prefab instance on a grid, with a camera
 //! and a sun. Not bundled: `scenegen DIR --fbx MODELS` writes it (16 models: 1,048,576
-//! triangles in the files, twice that in the scene).
+//! triangles in the files, twice that in the scene; `--deflate` compresses the arrays as
+//! exporters do).
 
 use crate::fbx::{self, Part};
 use crate::material::{write_material, MatDesc};
@@ -104,8 +105,9 @@ fn vertex_normals(positions: &[Vec3], polygons: &[Vec<u32>]) -> Vec<Vec3> {
     acc.into_iter().map(|n| n.normalize_or_zero()).collect()
 }
 
-/// The FBX file of model `k`.
-pub fn model_file(k: usize) -> Vec<u8> {
+/// The FBX file of model `k`, its arrays deflated when `compress` (as exporters write
+/// them) or raw.
+pub fn model_file(k: usize, compress: bool) -> Vec<u8> {
     let parts: Vec<Part> = (0..PARTS).map(|j| part(k, j)).collect();
     let hue = k as f32 * 0.618_034 % 1.0;
     let color = [
@@ -117,11 +119,12 @@ pub fn model_file(k: usize) -> Vec<u8> {
         parts: &parts,
         material: &format!("Torus{k}"),
         color,
+        compress,
     })
 }
 
-/// The project with `models` (at least 1) distinct FBX models.
-pub fn project(models: usize) -> Project {
+/// The project with `models` (at least 1) distinct FBX models, compressed or raw.
+pub fn project(models: usize, compress: bool) -> Project {
     let models = models.max(1);
     let mut p = Project::new(NAME);
     let floor = p.add_asset(
@@ -132,7 +135,7 @@ pub fn project(models: usize) -> Project {
     let guids: Vec<String> = (0..models)
         .map(|k| {
             let path = format!("Assets/Models/Torus{k}.fbx");
-            p.add_binary_asset(&path, model_file(k), meta::model)
+            p.add_binary_asset(&path, model_file(k, compress), meta::model)
         })
         .collect();
     let count = models * INSTANCES;
@@ -194,7 +197,7 @@ mod tests {
 
     #[test]
     fn every_model_holds_its_triangles_half_of_them_as_quads() {
-        let bytes = model_file(3);
+        let bytes = model_file(3, false);
         let scene = ufbx::load_memory(&bytes, ufbx::LoadOpts::default())
             .unwrap_or_else(|e| panic!("{}", e.description));
         let tris: usize = scene.meshes.iter().map(|m| m.num_triangles).sum();
@@ -207,12 +210,34 @@ mod tests {
             .filter(|m| m.max_face_triangles == 2)
             .count();
         assert_eq!(quads, PARTS / 2);
-        assert_ne!(model_file(4), bytes);
+        assert_ne!(model_file(4, false), bytes);
+    }
+
+    #[test]
+    fn a_compressed_model_reads_back_the_same_and_smaller() {
+        let opts = || ufbx::LoadOpts {
+            strict: true,
+            ..Default::default()
+        };
+        let (raw, zipped) = (model_file(5, false), model_file(5, true));
+        assert!(zipped.len() < raw.len());
+        let a = ufbx::load_memory(&raw, opts()).unwrap_or_else(|e| panic!("{}", e.description));
+        let b = ufbx::load_memory(&zipped, opts()).unwrap_or_else(|e| panic!("{}", e.description));
+        assert_eq!(a.meshes.len(), b.meshes.len());
+        for (x, y) in a.meshes.iter().zip(b.meshes.iter()) {
+            assert_eq!(x.num_triangles, y.num_triangles);
+            let ix: Vec<u32> = x.vertex_indices.iter().copied().collect();
+            let iy: Vec<u32> = y.vertex_indices.iter().copied().collect();
+            assert_eq!(ix, iy);
+            let px: Vec<[f64; 3]> = x.vertices.iter().map(|v| [v.x, v.y, v.z]).collect();
+            let py: Vec<[f64; 3]> = y.vertices.iter().map(|v| [v.x, v.y, v.z]).collect();
+            assert_eq!(px, py);
+        }
     }
 
     #[test]
     fn scene_places_each_model_twice_as_a_prefab_with_a_camera_and_a_sun() {
-        let p = project(3);
+        let p = project(3, false);
         let scene = String::from_utf8(p.files[SCENE_PATH].clone()).unwrap();
         assert_eq!(scene.matches("--- !u!1001 &").count(), 3 * INSTANCES);
         assert_eq!(scene.matches("--- !u!20 &").count(), 1);

@@ -24,6 +24,9 @@ struct Args {
     /// the files).
     #[arg(long, value_name = "MODELS", conflicts_with_all = ["only", "large"])]
     fbx: Option<usize>,
+    /// With `--fbx`: deflate the models' arrays, as exporters write them.
+    #[arg(long, requires = "fbx")]
+    deflate: bool,
 }
 
 fn main() {
@@ -37,7 +40,7 @@ fn run() -> Result<()> {
     let args = Args::parse();
     let projects: Vec<_> = match (args.large, args.fbx) {
         (Some(side), _) => vec![scenegen::baseline::large(side)],
-        (None, Some(models)) => vec![scenegen::fbx_scene::project(models)],
+        (None, Some(models)) => vec![scenegen::fbx_scene::project(models, args.deflate)],
         (None, None) => scenegen::all_projects()
             .into_iter()
             .filter(|p| args.only.as_deref().is_none_or(|o| o == p.name))
