@@ -69,6 +69,12 @@ large SIDE="16": build
     {{bin}}/scenegen out --large {{SIDE}}
     just scene out/large/Assets/Scenes/Large.unity large
 
+# FBX scale test: MODELS distinct binary FBX models of 65,536 triangles (16: 1,048,576), each placed twice; times the FBX reader alone on them, then converts, compiles and renders to out/fbxlarge.exr/.png.
+fbx-scene MODELS="16": build
+    {{bin}}/scenegen out --fbx {{MODELS}}
+    {{bin}}/fbxload out/fbxlarge/Assets/Models --runs 3
+    just scene out/fbxlarge/Assets/Scenes/FbxLarge.unity fbxlarge
+
 # Render speed-up from 1 to 2 threads on the baseline (interleaved pairs, one process); `just threads --width 320 --height 240`.
 threads *ARGS:
     cargo run --release --quiet -p bench --bin threads -- {{ARGS}}

@@ -19,12 +19,15 @@
 //! The root node is named after the file (Unity's `//RootNode`); when the file's root
 //! has a single child, that child is the root.
 
+use crate::fbx_pool::{thread_opts, Pool};
 use crate::mesh::{smooth_normals, Mesh, EAR_CLIP_MAX};
 use crate::meta::ModelMeta;
 use crate::model::{Model, ModelMaterial, ModelMesh, ModelNode, Skin};
 use glam::{DMat3, DMat4, DQuat, DVec3, Mat4, Vec3};
+use rayon::prelude::*;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 #[derive(Debug, thiserror::Error)]
 pub enum FbxError {
@@ -38,6 +41,74 @@ pub enum FbxError {
     LfsPointer(PathBuf),
     #[error("{path}: not a readable FBX file: {detail}")]
     Corrupt { path: PathBuf, detail: String },
+}
+
+/// Unity welds the corners that share a source vertex and a normal (bit for bit) into
+/// one vertex, numbered in the order corners first use them. Each source vertex keeps a
+/// short chain of the vertices made from it, so the common case is a walk of one or two
+/// entries and no hashing; a vertex with more distinct normals than a chain holds (a fan
+/// of flat faces) spills into a hash map, which keeps a pathological file linear.
+struct Weld {
+    /// Per source vertex: the newest output vertex made from it (`NONE` if none).
+    head: Vec<u32>,
+    /// Per source vertex: how many outputs its chain holds.
+    len: Vec<u8>,
+    /// Per output vertex: the next older output of the same source vertex.
+    next: Vec<u32>,
+    overflow: HashMap<(u32, [u32; 3]), u32>,
+}
+
+const NONE: u32 = u32::MAX;
+const CHAIN: u8 = 16;
+
+impl Weld {
+    fn new(vertices: usize, corners: usize) -> Weld {
+        Weld {
+            head: vec![NONE; vertices],
+            len: vec![0; vertices],
+            next: Vec::with_capacity(corners.min(vertices * 2)),
+            overflow: HashMap::new(),
+        }
+    }
+
+    /// The output vertex of (`v`, `normal`); `add` appends it to `mesh` when it is new.
+    fn vertex(
+        &mut self,
+        v: u32,
+        normal: Vec3,
+        add: impl FnOnce(&mut Mesh),
+        mesh: &mut Mesh,
+    ) -> u32 {
+        let bits = normal.to_array().map(f32::to_bits);
+        let vi = v as usize;
+        if vi >= self.head.len() {
+            // Callers clamp `v`; stay total anyway.
+            return 0;
+        }
+        let mut o = self.head[vi];
+        while o != NONE {
+            if mesh.normals[o as usize].to_array().map(f32::to_bits) == bits {
+                return o;
+            }
+            o = self.next[o as usize];
+        }
+        if self.len[vi] >= CHAIN {
+            if let Some(&o) = self.overflow.get(&(v, bits)) {
+                return o;
+            }
+        }
+        let o = mesh.positions.len() as u32;
+        add(mesh);
+        if self.len[vi] < CHAIN {
+            self.next.push(self.head[vi]);
+            self.head[vi] = o;
+            self.len[vi] += 1;
+        } else {
+            self.next.push(NONE);
+            self.overflow.insert((v, bits), o);
+        }
+        o
+    }
 }
 
 /// Deepest node hierarchy accepted (real files stay far below; a corrupt one could nest
@@ -59,8 +130,9 @@ pub fn load_bytes(bytes: &[u8], path: &Path, meta: &ModelMeta) -> Result<Model, 
     if bytes.starts_with(b"version https://git-lfs.github.com/spec") {
         return Err(FbxError::LfsPointer(path.to_path_buf()));
     }
+    let pool = Arc::new(Pool::default());
     let scene =
-        ufbx::load_memory(bytes, load_opts(bytes.len())).map_err(|e| FbxError::Corrupt {
+        ufbx::load_memory(bytes, load_opts(bytes.len(), &pool)).map_err(|e| FbxError::Corrupt {
             path: path.to_path_buf(),
             detail: e.description.to_string(),
         })?;
@@ -71,7 +143,7 @@ pub fn load_bytes(bytes: &[u8], path: &Path, meta: &ModelMeta) -> Result<Model, 
     Ok(Importer::new(&scene, meta).model(&scene, stem))
 }
 
-fn load_opts(file_len: usize) -> ufbx::LoadOpts<'static> {
+fn load_opts(file_len: usize, pool: &Arc<Pool>) -> ufbx::LoadOpts<'static> {
     // Compressed binary arrays legitimately inflate a file many times over; a bound
     // proportional to the file keeps a corrupt header from asking for gigabytes.
     let limit = file_len.saturating_mul(256).clamp(64 << 20, 2 << 30);
@@ -82,6 +154,7 @@ fn load_opts(file_len: usize) -> ufbx::LoadOpts<'static> {
     ufbx::LoadOpts {
         temp_allocator: alloc(),
         result_allocator: alloc(),
+        thread_opts: thread_opts(pool),
         ignore_animation: true,
         ignore_embedded: true,
         load_external_files: false,
@@ -230,7 +303,7 @@ impl Importer {
         mirror_m(m)
     }
 
-    fn model(mut self, scene: &ufbx::Scene, stem: String) -> Model {
+    fn model(mut self, scene: &ufbx::SceneRoot, stem: String) -> Model {
         let mut model = Model::default();
         let root = &scene.root_node;
         // Without baking, the axis conversion is a rotation on each node directly under
@@ -245,6 +318,8 @@ impl Importer {
         };
         // (ufbx node, parent index, directly under the file's root) in depth-first order.
         let mut stack: Vec<(&ufbx::Node, Option<usize>, bool)> = Vec::new();
+        // (model node index, ufbx node id) of every node with a mesh, in order.
+        let mut mesh_nodes: Vec<(usize, u32)> = Vec::new();
         if root.children.len() == 1 {
             stack.push((&root.children[0], None, true));
         } else {
@@ -270,18 +345,16 @@ impl Importer {
                 node.element.name.to_string()
             };
             let index = model.nodes.len();
-            let mesh = node.mesh.as_ref().and_then(|m| {
-                let built = self.mesh(node, m)?;
-                model.meshes.push(built);
-                Some(model.meshes.len() - 1)
-            });
+            if node.mesh.is_some() {
+                mesh_nodes.push((index, node.element.typed_id));
+            }
             model.nodes.push(ModelNode {
                 name,
                 parent,
                 translation: t.as_vec3(),
                 rotation: q.as_quat(),
                 scale: s.as_vec3(),
-                mesh,
+                mesh: None,
             });
             stack.extend(
                 node.children
@@ -289,6 +362,25 @@ impl Importer {
                     .rev()
                     .map(|c| (&**c, Some(index), false)),
             );
+        }
+        // Meshes are independent: converted in parallel, numbered in depth-first order.
+        let importer = &self;
+        let built: Vec<(Option<ModelMesh>, Vec<String>)> = mesh_nodes
+            .par_iter()
+            .map(|&(_, id)| {
+                let node = &scene.nodes[id as usize];
+                match node.mesh.as_ref() {
+                    Some(m) => importer.mesh(node, m),
+                    None => (None, Vec::new()),
+                }
+            })
+            .collect();
+        for (&(index, _), (mesh, warnings)) in mesh_nodes.iter().zip(built) {
+            self.warnings.extend(warnings);
+            if let Some(mesh) = mesh {
+                model.meshes.push(mesh);
+                model.nodes[index].mesh = Some(model.meshes.len() - 1);
+            }
         }
         for m in scene.materials.iter() {
             let diffuse = &m.fbx.diffuse_color;
@@ -312,8 +404,20 @@ impl Importer {
         model
     }
 
-    /// The Mesh Unity makes for `node`; `None` when it has no polygon.
-    fn mesh(&mut self, node: &ufbx::Node, m: &ufbx::Mesh) -> Option<ModelMesh> {
+    /// The Mesh Unity makes for `node` (`None` when it has no polygon), and what it could
+    /// not honour.
+    fn mesh(&self, node: &ufbx::Node, m: &ufbx::Mesh) -> (Option<ModelMesh>, Vec<String>) {
+        let mut warnings = Vec::new();
+        let mesh = self.mesh_into(node, m, &mut warnings);
+        (mesh, warnings)
+    }
+
+    fn mesh_into(
+        &self,
+        node: &ufbx::Node,
+        m: &ufbx::Mesh,
+        warnings: &mut Vec<String>,
+    ) -> Option<ModelMesh> {
         let name = node.element.name.to_string();
         let g2m = self.geometry_to_mesh(node);
         let normal_m = DMat3::from_mat4(g2m).inverse().transpose();
@@ -399,54 +503,73 @@ impl Importer {
                 .collect();
             smooth_normals(&positions, &tris, self.smoothing_angle)
         };
-        let mut mesh = Mesh::default();
-        let mut src_vertex: Vec<u32> = Vec::new();
-        let mut vmap: HashMap<(u32, [u32; 3]), u32> = HashMap::new();
+        // Each normal value once in the mesh's frame (files index them per corner).
+        let normal_values: Vec<Vec3> = if file_normals {
+            m.vertex_normal
+                .values
+                .iter()
+                .map(|&n| {
+                    let n = (normal_m * v3(n)).normalize_or_zero().as_vec3();
+                    if n.is_finite() {
+                        n
+                    } else {
+                        Vec3::ZERO
+                    }
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let corners: usize = subs.iter().map(|t| 3 * t.len()).sum();
+        let mut mesh = Mesh {
+            positions: Vec::with_capacity(positions.len()),
+            normals: Vec::with_capacity(positions.len()),
+            submeshes: Vec::with_capacity(subs.len()),
+        };
+        let mut src_vertex: Vec<u32> = Vec::with_capacity(positions.len());
+        let mut weld = Weld::new(positions.len().max(1), corners);
         let mut k = 0usize;
-        for tris in subs {
-            let mut out = Vec::with_capacity(tris.len());
-            for t in tris {
+        // Corners are replaced by output vertices in place: the sub-mesh lists become
+        // the Mesh's.
+        for mut tris in subs {
+            for t in tris.iter_mut() {
                 let mut corners = [0u32; 3];
                 for (j, &ix) in t.iter().enumerate() {
                     let v = vertex_of(ix).unwrap_or(0);
                     let jj = if reverse { [0, 2, 1][j] } else { j };
                     let normal = if file_normals {
-                        let n = m
-                            .vertex_normal
+                        m.vertex_normal
                             .indices
                             .get(ix as usize)
-                            .and_then(|&i| m.vertex_normal.values.get(i as usize))
-                            .map(|&n| (normal_m * v3(n)).normalize_or_zero().as_vec3())
-                            .unwrap_or(Vec3::ZERO);
-                        if n.is_finite() {
-                            n
-                        } else {
-                            Vec3::ZERO
-                        }
+                            .and_then(|&i| normal_values.get(i as usize))
+                            .copied()
+                            .unwrap_or(Vec3::ZERO)
                     } else {
                         smooth[k][jj]
                     };
-                    let key = (v, normal.to_array().map(f32::to_bits));
-                    corners[jj] = *vmap.entry(key).or_insert_with(|| {
-                        mesh.positions
-                            .push(positions.get(v as usize).copied().unwrap_or_default());
-                        mesh.normals.push(normal);
-                        src_vertex.push(v);
-                        (mesh.positions.len() - 1) as u32
-                    });
+                    corners[jj] = weld.vertex(
+                        v,
+                        normal,
+                        |o| {
+                            o.positions
+                                .push(positions.get(v as usize).copied().unwrap_or_default());
+                            o.normals.push(normal);
+                            src_vertex.push(v);
+                        },
+                        &mut mesh,
+                    );
                 }
-                out.push(corners);
+                *t = corners;
                 k += 1;
             }
-            mesh.submeshes.push(out);
+            mesh.submeshes.push(tris);
         }
         if !m.blend_deformers.is_empty() {
-            self.warnings
-                .push(format!("mesh {name}: blend shapes ignored"));
+            warnings.push(format!("mesh {name}: blend shapes ignored"));
         }
         let skin = m.skin_deformers.first().map(|sk| {
             if m.skin_deformers.len() > 1 {
-                self.warnings.push(format!(
+                warnings.push(format!(
                     "mesh {name}: {} skin deformers; only the first is used",
                     m.skin_deformers.len()
                 ));
@@ -509,5 +632,58 @@ impl Importer {
             bind_poses,
             weights,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The welding Unity does, written the obvious way: first use of (vertex, normal
+    /// bits) makes the next output vertex.
+    fn weld_by_map(corners: &[(u32, Vec3)]) -> Vec<u32> {
+        let mut map = HashMap::new();
+        corners
+            .iter()
+            .map(|&(v, n)| {
+                let next = map.len() as u32;
+                *map.entry((v, n.to_array().map(f32::to_bits)))
+                    .or_insert(next)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn weld_numbers_vertices_as_a_map_would_past_the_chain_length() {
+        // Vertex 0 is a fan with 40 distinct normals (past the 16 a chain holds), each
+        // used twice; vertices 1..8 have a few normals, interleaved; −0 and 0 differ.
+        let mut corners = Vec::new();
+        for round in 0..2 {
+            for k in 0..40u32 {
+                corners.push((0, Vec3::new(k as f32, 1.0, 0.0)));
+                corners.push((1 + k % 8, Vec3::new(0.0, (k % 3) as f32, 1.0)));
+            }
+            corners.push((2, Vec3::new(if round == 0 { 0.0 } else { -0.0 }, 0.0, 1.0)));
+        }
+        let mut mesh = Mesh::default();
+        let mut weld = Weld::new(9, corners.len());
+        let got: Vec<u32> = corners
+            .iter()
+            .map(|&(v, n)| {
+                weld.vertex(
+                    v,
+                    n,
+                    |o| {
+                        o.positions.push(Vec3::splat(v as f32));
+                        o.normals.push(n);
+                    },
+                    &mut mesh,
+                )
+            })
+            .collect();
+        let want = weld_by_map(&corners);
+        assert_eq!(got, want);
+        assert_eq!(mesh.positions.len(), 40 + 8 * 3 + 1);
+        assert_eq!(mesh.normals.len(), mesh.positions.len());
     }
 }

@@ -12,6 +12,7 @@ pub mod embedded;
 pub mod emit;
 pub mod environment;
 pub mod fbx;
+mod fbx_pool;
 pub mod graph;
 pub mod light;
 pub mod material;

@@ -13,7 +13,21 @@ pub fn guid(project: &str, asset_path: &str) -> String {
 /// The fileID Unity gives mesh `name` of a model imported with `fileIdsGeneration: 2`:
 /// xxHash64 (seed 0) of `Type:Mesh-><name>0`, read as a signed 64-bit integer.
 pub fn mesh_file_id(name: &str) -> i64 {
-    xxh64(format!("Type:Mesh->{name}0").as_bytes(), 0) as i64
+    imported_id(&format!("Type:Mesh->{name}0"))
+}
+
+/// The fileIDs of an imported model's root GameObject and its Transform under
+/// `fileIdsGeneration: 2`, the targets a PrefabInstance of the model modifies.
+pub fn model_root_ids() -> (i64, i64) {
+    (
+        imported_id("Type:GameObject->//RootNode/root0"),
+        imported_id("Type:Transform->//RootNode/root/Transform0"),
+    )
+}
+
+/// xxHash64 (seed 0) of an imported object's key, read as a signed 64-bit integer.
+fn imported_id(key: &str) -> i64 {
+    xxh64(key.as_bytes(), 0) as i64
 }
 
 /// Hands out in-scene fileIDs. Unity's are random positive numbers below 2³¹ with a
@@ -48,6 +62,15 @@ mod tests {
     fn mesh_file_id_matches_unity_on_the_corpus_value() {
         // Read from a real fileIdsGeneration 2 project.
         assert_eq!(mesh_file_id("default"), -2_432_090_755_550_338_912);
+    }
+
+    #[test]
+    fn model_root_ids_match_unity_on_the_corpus_values() {
+        // A real 2022 scene's PrefabInstance of a fileIdsGeneration 2 model.
+        assert_eq!(
+            model_root_ids(),
+            (919_132_149_155_446_097, -8_679_921_383_154_817_045)
+        );
     }
 
     #[test]

@@ -7,6 +7,8 @@
 
 pub mod baseline;
 pub mod effects;
+pub mod fbx;
+pub mod fbx_scene;
 pub mod ids;
 pub mod material;
 pub mod mesh;

@@ -1,5 +1,6 @@
 //! `scenegen [SCENES_DIR] [--only NAME]`: (re)write the bundled Unity projects;
-//! `scenegen DIR --large SIDE`: write the scale-test project instead.
+//! `scenegen DIR --large SIDE`: write the scale-test project instead;
+//! `scenegen DIR --fbx MODELS`: write the FBX scale-test project instead.
 
 use anyhow::{bail, Context, Result};
 use clap::Parser;
@@ -18,6 +19,14 @@ struct Args {
     /// grid (41,821·SIDE² + 12 triangles; 16 gives 10.7 million).
     #[arg(long, value_name = "SIDE", conflicts_with = "only")]
     large: Option<usize>,
+    /// Write only the FBX scale-test project `fbxlarge`: MODELS distinct binary FBX
+    /// models of 65,536 triangles, each placed twice (16 gives 1,048,576 triangles in
+    /// the files).
+    #[arg(long, value_name = "MODELS", conflicts_with_all = ["only", "large"])]
+    fbx: Option<usize>,
+    /// With `--fbx`: deflate the models' arrays, as exporters write them.
+    #[arg(long, requires = "fbx")]
+    deflate: bool,
 }
 
 fn main() {
@@ -29,9 +38,10 @@ fn main() {
 
 fn run() -> Result<()> {
     let args = Args::parse();
-    let projects: Vec<_> = match args.large {
-        Some(side) => vec![scenegen::baseline::large(side)],
-        None => scenegen::all_projects()
+    let projects: Vec<_> = match (args.large, args.fbx) {
+        (Some(side), _) => vec![scenegen::baseline::large(side)],
+        (None, Some(models)) => vec![scenegen::fbx_scene::project(models, args.deflate)],
+        (None, None) => scenegen::all_projects()
             .into_iter()
             .filter(|p| args.only.as_deref().is_none_or(|o| o == p.name))
             .collect(),

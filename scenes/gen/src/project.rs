@@ -43,8 +43,18 @@ impl Project {
         text: impl Into<String>,
         meta_of: fn(&str) -> String,
     ) -> String {
+        self.add_binary_asset(path, text.into().into_bytes(), meta_of)
+    }
+
+    /// [`Project::add_asset`] for a file that is not text (a binary FBX model).
+    pub fn add_binary_asset(
+        &mut self,
+        path: &str,
+        bytes: Vec<u8>,
+        meta_of: fn(&str) -> String,
+    ) -> String {
         let guid = self.guid(path);
-        self.add(path, text);
+        self.files.insert(path.to_string(), bytes);
         self.add(&format!("{path}.meta"), meta_of(&guid));
         guid
     }

@@ -120,6 +120,11 @@ pub enum Body {
     },
     Light(LightDesc),
     Camera(CameraDesc),
+    /// A PrefabInstance of the imported model with this GUID (the object's name and
+    /// transform become modifications of the model's root).
+    ModelPrefab {
+        guid: String,
+    },
 }
 
 pub struct Object {
@@ -174,8 +179,15 @@ pub fn write_scene(scene_key: &str, scene: &SceneDesc) -> String {
             Body::Mesh { .. } => 4,
             Body::Light(_) => 3,
             Body::Camera(_) => 4,
+            Body::ModelPrefab { .. } => 1,
         };
         let id = ids.block(&format!("{scene_key}/{k}/{}", obj.name), count);
+        if let Body::ModelPrefab { guid } = &obj.body {
+            // Unity lists a root prefab instance by its PrefabInstance document.
+            roots.push(id[0]);
+            docs.push((id[0], prefab_instance(id[0], obj, guid)));
+            continue;
+        }
         let (go, tr) = (id[0], id[1]);
         roots.push(tr);
         // Unity lists a GameObject's components in the order they were added.
@@ -197,6 +209,7 @@ pub fn write_scene(scene_key: &str, scene: &SceneDesc) -> String {
                 docs.push((id[2], camera_doc(id[2], go, cam)));
                 docs.push((id[3], audio_listener(id[3], go)));
             }
+            Body::ModelPrefab { .. } => {}
         }
     }
     // Unity writes the settings first, then every object sorted by fileID.
@@ -268,6 +281,64 @@ Transform:
         v3(x.scale),
         v3(x.euler)
     )
+}
+
+/// A model placed as Unity 2022 writes it: the root's name and local transform as
+/// modifications, nothing added or removed.
+fn prefab_instance(id: i64, obj: &Object, guid: &str) -> String {
+    let (root_go, root_tr) = crate::ids::model_root_ids();
+    let x = &obj.xform;
+    let q = x.rotation();
+    let mut s = format!(
+        "--- !u!1001 &{id}
+PrefabInstance:
+  m_ObjectHideFlags: 0
+  serializedVersion: 2
+  m_Modification:
+    serializedVersion: 3
+    m_TransformParent: {{fileID: 0}}
+    m_Modifications:
+"
+    );
+    let mut modify = |target: i64, path: &str, value: &str| {
+        let _ = write!(
+            s,
+            "    - target: {{fileID: {target}, guid: {guid}, type: 3}}
+      propertyPath: {path}
+      value: {value}
+      objectReference: {{fileID: 0}}
+"
+        );
+    };
+    let tr = [
+        ("m_LocalPosition.x", x.position.x),
+        ("m_LocalPosition.y", x.position.y),
+        ("m_LocalPosition.z", x.position.z),
+        ("m_LocalRotation.w", q.w),
+        ("m_LocalRotation.x", q.x),
+        ("m_LocalRotation.y", q.y),
+        ("m_LocalRotation.z", q.z),
+        ("m_LocalScale.x", x.scale.x),
+        ("m_LocalScale.y", x.scale.y),
+        ("m_LocalScale.z", x.scale.z),
+        ("m_LocalEulerAnglesHint.x", x.euler.x),
+        ("m_LocalEulerAnglesHint.y", x.euler.y),
+        ("m_LocalEulerAnglesHint.z", x.euler.z),
+    ];
+    for (path, v) in tr {
+        modify(root_tr, path, &num(v));
+    }
+    modify(root_go, "m_Name", &obj.name);
+    let _ = write!(
+        s,
+        "    m_RemovedComponents: []
+    m_RemovedGameObjects: []
+    m_AddedGameObjects: []
+    m_AddedComponents: []
+  m_SourcePrefab: {{fileID: 100100000, guid: {guid}, type: 3}}
+"
+    );
+    s
 }
 
 fn mesh_filter(id: i64, go: i64, mesh: &MeshRef) -> String {

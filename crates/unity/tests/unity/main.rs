@@ -1,6 +1,6 @@
 //! The crate's integration tests, one binary: the command-line tools, conversions of
-//! tiny hand-written projects, the FBX reader on hand-written ASCII files, and the real
-//! projects of the corpus.
+//! tiny hand-written projects, the FBX reader on hand-written ASCII files (and under
+//! concurrent loads), and the real projects of the corpus.
 
 mod cli;
 mod convert;
@@ -9,4 +9,5 @@ mod fbx;
 mod fbx_ascii;
 mod fbx_corpus;
 mod fbx_scene;
+mod fbx_threads;
 mod support;
