@@ -43,10 +43,15 @@ pub(crate) struct Emitter<'g, 'p> {
     pub(crate) meshes: HashMap<String, Option<Arc<Mesh>>>,
     /// Material source key → soup material index.
     pub(crate) materials: HashMap<String, u32>,
+    /// The chosen camera's culling mask (see [`crate::layer`]).
+    pub(crate) camera_mask: u32,
+    /// Renderers not drawn by Unity's own rules, one line each for `--list`.
+    pub(crate) skipped: Vec<String>,
 }
 
-/// The soup, and how many enabled cameras on active objects the scene has.
-pub fn emit(g: &Graph, scene_rel: &str) -> Result<(Soup, usize), EmitError> {
+/// The soup, how many enabled cameras on active objects the scene has, and the renderers
+/// skipped by Unity's draw rules.
+pub fn emit(g: &Graph, scene_rel: &str) -> Result<(Soup, usize, Vec<String>), EmitError> {
     let mut e = Emitter {
         g,
         scene_rel,
@@ -56,6 +61,8 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<(Soup, usize), EmitError> {
         world: HashMap::new(),
         meshes: HashMap::new(),
         materials: HashMap::new(),
+        camera_mask: crate::layer::EVERYTHING,
+        skipped: Vec::new(),
     };
     e.soup.warnings = g.warnings.clone();
     for (i, o) in g.objs.iter().enumerate() {
@@ -66,7 +73,23 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<(Soup, usize), EmitError> {
             e.go_comps.entry(go).or_default().push(i);
         }
     }
+    // The camera comes first: its culling mask decides which renderers are converted.
     let mut cameras: Vec<(usize, usize)> = Vec::new(); // (go, camera component)
+    for (gi, o) in g.objs.iter().enumerate() {
+        if o.class != docs::GAME_OBJECT || !e.active(gi) {
+            continue;
+        }
+        for &c in e.go_comps.get(&gi).into_iter().flatten() {
+            if g.objs[c].class == docs::CAMERA && enabled(&g.objs[c]) {
+                cameras.push((gi, c));
+            }
+        }
+    }
+    let before = e.soup.warnings.len();
+    e.camera(&cameras)?;
+    // Keep the camera's warnings after the objects', where they have always been.
+    let camera_warnings = e.soup.warnings.split_off(before);
+    let lod_hidden = e.lod_hidden();
     for (gi, o) in g.objs.iter().enumerate() {
         if o.class != docs::GAME_OBJECT || !e.active(gi) {
             continue;
@@ -76,7 +99,12 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<(Soup, usize), EmitError> {
         if let Some(mf) = class_of(docs::MESH_FILTER) {
             if let Some(mr) = class_of(docs::MESH_RENDERER) {
                 if enabled(&g.objs[mr]) {
-                    e.mesh_object(gi, mf, mr)?;
+                    if let Some(why) = lod_hidden.get(&mr) {
+                        let line = format!("object {:?}: {why}; not converted", e.path(gi));
+                        e.skipped.push(line);
+                    } else if e.camera_draws(gi) {
+                        e.mesh_object(gi, mf, mr)?;
+                    }
                 }
             }
         }
@@ -95,13 +123,8 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<(Soup, usize), EmitError> {
         for &c in comps.iter().filter(|&&i| g.objs[i].class == docs::LIGHT) {
             e.light(gi, c)?;
         }
-        for &c in comps.iter().filter(|&&i| g.objs[i].class == docs::CAMERA) {
-            if enabled(&g.objs[c]) {
-                cameras.push((gi, c));
-            }
-        }
     }
-    e.camera(&cameras)?;
+    e.soup.warnings.extend(camera_warnings);
     if let Some(ambient) = g
         .render_settings
         .as_ref()
@@ -110,7 +133,7 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<(Soup, usize), EmitError> {
         e.soup.environment.ambient = ambient;
     }
     e.soup.seal();
-    Ok((e.soup, cameras.len()))
+    Ok((e.soup, cameras.len(), e.skipped))
 }
 
 /// A component's `m_Enabled` (on unless it says 0).

@@ -98,6 +98,7 @@ fn wanted(class: u32) -> bool {
             | docs::LIGHT
             | docs::SKINNED_MESH_RENDERER
             | docs::TERRAIN
+            | docs::LOD_GROUP
     )
 }
 

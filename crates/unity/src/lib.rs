@@ -13,7 +13,9 @@ pub mod emit;
 pub mod environment;
 pub mod fbx;
 pub mod graph;
+pub mod layer;
 pub mod light;
+pub mod lod;
 pub mod material;
 pub mod mesh;
 pub mod mesh_source;
@@ -60,6 +62,9 @@ pub struct Report {
     pub soup: Soup,
     /// Enabled cameras on active objects (the soup keeps one).
     pub cameras: usize,
+    /// Renderers Unity does not draw by design (outside the camera's culling mask, above
+    /// LOD0), one line each.
+    pub skipped: Vec<String>,
 }
 
 /// Convert a scene into a sealed soup.
@@ -84,7 +89,7 @@ pub fn convert_report(scene: &Path, opts: &Options) -> Result<Report, ConvertErr
     g.warnings.extend(project.guids.warnings.iter().cloned());
     g.load_scene(scene, text);
     let scene_rel = project.rel(scene);
-    let (mut soup, cameras) = emit::emit(&g, &scene_rel)?;
+    let (mut soup, cameras, skipped) = emit::emit(&g, &scene_rel)?;
     // Model-level warnings (missing .mtl …), once per model used.
     let mut model_warnings: Vec<String> = Vec::new();
     for f in soup
@@ -108,5 +113,9 @@ pub fn convert_report(scene: &Path, opts: &Options) -> Result<Report, ConvertErr
             first: soup.warnings[0].clone(),
         });
     }
-    Ok(Report { soup, cameras })
+    Ok(Report {
+        soup,
+        cameras,
+        skipped,
+    })
 }

@@ -2,7 +2,8 @@
 //! space, soup handedness, each with the material of its sub-mesh's slot.
 
 use crate::emit::{flip, EmitError, Emitter};
-use formats::Object;
+use crate::layer::layer;
+use formats::{CastShadows, Object};
 use glam::{Mat3, Vec3};
 
 impl Emitter<'_, '_> {
@@ -28,9 +29,18 @@ impl Emitter<'_, '_> {
         let flip_winding = world.determinant() < 0.0;
         let slots = &g.objs[mr].materials;
         let obj_index = self.soup.objects.len() as u32;
+        let r = &g.objs[mr].body;
         self.soup.objects.push(Object {
             name: self.path(go),
             source,
+            layer: layer(&g.objs[go].body),
+            cast_shadows: match r.i64_at("m_CastShadows") {
+                Some(0) => CastShadows::Off,
+                Some(2) => CastShadows::TwoSided,
+                Some(3) => CastShadows::ShadowsOnly,
+                _ => CastShadows::On,
+            },
+            receive_shadows: r.i64_at("m_ReceiveShadows") != Some(0),
         });
         let mut emitted = 0usize;
         for (si, tris) in mesh.submeshes.iter().enumerate() {

@@ -41,7 +41,7 @@ fn run(args: &Args) -> anyhow::Result<()> {
         project: args.assets.clone(),
         strict: args.strict,
     };
-    let soup = unity::convert(&args.scene, &opts)?;
+    let unity::Report { soup, skipped, .. } = unity::convert_report(&args.scene, &opts)?;
     soup.write(&args.output)
         .with_context(|| format!("writing {}", args.output.display()))?;
     let secs = t0.elapsed().as_secs_f64();
@@ -57,7 +57,7 @@ fn run(args: &Args) -> anyhow::Result<()> {
         );
     }
     if args.list {
-        list(&soup);
+        list(&soup, &skipped);
     }
     eprintln!(
         "{}: {} objects, {} triangles, {} lights, {} materials, {} warnings, {} degenerate dropped, {:.3} s",
@@ -85,8 +85,8 @@ fn run(args: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// One line per object and light, for checking a conversion by eye.
-fn list(soup: &formats::Soup) {
+/// One line per object, skipped renderer and light, for checking a conversion by eye.
+fn list(soup: &formats::Soup, skipped: &[String]) {
     let mut tris = vec![0usize; soup.objects.len()];
     let mut mats: Vec<Vec<u32>> = vec![Vec::new(); soup.objects.len()];
     for (&o, &m) in soup.tri_object.iter().zip(&soup.tri_material) {
@@ -101,23 +101,36 @@ fn list(soup: &formats::Soup) {
             .map(|&m| {
                 let m = &soup.materials[m as usize];
                 format!(
-                    "{} rgb({:.3},{:.3},{:.3})",
-                    m.name, m.color.x, m.color.y, m.color.z
+                    "{} rgb({:.3},{:.3},{:.3}) cull {:?}",
+                    m.name, m.color.x, m.color.y, m.color.z, m.cull
                 )
             })
             .collect();
         eprintln!(
-            "object {:?}: {} triangles from {} [{}]",
+            "object {:?}: {} triangles from {} [{}], layer {}, shadows {:?}{}",
             o.name,
             tris[i],
             o.source,
-            names.join("; ")
+            names.join("; "),
+            o.layer,
+            o.cast_shadows,
+            if o.receive_shadows {
+                ""
+            } else {
+                ", receives none"
+            }
         );
+    }
+    for s in skipped {
+        eprintln!("skipped {s}");
+    }
+    if !skipped.is_empty() {
+        eprintln!("skipped {} renderers by Unity's draw rules", skipped.len());
     }
     for l in &soup.lights {
         eprintln!(
-            "light {:?}: {:?} at {} along {}, colour {}, intensity {}, range {}, shadows {:?}",
-            l.name, l.kind, l.position, l.direction, l.color, l.intensity, l.range, l.shadows
+            "light {:?}: {:?} at {} along {}, colour {}, intensity {}, range {}, shadows {:?}, layers {:#010x}",
+            l.name, l.kind, l.position, l.direction, l.color, l.intensity, l.range, l.shadows, l.culling_mask
         );
     }
     let c = &soup.camera;
