@@ -21,8 +21,9 @@ struct Args {
     /// Treat every warning as an error.
     #[arg(long)]
     strict: bool,
-    /// List every converted object (triangles, source, materials), light and warning on
-    /// stderr.
+    /// List every converted object (triangles, source, materials, layer, shadows), every
+    /// renderer Unity's draw rules skip (camera culling mask, LOD above 0), light and
+    /// warning on stderr.
     #[arg(long)]
     list: bool,
 }
@@ -78,6 +79,7 @@ fn run(args: &Args) -> anyhow::Result<()> {
             "materials": soup.materials.len(),
             "warnings": soup.warnings,
             "dropped_degenerate": soup.dropped_degenerate,
+            "skipped": skipped,
             "seconds": secs,
         });
         println!("{j}");
