@@ -2,6 +2,7 @@
 //! once: the pipeline on a Unity project with known pixels, bad input at every stage, and
 //! (ignored by default) a million rays through `raycast` against brute force.
 
+mod draw_rules;
 mod million_rays;
 mod pipeline;
 mod reliability;
