@@ -15,8 +15,8 @@ pub use error::FormatError;
 pub use kd::{BuildParams, KdFile, KdNode, TreeStats};
 pub use rays::{Hit, RayRecord};
 pub use soup::{
-    Ambient, AmbientMode, Camera, ClearFlags, Environment, Light, LightKind, Material, Object,
-    Projection, Shadows, Soup,
+    Ambient, AmbientMode, Camera, CastShadows, ClearFlags, Cull, Environment, Light, LightKind,
+    Material, Object, Projection, Shadows, Soup,
 };
 
 /// BLAKE3 digest, used for geometry hashes and payload checksums.

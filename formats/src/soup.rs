@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 pub const MAGIC: &[u8; 8] = b"UTSOUP\0\0";
-pub const VERSION: u32 = 1;
+pub const VERSION: u32 = 2;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Soup {
@@ -39,6 +39,66 @@ pub struct Object {
     pub name: String,
     /// Where its mesh came from: an asset path relative to the project, or `builtin:Cube` …
     pub source: String,
+    /// The GameObject's `m_Layer`, 0–31: lights light only the layers in their mask.
+    pub layer: u8,
+    /// The renderer's `m_CastShadows`.
+    pub cast_shadows: CastShadows,
+    /// The renderer's `m_ReceiveShadows`: false means lit as if nothing were in the way.
+    pub receive_shadows: bool,
+}
+
+impl Object {
+    /// An object on the Default layer that casts (culled like its material) and receives
+    /// shadows: what Unity gives a new MeshRenderer.
+    pub fn new(name: impl Into<String>, source: impl Into<String>) -> Self {
+        Object {
+            name: name.into(),
+            source: source.into(),
+            layer: 0,
+            cast_shadows: CastShadows::On,
+            receive_shadows: true,
+        }
+    }
+
+    /// Whether camera and reflection rays see the object.
+    pub fn visible(&self) -> bool {
+        self.cast_shadows != CastShadows::ShadowsOnly
+    }
+}
+
+/// `MeshRenderer.m_CastShadows`, in Unity's order (0–3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum CastShadows {
+    Off,
+    /// Casts with the faces its material draws.
+    On,
+    /// Casts from both faces whatever the material culls.
+    TwoSided,
+    /// Casts like `On` but camera and reflection rays pass through it.
+    ShadowsOnly,
+}
+
+/// Which faces a material does not draw: the shader's `_Cull`, in Unity's order (0–2).
+/// The front face is the one the soup's winding shows counter-clockwise.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Cull {
+    /// Two-sided.
+    None,
+    Front,
+    Back,
+}
+
+impl Cull {
+    /// Whether a ray travelling along `dir` skips a face with (unnormalised) winding
+    /// normal `n`: it sees the front when `dir·n < 0`. Edge-on hits are kept.
+    pub fn skips(self, n: Vec3, dir: Vec3) -> bool {
+        let d = n.dot(dir);
+        match self {
+            Cull::None => false,
+            Cull::Back => d > 0.0,
+            Cull::Front => d < 0.0,
+        }
+    }
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -56,6 +116,9 @@ pub struct Material {
     pub reflectivity: Option<f32>,
     /// `_EmissionColor` when emission is enabled, linear RGB (HDR, may exceed 1).
     pub emission: Vec3,
+    /// `_Cull`: the faces camera, reflection and (for casters that are `On`) shadow rays
+    /// pass through.
+    pub cull: Cull,
 }
 
 impl Material {
@@ -69,6 +132,7 @@ impl Material {
             smoothness: 0.5,
             reflectivity: None,
             emission: Vec3::ZERO,
+            cull: Cull::Back,
         }
     }
 
@@ -127,6 +191,15 @@ pub struct Light {
     /// Soft shadows: emitter radius in metres (point, spot) or angular diameter in degrees
     /// (directional).
     pub shadow_radius: f32,
+    /// `m_CullingMask.m_Bits`: bit `l` set means the light lights objects on layer `l`.
+    pub culling_mask: u32,
+}
+
+impl Light {
+    /// Whether the light lights an object on `layer`.
+    pub fn lights_layer(&self, layer: u8) -> bool {
+        layer < 32 && self.culling_mask >> layer & 1 == 1
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -293,6 +366,12 @@ impl Soup {
                 "triangle {i} names object {} of {}",
                 self.tri_object[i],
                 self.objects.len()
+            ));
+        }
+        if let Some(i) = self.objects.iter().position(|o| o.layer >= 32) {
+            return Err(format!(
+                "object {i} is on layer {}; Unity has 32",
+                self.objects[i].layer
             ));
         }
         if let Some(i) = self

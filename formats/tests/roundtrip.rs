@@ -12,8 +12,10 @@ fn sample_soup() -> Soup {
     s.tri_material = vec![0, 0];
     s.tri_object = vec![0, 0];
     s.objects = vec![Object {
-        name: "Cube".into(),
-        source: "builtin:Cube".into(),
+        layer: 9,
+        cast_shadows: CastShadows::ShadowsOnly,
+        receive_shadows: false,
+        ..Object::new("Cube", "builtin:Cube")
     }];
     s.materials = vec![Material::unity_default()];
     s.lights = vec![Light {
@@ -29,6 +31,7 @@ fn sample_soup() -> Soup {
         range: 10.0,
         shadows: Shadows::Soft,
         shadow_radius: 0.1,
+        culling_mask: 0xffff_fdff,
     }];
     s.warnings = vec!["a warning".into()];
     s.seal();
@@ -64,7 +67,7 @@ fn soup_round_trips_through_a_file() {
     assert_eq!(Soup::read(&path).unwrap(), s);
     let bytes = std::fs::read(&path).unwrap();
     assert_eq!(&bytes[..8], b"UTSOUP\0\0");
-    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 1);
+    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 2);
     // Nothing but the artifact is left in the folder (the temp file was renamed).
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
 }
@@ -275,4 +278,74 @@ fn atomic_outputs_get_the_umask_permissions_not_the_temporary_files() {
     let mode = std::fs::metadata(&path).unwrap().permissions().mode() & 0o777;
     assert_eq!(mode, 0o666 & !umask, "mode {mode:o} with umask {umask:o}");
     assert_eq!(std::fs::read(&path).unwrap(), b"bytes");
+}
+
+#[test]
+fn a_version_1_soup_is_refused_with_the_versions_named() {
+    let p = Path::new("old.soup");
+    let mut b = sample_soup().to_bytes(p).unwrap();
+    b[8..12].copy_from_slice(&1u32.to_le_bytes());
+    let msg = Soup::from_bytes(&b, p).unwrap_err().to_string();
+    assert!(
+        msg.contains("soup format version 1, this build reads version 2"),
+        "{msg}"
+    );
+    assert!(msg.contains("re-run the stage that made it"), "{msg}");
+}
+
+#[test]
+fn draw_rule_fields_are_encoded_in_unitys_numbering() {
+    let p = Path::new("rules.soup");
+    let mut s = Soup::empty();
+    s.materials = vec![Material {
+        name: "M".into(),
+        cull: Cull::Front,
+        ..Material::unity_default()
+    }];
+    s.objects = vec![Object {
+        layer: 7,
+        cast_shadows: CastShadows::TwoSided,
+        receive_shadows: false,
+        ..Object::new("Obj", "src")
+    }];
+    let b = s.to_bytes(p).unwrap();
+    let payload = &b[52..];
+    let find = |needle: &[u8]| {
+        payload
+            .windows(needle.len())
+            .position(|w| w == needle)
+            .unwrap()
+    };
+    // Object: name, source, layer u8, cast_shadows u32 variant, receive_shadows bool.
+    let o = find(b"src") + 3;
+    assert_eq!(payload[o], 7);
+    assert_eq!(&payload[o + 1..o + 5], &2u32.to_le_bytes(), "TwoSided is 2");
+    assert_eq!(payload[o + 5], 0);
+    // Material ends with cull (u32 variant) after the 12-byte emission.
+    let m = find(b"builtin:Default-Material") + "builtin:Default-Material".len();
+    let cull = m + 12 + 4 + 4 + 1 + 12;
+    assert_eq!(&payload[cull..cull + 4], &1u32.to_le_bytes(), "Front is 1");
+    assert_eq!(Soup::from_bytes(&b, p).unwrap(), s);
+}
+
+#[test]
+fn an_object_on_layer_32_is_corrupt() {
+    let p = Path::new("layer.soup");
+    let mut s = sample_soup();
+    s.objects[0].layer = 32;
+    let msg = Soup::from_bytes(&s.to_bytes(p).unwrap(), p)
+        .unwrap_err()
+        .to_string();
+    assert!(msg.contains("layer 32"), "{msg}");
+}
+
+#[test]
+fn culling_keeps_the_side_the_winding_shows() {
+    let n = Vec3::Z; // counter-clockwise seen from +Z
+    let towards_front = -Vec3::Z; // a ray from +Z looks at the front
+    assert!(!Cull::Back.skips(n, towards_front));
+    assert!(Cull::Back.skips(n, -towards_front));
+    assert!(Cull::Front.skips(n, towards_front));
+    assert!(!Cull::None.skips(n, -towards_front));
+    assert!(!Cull::Back.skips(n, Vec3::X), "edge-on hits are kept");
 }

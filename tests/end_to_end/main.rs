@@ -3,6 +3,7 @@
 //! crop tiles, and (ignored by default) a million rays through `raycast` against brute force
 //! and a frame rendered on a throwaway Slurm cluster.
 
+mod draw_rules;
 mod million_rays;
 mod pipeline;
 mod reliability;

@@ -6,7 +6,7 @@
 //! right = Unity +X, image up = Unity +Z); a grey 10 m Plane; one point light with hard
 //! shadows at (−2, 2, 0), range 6; a 1 m horizontal Quad at (−1, 1, 1) that shadows the
 //! floor around (0, 0, 2); a 2 m horizontal mirror Quad at (3, 0.5, −3); and 12 m up,
-//! behind the camera, a red emissive Quad that only the mirror can show.
+//! behind the camera, a red emissive Quad facing down that only the mirror can show.
 
 use glam::Vec3;
 use scenegen::effects::Builder;
@@ -45,7 +45,15 @@ fn write_project(root: &Path) -> std::path::PathBuf {
     .mesh("Ground", PLANE, "Grey", Xform::at(0.0, 0.0, 0.0))
     .mesh("Occluder", QUAD, "Grey", flat(-1.0, 1.0, 1.0))
     .mesh("Mirror", QUAD, "Mirror", flat(3.0, 0.5, -3.0).uniform(2.0))
-    .mesh("Glow", QUAD, "Glow", flat(3.0, 12.0, -3.0).uniform(4.0))
+    // Facing down: Unity's Quad is one-sided, and the mirror sees it from below.
+    .mesh(
+        "Glow",
+        QUAD,
+        "Glow",
+        Xform::at(3.0, 12.0, -3.0)
+            .euler(-90.0, 0.0, 0.0)
+            .uniform(4.0),
+    )
     .light(
         "Point Light",
         Xform::at(-2.0, 2.0, 0.0),

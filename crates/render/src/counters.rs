@@ -10,6 +10,11 @@ pub struct RayCounts {
     pub shadow: u64,
     pub soft_shadow: u64,
     pub reflection: u64,
+    /// Camera and reflection rays traced again past a face their material culls or a
+    /// shadows-only object.
+    pub continuation: u64,
+    /// Shadow rays traced again past a surface that casts no shadow that way.
+    pub shadow_continuation: u64,
     /// Samples whose radiance was NaN or infinite and were replaced by 0 (not a ray kind).
     #[serde(skip)]
     pub sanitized: u64,
@@ -21,10 +26,17 @@ impl RayCounts {
         self.shadow += o.shadow;
         self.soft_shadow += o.soft_shadow;
         self.reflection += o.reflection;
+        self.continuation += o.continuation;
+        self.shadow_continuation += o.shadow_continuation;
         self.sanitized += o.sanitized;
     }
     pub fn total(&self) -> u64 {
-        self.camera + self.shadow + self.soft_shadow + self.reflection
+        self.camera
+            + self.shadow
+            + self.soft_shadow
+            + self.reflection
+            + self.continuation
+            + self.shadow_continuation
     }
 }
 
@@ -34,6 +46,8 @@ pub struct SharedCounts {
     shadow: AtomicU64,
     soft_shadow: AtomicU64,
     reflection: AtomicU64,
+    continuation: AtomicU64,
+    shadow_continuation: AtomicU64,
     sanitized: AtomicU64,
 }
 
@@ -43,6 +57,9 @@ impl SharedCounts {
         self.shadow.fetch_add(c.shadow, Relaxed);
         self.soft_shadow.fetch_add(c.soft_shadow, Relaxed);
         self.reflection.fetch_add(c.reflection, Relaxed);
+        self.continuation.fetch_add(c.continuation, Relaxed);
+        self.shadow_continuation
+            .fetch_add(c.shadow_continuation, Relaxed);
         self.sanitized.fetch_add(c.sanitized, Relaxed);
     }
     pub fn load(&self) -> RayCounts {
@@ -51,6 +68,8 @@ impl SharedCounts {
             shadow: self.shadow.load(Relaxed),
             soft_shadow: self.soft_shadow.load(Relaxed),
             reflection: self.reflection.load(Relaxed),
+            continuation: self.continuation.load(Relaxed),
+            shadow_continuation: self.shadow_continuation.load(Relaxed),
             sanitized: self.sanitized.load(Relaxed),
         }
     }

@@ -8,6 +8,13 @@
 //!
 //! n is the interpolated shading normal turned to face the incoming ray; the geometric
 //! normal decides which side a secondary ray leaves from (see [`crate::offset`]).
+//!
+//! Unity's draw rules: camera and reflection rays pass through faces their material culls
+//! and shadows-only objects; shadow rays pass through objects that cast no shadow and
+//! faces the material culls seen from the light (unless the object casts two-sided); a
+//! surface that receives no shadows is lit unoccluded; a light lights only the layers in
+//! its mask. Passing through is the same ray again with `tmin` just above the hit's t:
+//! the same ray parameters give the same t for that triangle, so it is never found again.
 
 use crate::counters::RayCounts;
 use crate::environment;
@@ -17,7 +24,7 @@ use crate::offset::{
 };
 use crate::plan::{Plan, ShadowMode};
 use crate::sampling::{disc_sample, Rng};
-use formats::{Light, LightKind, Soup};
+use formats::{CastShadows, Cull, Hit, Light, LightKind, Soup};
 use glam::Vec3;
 use kdtree::{Accel, Ray};
 
@@ -68,6 +75,10 @@ pub struct Integrator<'a> {
     max_depth: u32,
     cutoff: f32,
     soft_samples: u32,
+    /// Camera and reflection rays check their hits against the culling rules.
+    culling: bool,
+    /// Shadow rays loop closest hits past non-casting surfaces instead of any-hit.
+    shadow_filter: bool,
 }
 
 /// Replace NaN and ±Inf channels by 0; true when something was replaced.
@@ -104,6 +115,8 @@ impl<'a> Integrator<'a> {
             },
             cutoff: plan.reflections.cutoff,
             soft_samples,
+            culling: plan.culling.enabled,
+            shadow_filter: plan.shadow_casting.enabled,
         }
     }
 
@@ -145,7 +158,7 @@ impl<'a> Integrator<'a> {
         counts: &mut RayCounts,
         primary: Option<&mut Primary>,
     ) -> Vec3 {
-        let Some(hit) = self.accel.intersect(ray) else {
+        let Some(hit) = self.first_visible(ray, counts) else {
             return environment::background(&self.soup.environment, ray.dir);
         };
         let prim = hit.prim as usize;
@@ -174,6 +187,7 @@ impl<'a> Integrator<'a> {
         }
 
         let mat = &self.soup.materials[self.soup.tri_material[prim] as usize];
+        let obj = &self.soup.objects[self.soup.tri_object[prim] as usize];
         let albedo = mat.albedo();
         if let Some(pr) = primary {
             *pr = Primary {
@@ -194,6 +208,9 @@ impl<'a> Integrator<'a> {
                 l += environment::ambient(&self.soup.environment, ns) * albedo;
             }
             for al in &self.lights {
+                if !al.light.lights_layer(obj.layer) {
+                    continue;
+                }
                 let Some(inc) = incident(al.light, p) else {
                     continue;
                 };
@@ -201,11 +218,16 @@ impl<'a> Integrator<'a> {
                 if cos <= 0.0 {
                     continue;
                 }
-                let visible = match al.shadows {
+                let shadows = if obj.receive_shadows {
+                    al.shadows
+                } else {
+                    ShadowMode::None
+                };
+                let visible = match shadows {
                     ShadowMode::None => 1.0,
                     ShadowMode::Hard => {
                         counts.shadow += 1;
-                        if self.blocked(&surf, inc.dir, inc.dist) {
+                        if self.blocked(&surf, inc.dir, inc.dist, counts) {
                             0.0
                         } else {
                             1.0
@@ -246,9 +268,46 @@ impl<'a> Integrator<'a> {
         l
     }
 
+    /// The closest hit camera and reflection rays see, continuing past culled faces and
+    /// shadows-only objects (each continuation counted).
+    fn first_visible(&self, ray: &Ray, counts: &mut RayCounts) -> Option<Hit> {
+        let mut hit = self.accel.intersect(ray)?;
+        if !self.culling {
+            return Some(hit);
+        }
+        let mut r = *ray;
+        loop {
+            let prim = hit.prim as usize;
+            let obj = &self.soup.objects[self.soup.tri_object[prim] as usize];
+            let cull = self.soup.materials[self.soup.tri_material[prim] as usize].cull;
+            let through = !obj.visible()
+                || (cull != Cull::None && cull.skips(winding(self.soup, prim), r.dir));
+            if !through {
+                return Some(hit);
+            }
+            counts.continuation += 1;
+            r.tmin = hit.t.next_up();
+            hit = self.accel.intersect(&r)?;
+        }
+    }
+
+    /// Whether the hit triangle `prim` blocks a shadow ray travelling along `dir` (towards
+    /// the light): the shadow pass sees it from the light, looking along −`dir`.
+    fn casts(&self, prim: usize, dir: Vec3) -> bool {
+        let obj = &self.soup.objects[self.soup.tri_object[prim] as usize];
+        match obj.cast_shadows {
+            CastShadows::Off => false,
+            CastShadows::TwoSided => true,
+            CastShadows::On | CastShadows::ShadowsOnly => {
+                let cull = self.soup.materials[self.soup.tri_material[prim] as usize].cull;
+                cull == Cull::None || !cull.skips(winding(self.soup, prim), -dir)
+            }
+        }
+    }
+
     /// Whether the way from the surface at `p` along unit `dir` to a light `dist` away is
     /// blocked (`dist` infinite: a directional light, the ray is unbounded).
-    fn blocked(&self, surf: &Surface, dir: Vec3, dist: f32) -> bool {
+    fn blocked(&self, surf: &Surface, dir: Vec3, dist: f32, counts: &mut RayCounts) -> bool {
         let origin = surf.spawn(dir);
         let p = surf.p;
         let ray = if dist.is_infinite() {
@@ -270,7 +329,18 @@ impl<'a> Integrator<'a> {
                 tmax: d * SHADOW_TMAX_FRACTION,
             }
         };
-        self.accel.occluded(&ray)
+        if !self.shadow_filter {
+            return self.accel.occluded(&ray);
+        }
+        let mut r = ray;
+        while let Some(hit) = self.accel.intersect(&r) {
+            if self.casts(hit.prim as usize, r.dir) {
+                return true;
+            }
+            counts.shadow_continuation += 1;
+            r.tmin = hit.t.next_up();
+        }
+        false
     }
 
     /// Fraction of `soft_samples` stratified shadow rays that reach the light's extent: a
@@ -308,7 +378,7 @@ impl<'a> Integrator<'a> {
                         (1.0, 0.0)
                     };
                     let dir = (t * (c * sin_t) + b * (s * sin_t) + inc.dir * cos_t).normalize();
-                    self.blocked(surf, dir, f32::INFINITY)
+                    self.blocked(surf, dir, f32::INFINITY, counts)
                 }
                 LightKind::Point | LightKind::Spot { .. } => {
                     let q = light.position + (t * dx + b * dy) * light.shadow_radius;
@@ -317,7 +387,7 @@ impl<'a> Integrator<'a> {
                     if dist <= 0.0 {
                         continue;
                     }
-                    self.blocked(surf, to / dist, dist)
+                    self.blocked(surf, to / dist, dist, counts)
                 }
             };
             if !blocked {
@@ -326,4 +396,10 @@ impl<'a> Integrator<'a> {
         }
         visible as f32 / n as f32
     }
+}
+
+/// Triangle `prim`'s winding normal (unnormalised): it points out of the front face.
+fn winding(soup: &Soup, prim: usize) -> Vec3 {
+    let t = &soup.triangles[prim];
+    (t[1] - t[0]).cross(t[2] - t[0])
 }

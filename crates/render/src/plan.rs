@@ -3,7 +3,7 @@
 //! never traced; it is printed, stored in the EXR header and returned in `--json`.
 
 use crate::RenderOptions;
-use formats::{AmbientMode, ClearFlags, LightKind, Shadows, Soup};
+use formats::{AmbientMode, CastShadows, ClearFlags, Cull, LightKind, Shadows, Soup};
 use glam::Vec3;
 use serde::Serialize;
 
@@ -51,11 +51,40 @@ pub struct AntiAliasing {
     pub reason: String,
 }
 
+/// Which surfaces camera and reflection rays pass through: faces their material culls and
+/// shadows-only objects. Each pass-through costs a continuation ray.
+#[derive(Clone, Debug, Serialize)]
+pub struct CullPlan {
+    pub enabled: bool,
+    /// Used materials that cull a face (`_Cull` front or back).
+    pub culling_materials: usize,
+    /// Objects with `m_CastShadows` shadows only.
+    pub shadows_only: usize,
+    pub reason: String,
+}
+
+/// Whether shadow rays must look past surfaces that do not cast (`m_CastShadows` off, or
+/// a face the material culls seen from the light): then they loop closest-hit queries
+/// instead of stopping at the first blocker.
+#[derive(Clone, Debug, Serialize)]
+pub struct ShadowCastPlan {
+    pub enabled: bool,
+    /// Objects with `m_CastShadows` off.
+    pub non_casting: usize,
+    /// Used materials whose culled faces cast no shadow (on objects casting "on").
+    pub culled_in_shadow_pass: usize,
+    /// Objects with `m_ReceiveShadows` off: no shadow rays leave them.
+    pub not_receiving: usize,
+    pub reason: String,
+}
+
 #[derive(Clone, Debug, Serialize)]
 pub struct Plan {
     /// Direct lighting: on when some light is on and some material has a diffuse albedo.
     pub direct: Effect,
     pub lights: Vec<LightPlan>,
+    pub culling: CullPlan,
+    pub shadow_casting: ShadowCastPlan,
     pub reflections: ReflectionPlan,
     pub ambient: Effect,
     pub emission: Effect,
@@ -200,9 +229,13 @@ impl Plan {
             ClearFlags::Skybox => "sky gradient".into(),
         };
 
+        let (culling, shadow_casting) = draw_rules(soup, &used, &lights);
+
         Plan {
             direct,
             lights,
+            culling,
+            shadow_casting,
             reflections,
             ambient,
             emission,
@@ -232,6 +265,16 @@ impl Plan {
             );
         }
         s += &format!(
+            "  culling        {}  {}\n",
+            on(self.culling.enabled),
+            self.culling.reason
+        );
+        s += &format!(
+            "  shadow casting {}  {}\n",
+            on(self.shadow_casting.enabled),
+            self.shadow_casting.reason
+        );
+        s += &format!(
             "  reflections    {}  {}\n",
             on(self.reflections.enabled),
             self.reflections.reason
@@ -259,6 +302,97 @@ impl Plan {
     pub fn to_json(&self) -> serde_json::Value {
         serde_json::to_value(self).unwrap_or(serde_json::Value::Null)
     }
+}
+
+/// The culling and shadow-casting rules the soup's used materials and objects call for.
+fn draw_rules(soup: &Soup, used: &[bool], lights: &[LightPlan]) -> (CullPlan, ShadowCastPlan) {
+    let mut used_obj = vec![false; soup.objects.len()];
+    // Materials whose culled faces matter to shadows: used on an object casting "on".
+    let mut shadow_culled = vec![false; soup.materials.len()];
+    for (&m, &o) in soup.tri_material.iter().zip(&soup.tri_object) {
+        let (Some(obj), Some(mat)) = (soup.objects.get(o as usize), soup.materials.get(m as usize))
+        else {
+            continue;
+        };
+        used_obj[o as usize] = true;
+        if mat.cull != Cull::None
+            && matches!(obj.cast_shadows, CastShadows::On | CastShadows::ShadowsOnly)
+        {
+            shadow_culled[m as usize] = true;
+        }
+    }
+    let used_mats = || {
+        soup.materials
+            .iter()
+            .zip(used)
+            .filter(|(_, &u)| u)
+            .map(|(m, _)| m)
+    };
+    let culling_materials = used_mats().filter(|m| m.cull != Cull::None).count();
+    let front = used_mats().filter(|m| m.cull == Cull::Front).count();
+    let objs = || {
+        soup.objects
+            .iter()
+            .zip(&used_obj)
+            .filter(|(_, &u)| u)
+            .map(|(o, _)| o)
+    };
+    let shadows_only = objs()
+        .filter(|o| o.cast_shadows == CastShadows::ShadowsOnly)
+        .count();
+    let mut why = Vec::new();
+    if culling_materials > 0 {
+        why.push(if front > 0 {
+            format!("back-face culling: {culling_materials} materials ({front} cull front faces)")
+        } else {
+            format!("back-face culling: {culling_materials} materials")
+        });
+    }
+    if shadows_only > 0 {
+        why.push(format!("{shadows_only} shadows-only objects"));
+    }
+    let culling = CullPlan {
+        enabled: !why.is_empty(),
+        culling_materials,
+        shadows_only,
+        reason: if why.is_empty() {
+            "every material is two-sided and every object visible".into()
+        } else {
+            format!(
+                "{}: camera and reflection rays continue past them",
+                why.join(", ")
+            )
+        },
+    };
+
+    let non_casting = objs()
+        .filter(|o| o.cast_shadows == CastShadows::Off)
+        .count();
+    let culled_in_shadow_pass = shadow_culled.iter().filter(|&&c| c).count();
+    let not_receiving = objs().filter(|o| !o.receive_shadows).count();
+    let shadows = lights.iter().any(|l| l.enabled && l.shadow_rays > 0);
+    let filter = non_casting + culled_in_shadow_pass > 0;
+    let shadow_casting = ShadowCastPlan {
+        enabled: shadows && filter,
+        non_casting,
+        culled_in_shadow_pass,
+        not_receiving,
+        reason: if !shadows {
+            "no light traces shadow rays".into()
+        } else if !filter {
+            "every object casts from both faces: shadow rays stop at the first blocker".into()
+        } else {
+            format!(
+                "{non_casting} objects cast no shadow, {culled_in_shadow_pass} materials cull \
+                 faces in the shadow pass: shadow rays continue past them (closest-hit loop)"
+            )
+        } + &if not_receiving > 0 {
+            format!("; {not_receiving} objects receive no shadows")
+        } else {
+            String::new()
+        },
+    };
+    (culling, shadow_casting)
 }
 
 fn is_square(n: u32) -> bool {
@@ -328,6 +462,11 @@ fn light_plan(l: &formats::Light, diffuse: bool, opts: &RenderOptions) -> LightP
                 }
             ),
         ),
+    };
+    let reason = if l.culling_mask == u32::MAX {
+        reason
+    } else {
+        format!("{reason}; lights layers {:#010x} only", l.culling_mask)
     };
     LightPlan {
         name: l.name.clone(),

@@ -78,6 +78,7 @@ impl Emitter<'_, '_> {
             return Err(self.non_finite(go, "camera orientation is degenerate".into()));
         };
         self.soup.camera = camera;
+        self.camera_mask = crate::layer::culling_mask(b);
         self.soup.environment.clear = clear_flags(b);
         if let Some(bg) = b.get("m_BackGroundColor").and_then(Node::color) {
             self.soup.environment.background = linear_rgb(bg);

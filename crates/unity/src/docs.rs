@@ -16,6 +16,7 @@ pub const MESH: u32 = 43;
 pub const RENDER_SETTINGS: u32 = 104;
 pub const LIGHT: u32 = 108;
 pub const SKINNED_MESH_RENDERER: u32 = 137;
+pub const LOD_GROUP: u32 = 205;
 pub const TERRAIN: u32 = 218;
 pub const RECT_TRANSFORM: u32 = 224;
 pub const PREFAB_INSTANCE: u32 = 1001;

@@ -50,6 +50,10 @@ pub(crate) struct Emitter<'g, 'p> {
     /// (model, material name) → the extracted `.mat` found for it, if any: the search
     /// walks folders, and every instance of a model asks again.
     pub(crate) extracted: HashMap<(std::path::PathBuf, String), Option<std::path::PathBuf>>,
+    /// The chosen camera's culling mask (see [`crate::layer`]).
+    pub(crate) camera_mask: u32,
+    /// Renderers not drawn by Unity's own rules, one line each for `--list`.
+    pub(crate) skipped: Vec<String>,
 }
 
 /// What [`emit`] produces.
@@ -61,10 +65,13 @@ pub struct Emitted {
     /// override, a model importer remap, a `Materials/` folder, the model's own, or the
     /// default).
     pub material_origins: Vec<Vec<(u32, String)>>,
+    /// Renderers Unity does not draw by design (outside the camera's culling mask, above
+    /// LOD0), one line each.
+    pub skipped: Vec<String>,
 }
 
-/// The soup, how many enabled cameras on active objects the scene has, and where the
-/// objects' materials came from.
+/// The soup, how many enabled cameras on active objects the scene has, where the
+/// objects' materials came from, and the renderers skipped by Unity's draw rules.
 pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
     let mut e = Emitter {
         g,
@@ -77,6 +84,8 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
         materials: HashMap::new(),
         material_origins: Vec::new(),
         extracted: HashMap::new(),
+        camera_mask: crate::layer::EVERYTHING,
+        skipped: Vec::new(),
     };
     e.soup.warnings = g.warnings.clone();
     for (i, o) in g.objs.iter().enumerate() {
@@ -87,7 +96,23 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
             e.go_comps.entry(go).or_default().push(i);
         }
     }
+    // The camera comes first: its culling mask decides which renderers are converted.
     let mut cameras: Vec<(usize, usize)> = Vec::new(); // (go, camera component)
+    for (gi, o) in g.objs.iter().enumerate() {
+        if o.class != docs::GAME_OBJECT || !e.active(gi) {
+            continue;
+        }
+        for &c in e.go_comps.get(&gi).into_iter().flatten() {
+            if g.objs[c].class == docs::CAMERA && enabled(&g.objs[c]) {
+                cameras.push((gi, c));
+            }
+        }
+    }
+    let before = e.soup.warnings.len();
+    e.camera(&cameras)?;
+    // Keep the camera's warnings after the objects', where they have always been.
+    let camera_warnings = e.soup.warnings.split_off(before);
+    let lod_hidden = e.lod_hidden();
     for (gi, o) in g.objs.iter().enumerate() {
         if o.class != docs::GAME_OBJECT || !e.active(gi) {
             continue;
@@ -97,7 +122,12 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
         if let Some(mf) = class_of(docs::MESH_FILTER) {
             if let Some(mr) = class_of(docs::MESH_RENDERER) {
                 if enabled(&g.objs[mr]) {
-                    e.mesh_object(gi, mf, mr)?;
+                    if let Some(why) = lod_hidden.get(&mr) {
+                        let line = format!("object {:?}: {why}; not converted", e.path(gi));
+                        e.skipped.push(line);
+                    } else if e.camera_draws(gi) {
+                        e.mesh_object(gi, mf, mr)?;
+                    }
                 }
             }
         }
@@ -115,13 +145,8 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
         for &c in comps.iter().filter(|&&i| g.objs[i].class == docs::LIGHT) {
             e.light(gi, c)?;
         }
-        for &c in comps.iter().filter(|&&i| g.objs[i].class == docs::CAMERA) {
-            if enabled(&g.objs[c]) {
-                cameras.push((gi, c));
-            }
-        }
     }
-    e.camera(&cameras)?;
+    e.soup.warnings.extend(camera_warnings);
     if let Some(ambient) = g
         .render_settings
         .as_ref()
@@ -134,6 +159,7 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
         soup: e.soup,
         cameras: cameras.len(),
         material_origins: e.material_origins,
+        skipped: e.skipped,
     })
 }
 

@@ -101,6 +101,7 @@ fn wanted(class: u32) -> bool {
             | docs::LIGHT
             | docs::SKINNED_MESH_RENDERER
             | docs::TERRAIN
+            | docs::LOD_GROUP
     )
 }
 

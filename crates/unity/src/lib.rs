@@ -14,7 +14,9 @@ pub mod environment;
 pub mod fbx;
 mod fbx_pool;
 pub mod graph;
+pub mod layer;
 pub mod light;
+pub mod lod;
 pub mod material;
 pub mod mesh;
 pub mod mesh_source;
@@ -64,6 +66,9 @@ pub struct Report {
     pub cameras: usize,
     /// Per soup object: each soup material it uses and where the material came from.
     pub material_origins: Vec<Vec<(u32, String)>>,
+    /// Renderers Unity does not draw by design (outside the camera's culling mask, above
+    /// LOD0), one line each.
+    pub skipped: Vec<String>,
 }
 
 /// Convert a scene into a sealed soup.
@@ -92,6 +97,7 @@ pub fn convert_report(scene: &Path, opts: &Options) -> Result<Report, ConvertErr
         mut soup,
         cameras,
         material_origins,
+        skipped,
     } = emit::emit(&g, &scene_rel)?;
     // Model-level warnings (missing .mtl …), once per model used.
     let mut model_warnings: Vec<String> = Vec::new();
@@ -120,5 +126,6 @@ pub fn convert_report(scene: &Path, opts: &Options) -> Result<Report, ConvertErr
         soup,
         cameras,
         material_origins,
+        skipped,
     })
 }

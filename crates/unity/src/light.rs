@@ -98,6 +98,7 @@ pub fn convert(
         range,
         shadows,
         shadow_radius,
+        culling_mask: crate::layer::culling_mask(b),
     };
     Some((light, note))
 }

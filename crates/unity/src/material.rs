@@ -8,7 +8,7 @@ use crate::model::Model;
 use crate::project::ModelError;
 use crate::reference::Ref;
 use crate::yaml::Node;
-use formats::Material;
+use formats::{Cull, Material};
 use glam::{Vec3, Vec4};
 use std::path::Path;
 
@@ -92,6 +92,12 @@ pub fn convert(body: &Node, source: &str) -> (Material, Vec<String>) {
     }
     if let Some(x) = float("_Smoothness").or_else(|| float("_Glossiness")) {
         m.smoothness = x.clamp(0.0, 1.0);
+    }
+    // Unity's Standard and Lit shaders cull back faces unless `_Cull` says otherwise.
+    match float("_Cull").map(|c| c.round() as i64) {
+        Some(0) => m.cull = Cull::None,
+        Some(1) => m.cull = Cull::Front,
+        _ => {}
     }
     if let Some(x) = float("_Reflectivity") {
         m.reflectivity = Some(x.clamp(0.0, 1.0));

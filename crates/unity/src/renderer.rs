@@ -3,8 +3,9 @@
 //! renderers draw their posed mesh through the same `draw`.
 
 use crate::emit::{flip, EmitError, Emitter};
+use crate::layer::layer;
 use crate::mesh::Mesh;
-use formats::Object;
+use formats::{CastShadows, Object};
 use glam::{Mat3, Mat4, Vec3};
 
 impl Emitter<'_, '_> {
@@ -45,9 +46,18 @@ impl Emitter<'_, '_> {
         let flip_winding = world.determinant() < 0.0;
         let slots = &g.objs[renderer].materials;
         let obj_index = self.soup.objects.len() as u32;
+        let r = &g.objs[renderer].body;
         self.soup.objects.push(Object {
             name: self.path(go),
             source,
+            layer: layer(&g.objs[go].body),
+            cast_shadows: match r.i64_at("m_CastShadows") {
+                Some(0) => CastShadows::Off,
+                Some(2) => CastShadows::TwoSided,
+                Some(3) => CastShadows::ShadowsOnly,
+                _ => CastShadows::On,
+            },
+            receive_shadows: r.i64_at("m_ReceiveShadows") != Some(0),
         });
         let mut origins: Vec<(u32, String)> = Vec::new();
         let mut emitted = 0usize;

@@ -23,10 +23,7 @@ fn big_soup(path: &Path, n: usize) {
         soup.tri_material.push(0);
         soup.tri_object.push(0);
     }
-    soup.objects.push(formats::Object {
-        name: "noise".into(),
-        source: "test".into(),
-    });
+    soup.objects.push(formats::Object::new("noise", "test"));
     soup.materials.push(formats::Material::unity_default());
     soup.camera.position = Vec3::new(50.0, 50.0, -150.0);
     soup.seal();

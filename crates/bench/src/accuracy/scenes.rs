@@ -3,8 +3,8 @@
 
 use anyhow::{bail, Context, Result};
 use formats::{
-    Ambient, AmbientMode, Camera, ClearFlags, Environment, Light, LightKind, Material, Object,
-    Projection, Shadows, Soup,
+    Ambient, AmbientMode, Camera, ClearFlags, Cull, Environment, Light, LightKind, Material,
+    Object, Projection, Shadows, Soup,
 };
 use glam::Vec3;
 use std::path::Path;
@@ -64,6 +64,8 @@ fn material(name: &str, color: Vec3, metallic: f32, smoothness: f32) -> Material
         smoothness,
         reflectivity: None,
         emission: Vec3::ZERO,
+        // Two-sided: the analytic references draw both faces.
+        cull: Cull::None,
     }
 }
 
@@ -78,6 +80,7 @@ fn point_light(name: &str, position: Vec3, intensity: f32, radius: f32) -> Light
         range: 30.0,
         shadows: Shadows::Soft,
         shadow_radius: radius,
+        culling_mask: u32::MAX,
     }
 }
 
@@ -149,14 +152,8 @@ pub fn mesh_on_mirror(path: &Path) -> Result<Scene> {
         material("mesh", Vec3::new(0.9, 0.55, 0.3), 0.0, 0.5),
     ];
     soup.objects = vec![
-        Object {
-            name: "floor".into(),
-            source: "accuracy".into(),
-        },
-        Object {
-            name: "mesh".into(),
-            source: path.display().to_string(),
-        },
+        Object::new("floor", "accuracy"),
+        Object::new("mesh", path.display().to_string()),
     ];
     floor(&mut soup, 3.0, 0, 0);
     for t in &tris {
@@ -183,6 +180,7 @@ pub fn mesh_on_mirror(path: &Path) -> Result<Scene> {
             range: 0.0,
             shadows: Shadows::Hard,
             shadow_radius: 0.0,
+            culling_mask: u32::MAX,
         },
     ];
     soup.camera = look(Vec3::new(-1.2, 1.3, -2.6), Vec3::new(0.0, 0.45, 0.0), 45.0);
@@ -208,16 +206,7 @@ pub fn tiny() -> Scene {
         material("mirror", Vec3::splat(0.7), 1.0, 0.8),
         material("red", Vec3::new(0.8, 0.2, 0.2), 0.0, 0.5),
     ];
-    soup.objects = vec![
-        Object {
-            name: "floor".into(),
-            source: "tiny".into(),
-        },
-        Object {
-            name: "blocker".into(),
-            source: "tiny".into(),
-        },
-    ];
+    soup.objects = vec![Object::new("floor", "tiny"), Object::new("blocker", "tiny")];
     floor(&mut soup, 2.0, 0, 0);
     // A wall facing the camera (−Z), behind the blocker.
     quad(

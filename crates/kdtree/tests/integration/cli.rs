@@ -27,10 +27,7 @@ fn make_soup(dir: &Path, tris: Vec<[Vec3; 3]>) -> PathBuf {
     soup.tri_material = vec![0; n];
     soup.tri_object = vec![0; n];
     soup.materials = vec![Material::unity_default()];
-    soup.objects = vec![Object {
-        name: "test".into(),
-        source: "generated".into(),
-    }];
+    soup.objects = vec![Object::new("test", "generated")];
     soup.seal();
     let path = dir.join("scene.soup");
     soup.write(&path).unwrap();

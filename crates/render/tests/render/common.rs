@@ -1,6 +1,8 @@
 //! Small scenes built in code for the renderer's tests: quads, boxes, lights, cameras.
 
-use formats::{Camera, KdFile, Light, LightKind, Material, Object, Projection, Shadows, Soup};
+use formats::{
+    Camera, Cull, KdFile, Light, LightKind, Material, Object, Projection, Shadows, Soup,
+};
 use glam::Vec3;
 use render::{render_scene, Plan, RenderOptions, Rendered};
 
@@ -35,10 +37,7 @@ impl SceneBuilder {
     /// A quad with corners `o`, `o + u`, `o + u + v`, `o + v`; its front (and normal) is u × v.
     pub fn quad(&mut self, name: &str, o: Vec3, u: Vec3, v: Vec3, material: u32) -> u32 {
         let obj = self.soup.objects.len() as u32;
-        self.soup.objects.push(Object {
-            name: name.into(),
-            source: "test".into(),
-        });
+        self.soup.objects.push(Object::new(name, "test"));
         let n = u.cross(v).normalize();
         for t in [[o, o + u, o + u + v], [o, o + u + v, o + v]] {
             self.soup.triangles.push(t);
@@ -64,10 +63,7 @@ impl SceneBuilder {
     /// An axis-aligned box from `lo` to `hi`, faces pointing outwards.
     pub fn cube(&mut self, name: &str, lo: Vec3, hi: Vec3, material: u32) -> u32 {
         let obj = self.soup.objects.len() as u32;
-        self.soup.objects.push(Object {
-            name: name.into(),
-            source: "test".into(),
-        });
+        self.soup.objects.push(Object::new(name, "test"));
         let d = hi - lo;
         let (x, y, z) = (Vec3::X * d.x, Vec3::Y * d.y, Vec3::Z * d.z);
         let faces = [
@@ -110,6 +106,8 @@ impl SceneBuilder {
     }
 }
 
+/// Test materials are two-sided (`Cull::None`) so a scene sees both faces unless a test asks
+/// for culling.
 pub fn diffuse(c: Vec3) -> Material {
     Material {
         name: "diffuse".into(),
@@ -119,6 +117,7 @@ pub fn diffuse(c: Vec3) -> Material {
         smoothness: 0.0,
         reflectivity: None,
         emission: Vec3::ZERO,
+        cull: Cull::None,
     }
 }
 
@@ -131,6 +130,7 @@ pub fn mirror(reflectivity: f32) -> Material {
         smoothness: 1.0,
         reflectivity: Some(reflectivity),
         emission: Vec3::ZERO,
+        cull: Cull::None,
     }
 }
 
@@ -143,6 +143,7 @@ pub fn emissive(e: Vec3) -> Material {
         smoothness: 0.0,
         reflectivity: None,
         emission: e,
+        cull: Cull::None,
     }
 }
 
@@ -157,6 +158,7 @@ pub fn point_light(position: Vec3, intensity: f32, range: f32, shadows: Shadows)
         range,
         shadows,
         shadow_radius: 0.0,
+        culling_mask: u32::MAX,
     }
 }
 
@@ -177,6 +179,7 @@ pub fn spot_light(
         range,
         shadows: Shadows::None,
         shadow_radius: 0.0,
+        culling_mask: u32::MAX,
     }
 }
 
@@ -191,6 +194,7 @@ pub fn directional_light(direction: Vec3, intensity: f32, shadows: Shadows) -> L
         range: 0.0,
         shadows,
         shadow_radius: 0.0,
+        culling_mask: u32::MAX,
     }
 }
 

@@ -4,6 +4,7 @@
 
 mod cli;
 mod common;
+mod draw_rules;
 mod exr;
 mod lighting;
 mod plan;

@@ -45,10 +45,7 @@ fn spawned_rays_never_rehit_their_own_triangle() {
             }
             let mut b = SceneBuilder::new();
             let m = b.diffuse(Vec3::ONE);
-            b.soup.objects.push(formats::Object {
-                name: "tri".into(),
-                source: "test".into(),
-            });
+            b.soup.objects.push(formats::Object::new("tri", "test"));
             b.soup.triangles.push(tri);
             b.soup.normals.push([ng; 3]);
             b.soup.tri_material.push(m);

@@ -21,8 +21,9 @@ struct Args {
     /// Treat every warning as an error.
     #[arg(long)]
     strict: bool,
-    /// List every converted object (triangles, source, materials), light and warning on
-    /// stderr.
+    /// List every converted object (triangles, source, materials, layer, shadows), every
+    /// renderer Unity's draw rules skip (camera culling mask, LOD above 0), light and
+    /// warning on stderr.
     #[arg(long)]
     list: bool,
 }
@@ -79,6 +80,7 @@ fn run(args: &Args) -> anyhow::Result<()> {
             "materials": soup.materials.len(),
             "warnings": soup.warnings,
             "dropped_degenerate": soup.dropped_degenerate,
+            "skipped": report.skipped,
             "seconds": secs,
         });
         println!("{j}");
@@ -86,7 +88,7 @@ fn run(args: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// One line per object and light, for checking a conversion by eye.
+/// One line per object, skipped renderer and light, for checking a conversion by eye.
 fn list(report: &unity::Report) {
     let soup = &report.soup;
     let mut tris = vec![0usize; soup.objects.len()];
@@ -108,23 +110,39 @@ fn list(report: &unity::Report) {
                     .map(|(_, o)| o.as_str())
                     .unwrap_or("?");
                 format!(
-                    "{} rgb({:.3},{:.3},{:.3}) from {origin}",
-                    m.name, m.color.x, m.color.y, m.color.z
+                    "{} rgb({:.3},{:.3},{:.3}) cull {:?} from {origin}",
+                    m.name, m.color.x, m.color.y, m.color.z, m.cull
                 )
             })
             .collect();
         eprintln!(
-            "object {:?}: {} triangles from {} [{}]",
+            "object {:?}: {} triangles from {} [{}], layer {}, shadows {:?}{}",
             o.name,
             tris[i],
             o.source,
-            names.join("; ")
+            names.join("; "),
+            o.layer,
+            o.cast_shadows,
+            if o.receive_shadows {
+                ""
+            } else {
+                ", receives none"
+            }
+        );
+    }
+    for s in &report.skipped {
+        eprintln!("skipped {s}");
+    }
+    if !report.skipped.is_empty() {
+        eprintln!(
+            "skipped {} renderers by Unity's draw rules",
+            report.skipped.len()
         );
     }
     for l in &soup.lights {
         eprintln!(
-            "light {:?}: {:?} at {} along {}, colour {}, intensity {}, range {}, shadows {:?}",
-            l.name, l.kind, l.position, l.direction, l.color, l.intensity, l.range, l.shadows
+            "light {:?}: {:?} at {} along {}, colour {}, intensity {}, range {}, shadows {:?}, layers {:#010x}",
+            l.name, l.kind, l.position, l.direction, l.color, l.intensity, l.range, l.shadows, l.culling_mask
         );
     }
     let c = &soup.camera;

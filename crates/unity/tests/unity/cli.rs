@@ -126,7 +126,7 @@ fn unity2soup_list_says_where_each_material_came_from() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(
-        stderr.contains("object \"Box A\": 12 triangles from builtin:Cube [Default-Material rgb(1.000,1.000,1.000) from default]"),
+        stderr.contains("object \"Box A\": 12 triangles from builtin:Cube [Default-Material rgb(1.000,1.000,1.000) cull Back from default], layer 0, shadows On"),
         "{stderr}"
     );
 }

@@ -5,6 +5,7 @@
 mod cli;
 mod convert;
 mod corpus;
+mod draw_rules;
 mod fbx;
 mod fbx_ascii;
 mod fbx_corpus;

@@ -1,0 +1,242 @@
+//! Unity's draw rules with known pixel values: one-sided materials, shadow casting and
+//! receiving, and light culling masks.
+
+use crate::common::*;
+use formats::{CastShadows, Cull, Material, Shadows};
+use glam::Vec3;
+
+const WALL: Vec3 = Vec3::new(0.2, 0.4, 0.6);
+const QUAD: Vec3 = Vec3::new(0.9, 0.1, 0.3);
+
+fn emissive_cull(e: Vec3, cull: Cull) -> Material {
+    Material {
+        cull,
+        ..emissive(e)
+    }
+}
+
+/// A glowing wall at y = 0 facing up, and a glowing quad at y = 5 over it whose front faces
+/// `quad_up` (+Y, towards the camera) or −Y; a camera above looks down at both.
+fn quad_over_wall(cull: Cull, quad_up: bool) -> SceneBuilder {
+    let mut s = SceneBuilder::new();
+    let wall = s.material(emissive_cull(WALL, Cull::Back));
+    s.floor(0.0, 0.0, 0.0, 20.0, wall);
+    let q = s.material(emissive_cull(QUAD, cull));
+    let (u, v) = (Vec3::new(0.0, 0.0, 2.0), Vec3::new(2.0, 0.0, 0.0));
+    let (u, v) = if quad_up { (u, v) } else { (v, u) };
+    s.quad("quad", Vec3::new(-1.0, 5.0, -1.0), u, v, q);
+    s.camera(top_down_camera(Vec3::new(0.0, 10.0, 0.0), 2.0));
+    s
+}
+
+#[test]
+fn a_one_sided_quad_seen_from_behind_shows_the_wall_behind_it() {
+    let (soup, kd) = quad_over_wall(Cull::Back, false).build();
+    let (out, plan) = render(&soup, &kd, &opts(20, 20));
+    // The quad covers the middle half of the view; the camera sees its back.
+    assert_eq!(out.frame.pixel(10, 10), WALL);
+    assert_eq!(out.frame.pixel(0, 0), WALL);
+    assert_eq!(
+        out.counts.continuation,
+        10 * 10,
+        "one continuation per pixel on the quad"
+    );
+    assert!(plan.culling.enabled);
+    assert!(
+        plan.culling
+            .reason
+            .contains("back-face culling: 2 materials"),
+        "{}",
+        plan.culling.reason
+    );
+    assert!(plan.describe().contains("back-face culling: 2 materials"));
+}
+
+#[test]
+fn a_two_sided_quad_seen_from_behind_shows() {
+    let (soup, kd) = quad_over_wall(Cull::None, false).build();
+    let (out, plan) = render(&soup, &kd, &opts(20, 20));
+    assert_eq!(out.frame.pixel(10, 10), QUAD);
+    assert_eq!(out.frame.pixel(0, 0), WALL);
+    assert_eq!(out.counts.continuation, 0);
+    assert!(plan
+        .culling
+        .reason
+        .contains("back-face culling: 1 materials"));
+}
+
+#[test]
+fn a_front_culled_quad_facing_the_camera_is_invisible_and_back_culled_one_shows() {
+    let (soup, kd) = quad_over_wall(Cull::Front, true).build();
+    let (out, _) = render(&soup, &kd, &opts(20, 20));
+    assert_eq!(out.frame.pixel(10, 10), WALL);
+    let (soup, kd) = quad_over_wall(Cull::Back, true).build();
+    let (out, _) = render(&soup, &kd, &opts(20, 20));
+    assert_eq!(out.frame.pixel(10, 10), QUAD);
+    assert_eq!(out.counts.continuation, 0);
+}
+
+#[test]
+fn two_sided_scenes_pay_nothing_for_culling() {
+    let mut s = SceneBuilder::new();
+    let m = s.material(emissive(WALL));
+    s.floor(0.0, 0.0, 0.0, 20.0, m);
+    s.camera(top_down_camera(Vec3::new(0.0, 10.0, 0.0), 2.0));
+    let (soup, kd) = s.build();
+    let (out, plan) = render(&soup, &kd, &opts(8, 8));
+    assert!(!plan.culling.enabled);
+    assert!(!plan.shadow_casting.enabled);
+    assert_eq!(out.counts.continuation + out.counts.shadow_continuation, 0);
+}
+
+/// A white floor lit by a sun travelling along (−1, −1, 0) and a 1 m blocker quad at
+/// y = 1 over x, z ∈ [−0.55, 0.45] (5 × 5 pixel centres, none on an edge) facing
+/// `blocker_up`; its shadow falls on x ∈ [−1.55, −0.55]. The camera sees x, z ∈ [−2, 2]
+/// from above, 20 × 20 pixels.
+struct Shadowed {
+    scene: SceneBuilder,
+    floor: u32,
+    blocker: u32,
+}
+
+fn shadowed(blocker_cull: Cull, blocker_up: bool) -> Shadowed {
+    let mut s = SceneBuilder::new();
+    let white = s.material(Material {
+        cull: Cull::Back,
+        ..diffuse(Vec3::ONE)
+    });
+    let floor = s.floor(0.0, 0.0, 0.0, 20.0, white);
+    let grey = s.material(Material {
+        cull: blocker_cull,
+        ..diffuse(Vec3::splat(0.5))
+    });
+    let (u, v) = (Vec3::new(0.0, 0.0, 1.0), Vec3::new(1.0, 0.0, 0.0));
+    let (u, v) = if blocker_up { (u, v) } else { (v, u) };
+    let blocker = s.quad("blocker", Vec3::new(-0.55, 1.0, -0.55), u, v, grey);
+    s.light(directional_light(
+        Vec3::new(-1.0, -1.0, 0.0),
+        1.0,
+        Shadows::Hard,
+    ));
+    s.camera(top_down_camera(Vec3::new(0.0, 10.0, 0.0), 2.0));
+    Shadowed {
+        scene: s,
+        floor,
+        blocker,
+    }
+}
+
+/// Pixel (14, 10) sees the floor at (−0.9, 0, −0.1): in the blocker's shadow, not under it.
+const IN_SHADOW: (u32, u32) = (14, 10);
+/// Pixel (10, 10) sees the blocker from above (or the floor under it).
+const UNDER: (u32, u32) = (10, 10);
+const LIT: f32 = std::f32::consts::FRAC_1_SQRT_2;
+
+fn pixel(s: Shadowed, at: (u32, u32)) -> (Vec3, render::Rendered, render::Plan) {
+    let (soup, kd) = s.scene.build();
+    let p = ortho_point(&soup.camera, 20, 20, IN_SHADOW.0, IN_SHADOW.1, 0.0);
+    assert!((p - Vec3::new(-0.9, 0.0, -0.1)).length() < 1e-5, "{p}");
+    let (out, plan) = render(&soup, &kd, &opts(20, 20));
+    (out.frame.pixel(at.0, at.1), out, plan)
+}
+
+#[test]
+fn a_blocker_casting_on_throws_a_shadow_from_the_face_the_light_sees() {
+    let (v, _, plan) = pixel(shadowed(Cull::Back, true), IN_SHADOW);
+    assert_eq!(v, Vec3::ZERO);
+    assert!(
+        plan.shadow_casting.enabled,
+        "{}",
+        plan.shadow_casting.reason
+    );
+    // Lit floor elsewhere: n·l = 1/√2.
+    let (v, _, _) = pixel(shadowed(Cull::Back, true), (3, 10));
+    assert_close(v, Vec3::splat(LIT), 1e-5, "lit floor");
+}
+
+#[test]
+fn a_one_sided_blocker_facing_away_from_the_light_casts_no_shadow_unless_two_sided() {
+    let (v, out, _) = pixel(shadowed(Cull::Back, false), IN_SHADOW);
+    assert_close(
+        v,
+        Vec3::splat(LIT),
+        1e-5,
+        "the light sees the blocker's back",
+    );
+    assert!(out.counts.shadow_continuation > 0);
+    let mut s = shadowed(Cull::Back, false);
+    s.scene.soup.objects[s.blocker as usize].cast_shadows = CastShadows::TwoSided;
+    let (v, _, _) = pixel(s, IN_SHADOW);
+    assert_eq!(v, Vec3::ZERO, "two-sided shadows cast from the back face");
+}
+
+#[test]
+fn a_shadows_only_blocker_is_invisible_but_its_shadow_is_on_the_floor() {
+    let mut s = shadowed(Cull::Back, true);
+    s.scene.soup.objects[s.blocker as usize].cast_shadows = CastShadows::ShadowsOnly;
+    let (v, out, plan) = pixel(s, IN_SHADOW);
+    assert_eq!(v, Vec3::ZERO, "no direct light in its shadow");
+    assert_eq!(plan.culling.shadows_only, 1);
+    // From above the camera sees through the blocker to the lit floor under it.
+    assert_close(
+        out.frame.pixel(UNDER.0, UNDER.1),
+        Vec3::splat(LIT),
+        1e-5,
+        "under",
+    );
+    assert_eq!(
+        out.counts.continuation,
+        5 * 5,
+        "a continuation per pixel on the blocker"
+    );
+}
+
+#[test]
+fn a_blocker_casting_off_casts_no_shadow_but_shows() {
+    let mut s = shadowed(Cull::None, true);
+    s.scene.soup.objects[s.blocker as usize].cast_shadows = CastShadows::Off;
+    let (v, out, plan) = pixel(s, IN_SHADOW);
+    assert_close(v, Vec3::splat(LIT), 1e-5, "floor in the would-be shadow");
+    assert_eq!(plan.shadow_casting.non_casting, 1);
+    assert!(plan.shadow_casting.enabled);
+    // The blocker itself is drawn, lit from its front: 0.5 · 1/√2.
+    assert_close(
+        out.frame.pixel(UNDER.0, UNDER.1),
+        Vec3::splat(0.5 * LIT),
+        1e-5,
+        "blocker",
+    );
+}
+
+#[test]
+fn a_floor_that_receives_no_shadows_is_lit_under_the_occluder() {
+    let mut s = shadowed(Cull::Back, true);
+    s.scene.soup.objects[s.floor as usize].receive_shadows = false;
+    let (v, out, plan) = pixel(s, IN_SHADOW);
+    assert_close(v, Vec3::splat(LIT), 1e-5, "floor under the occluder");
+    assert_eq!(plan.shadow_casting.not_receiving, 1);
+    // Only the blocker's 25 pixels send shadow rays.
+    assert_eq!(out.counts.shadow, 5 * 5);
+}
+
+#[test]
+fn a_light_leaves_objects_outside_its_culling_mask_unlit() {
+    let mut s = shadowed(Cull::None, true);
+    s.scene.soup.objects[s.blocker as usize].layer = 8;
+    s.scene.soup.lights[0].culling_mask = !(1 << 8);
+    let (v, out, plan) = pixel(s, UNDER);
+    assert_eq!(v, Vec3::ZERO, "the blocker on layer 8 is unlit");
+    // Still casting: the light's mask decides what it lights, not what casts.
+    assert_eq!(out.frame.pixel(IN_SHADOW.0, IN_SHADOW.1), Vec3::ZERO);
+    assert_close(
+        out.frame.pixel(3, 10),
+        Vec3::splat(LIT),
+        1e-5,
+        "layer 0 floor",
+    );
+    // No shadow rays towards a light for a surface it does not light.
+    assert_eq!(out.counts.shadow, 20 * 20 - 5 * 5);
+    assert!(plan.lights[0]
+        .reason
+        .contains("lights layers 0xfffffeff only"));
+}
