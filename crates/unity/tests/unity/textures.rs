@@ -152,7 +152,10 @@ fn every_corpus_material_loads_or_says_why() {
             match load_albedo(&project, &body) {
                 Ok(Some(_)) => loaded += 1,
                 Ok(None) => untextured += 1,
-                Err(e) => errors.push(e),
+                Err(e) => {
+                    eprintln!("{}: {e}", project.rel(&m));
+                    errors.push(e)
+                }
             }
         }
     }
