@@ -256,7 +256,7 @@ mod tests {
     fn constant_texture_is_constant_at_every_level() {
         let c = [200, 17, 99, 128];
         for filter in [Filter::Point, Filter::Bilinear, Filter::Trilinear] {
-            let mut t = texture(7, 5, &vec![c; 35], filter, Wrap::Mirror);
+            let mut t = texture(7, 5, &[c; 35], filter, Wrap::Mirror);
             t.srgb = true;
             let want = Vec4::from_array(t.texel(0, 0));
             let s = Sampler::new(&t);
