@@ -170,3 +170,76 @@ fn every_corpus_material_loads_or_says_why() {
         .iter()
         .any(|e| matches!(e, TextureError::Unresolved { .. })));
 }
+
+/// Every corpus model: each mesh has one UV per position or none, all finite, and the
+/// FBX and OBJ files that carry texture coordinates keep them.
+#[test]
+fn corpus_models_carry_their_uvs() {
+    let Some(root) = corpus() else { return };
+    let (mut with, mut without) = (0usize, 0usize);
+    let mut stack = vec![root.clone()];
+    let mut models = Vec::new();
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p
+                .extension()
+                .is_some_and(|x| x.eq_ignore_ascii_case("fbx") || x == "obj")
+            {
+                models.push(p);
+            }
+        }
+    }
+    models.sort();
+    for path in models {
+        let Some(project_root) = unity::project::find_root(path.parent().unwrap()) else {
+            continue;
+        };
+        let project = Project::open(&project_root);
+        let loaded = project.model(&path);
+        let Ok(asset) = loaded.as_ref() else { continue };
+        for m in &asset.model.meshes {
+            let mesh = &m.mesh;
+            if mesh.uvs.is_empty() {
+                without += 1;
+                continue;
+            }
+            with += 1;
+            assert_eq!(mesh.uvs.len(), mesh.positions.len(), "{}", path.display());
+            assert!(
+                mesh.uvs.iter().all(|uv| uv.is_finite()),
+                "{}",
+                path.display()
+            );
+        }
+    }
+    eprintln!("corpus model meshes: {with} with UVs, {without} without");
+    assert!(with > 100, "{with}");
+}
+
+/// CubeRoom's WindowTest holds scene-embedded meshes in Unity 2017's 8-channel layout,
+/// with UV0 in channel 3.
+#[test]
+fn corpus_embedded_meshes_have_uv0() {
+    let Some(root) = corpus() else { return };
+    let path = root.join("jonike__CubeRoom/Assets/Scenes/WindowTest.unity");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let mut decoded = 0;
+    for d in unity::docs::split(&text)
+        .into_iter()
+        .filter(|d| d.class == unity::docs::MESH)
+    {
+        let mesh = unity::embedded::decode(&d.parse()).unwrap();
+        assert_eq!(mesh.uvs.len(), mesh.positions.len());
+        // A real unwrap spans the texture, it is not one point.
+        assert!(mesh.uvs.iter().any(|&uv| uv != mesh.uvs[0]));
+        assert!(mesh
+            .uvs
+            .iter()
+            .all(|uv| uv.is_finite() && uv.abs().max_element() < 1e3));
+        decoded += 1;
+    }
+    assert_eq!(decoded, 4);
+}
