@@ -9,6 +9,7 @@ pub mod error;
 pub mod kd;
 pub mod rays;
 pub mod soup;
+pub mod texture;
 
 pub use envelope::write_atomic;
 pub use error::FormatError;

@@ -28,6 +28,7 @@ pub mod plan;
 pub mod preview;
 pub mod render;
 pub mod sampling;
+pub mod texture;
 
 pub use aov::{Aov, AovSet};
 pub use camera::CameraModel;

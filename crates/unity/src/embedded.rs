@@ -4,7 +4,7 @@
 
 use crate::mesh::{smooth_normals, Mesh};
 use crate::yaml::Node;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 fn hex(s: &str) -> Result<Vec<u8>, String> {
     let s = s.trim();
@@ -118,6 +118,33 @@ pub fn decode(body: &Node) -> Result<Mesh, String> {
         None => None,
     };
 
+    // UV0 is channel 3 in Unity ≤ 2018's 8-channel layout (position, normal, colour, UV0…)
+    // and channel 4 in 2019+'s 14 (position, normal, tangent, colour, UV0…). Only float
+    // and half UVs are read; any other encoding, or a short stream, leaves the mesh
+    // without UVs rather than refusing geometry that converts without them.
+    let uv_channel = if channels.len() >= 14 { 4 } else { 3 };
+    let uvs: Vec<Vec2> = channels
+        .get(uv_channel)
+        .filter(|c| c.dim >= 2 && (c.format == 0 || c.format == 1))
+        .and_then(|c| {
+            let size = if c.format == 0 { 4 } else { 2 };
+            (0..count)
+                .map(|i| {
+                    let base = start[c.stream] + stride[c.stream] * i + c.offset;
+                    let f = |k: usize| -> Option<f32> {
+                        let b = data.get(base + size * k..base + size * (k + 1))?;
+                        Some(if size == 4 {
+                            f32::from_le_bytes([b[0], b[1], b[2], b[3]])
+                        } else {
+                            f16_to_f32(u16::from_le_bytes([b[0], b[1]]))
+                        })
+                    };
+                    Some(Vec2::new(f(0)?, f(1)?))
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+
     let ib = hex(body.str_at("m_IndexBuffer").unwrap_or(""))?;
     let wide = body.i64_at("m_IndexFormat") == Some(1);
     let index = |k: usize| -> Option<u32> {
@@ -178,7 +205,21 @@ pub fn decode(body: &Node) -> Result<Mesh, String> {
         positions,
         normals,
         submeshes,
+        uvs,
     })
+}
+
+/// IEEE half → single (Unity's Float16 vertex format).
+fn f16_to_f32(h: u16) -> f32 {
+    let sign = if h & 0x8000 != 0 { -1.0 } else { 1.0 };
+    let exp = ((h >> 10) & 0x1f) as i32;
+    let frac = (h & 0x3ff) as f32;
+    sign * match exp {
+        0 => frac * 2f32.powi(-24),
+        31 if frac == 0.0 => f32::INFINITY,
+        31 => f32::NAN,
+        _ => (1.0 + frac / 1024.0) * 2f32.powi(exp - 15),
+    }
 }
 
 #[cfg(test)]
@@ -206,6 +247,7 @@ mod tests {
         assert_eq!(m.positions[1], Vec3::Y);
         assert_eq!(m.normals[2], Vec3::NEG_Z);
         assert_eq!(m.submeshes, vec![vec![[0, 1, 2]]]);
+        assert!(m.uvs.is_empty());
 
         // Fuzzer find: a stream number of 8·10¹⁷ asked for a vector that long; absurd
         // streams, offsets and counts are errors before anything is allocated.
@@ -224,6 +266,60 @@ mod tests {
             let bad = text.replace(from, to);
             let e = decode(parse(&bad).get("Mesh").unwrap()).unwrap_err();
             assert!(e.contains("stream") || e.contains("m_VertexCount"), "{e}");
+        }
+    }
+
+    #[test]
+    fn reads_uv0_in_both_channel_layouts() {
+        // Position (12 bytes) then UV0 (8 bytes float, or 4 bytes half) per vertex.
+        let build = |channels: usize, uv_at: usize, half: bool| {
+            let mut data = String::new();
+            for (p, uv) in [
+                ([0.0f32, 0.0, 0.0], [0.0f32, 0.0]),
+                ([0.0, 1.0, 0.0], [0.0, 1.0]),
+                ([1.0, 0.0, 0.0], [0.5, -2.0]),
+            ] {
+                for v in p {
+                    for b in v.to_le_bytes() {
+                        data += &format!("{b:02x}");
+                    }
+                }
+                for v in uv {
+                    if half {
+                        // 0 → 0x0000, 0.5 → 0x3800, 1 → 0x3c00, −2 → 0xc000.
+                        let h: u16 = match v {
+                            0.0 => 0,
+                            0.5 => 0x3800,
+                            1.0 => 0x3c00,
+                            _ => 0xc000,
+                        };
+                        data += &format!("{:02x}{:02x}", h & 0xff, h >> 8);
+                    } else {
+                        for b in v.to_le_bytes() {
+                            data += &format!("{b:02x}");
+                        }
+                    }
+                }
+            }
+            let mut ch = String::new();
+            for i in 0..channels {
+                let (offset, format, dim) = match i {
+                    0 => (0, 0, 3),
+                    i if i == uv_at => (12, half as i32, 2),
+                    _ => (0, 0, 0),
+                };
+                ch += &format!("    - stream: 0\n      offset: {offset}\n      format: {format}\n      dimension: {dim}\n");
+            }
+            format!("Mesh:\n  m_SubMeshes:\n  - serializedVersion: 2\n    firstByte: 0\n    indexCount: 3\n    topology: 0\n    baseVertex: 0\n  m_IndexFormat: 0\n  m_IndexBuffer: 000001000200\n  m_VertexData:\n    m_VertexCount: 3\n    m_Channels:\n{ch}    _typelessdata: {data}\n")
+        };
+        for (channels, uv_at, half) in [(8, 3, false), (14, 4, false), (14, 4, true)] {
+            let text = build(channels, uv_at, half);
+            let m = decode(parse(&text).get("Mesh").unwrap()).unwrap();
+            assert_eq!(
+                m.uvs,
+                vec![Vec2::ZERO, Vec2::Y, Vec2::new(0.5, -2.0)],
+                "{channels} channels, half {half}"
+            );
         }
     }
 }

@@ -23,7 +23,7 @@ use crate::fbx_pool::{thread_opts, Pool};
 use crate::mesh::{smooth_normals, Mesh, EAR_CLIP_MAX};
 use crate::meta::ModelMeta;
 use crate::model::{Model, ModelMaterial, ModelMesh, ModelNode, Skin};
-use glam::{DMat3, DMat4, DQuat, DVec3, Mat4, Vec3};
+use glam::{DMat3, DMat4, DQuat, DVec3, Mat4, Vec2, Vec3};
 use rayon::prelude::*;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -55,7 +55,8 @@ struct Weld {
     len: Vec<u8>,
     /// Per output vertex: the next older output of the same source vertex.
     next: Vec<u32>,
-    overflow: HashMap<(u32, [u32; 3]), u32>,
+    /// Past the chain: (source vertex, normal and UV bits) → output vertex.
+    overflow: HashMap<(u32, [u32; 5]), u32>,
 }
 
 const NONE: u32 = u32::MAX;
@@ -71,23 +72,30 @@ impl Weld {
         }
     }
 
-    /// The output vertex of (`v`, `normal`); `add` appends it to `mesh` when it is new.
+    /// The output vertex of (`v`, `normal`, `uv`); `add` appends it to `mesh` when it is
+    /// new. `uv` counts only when the mesh has UVs (`add` pushes one per vertex then).
     fn vertex(
         &mut self,
         v: u32,
         normal: Vec3,
+        uv: Vec2,
         add: impl FnOnce(&mut Mesh),
         mesh: &mut Mesh,
     ) -> u32 {
-        let bits = normal.to_array().map(f32::to_bits);
+        let nb = normal.to_array().map(f32::to_bits);
+        let ub = uv.to_array().map(f32::to_bits);
+        let bits = [nb[0], nb[1], nb[2], ub[0], ub[1]];
         let vi = v as usize;
         if vi >= self.head.len() {
             // Callers clamp `v`; stay total anyway.
             return 0;
         }
+        let with_uv = !mesh.uvs.is_empty();
         let mut o = self.head[vi];
         while o != NONE {
-            if mesh.normals[o as usize].to_array().map(f32::to_bits) == bits {
+            if mesh.normals[o as usize].to_array().map(f32::to_bits) == nb
+                && (!with_uv || mesh.uvs[o as usize].to_array().map(f32::to_bits) == ub)
+            {
                 return o;
             }
             o = self.next[o as usize];
@@ -521,10 +529,22 @@ impl Importer {
             Vec::new()
         };
         let corners: usize = subs.iter().map(|t| 3 * t.len()).sum();
+        // UV0 as Unity imports it: the file's values, not flipped.
+        let uv_values: Vec<Vec2> = if m.vertex_uv.exists {
+            m.vertex_uv
+                .values
+                .iter()
+                .map(|t| Vec2::new(t.x as f32, t.y as f32))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let has_uv = !uv_values.is_empty();
         let mut mesh = Mesh {
             positions: Vec::with_capacity(positions.len()),
             normals: Vec::with_capacity(positions.len()),
             submeshes: Vec::with_capacity(subs.len()),
+            uvs: Vec::with_capacity(if has_uv { positions.len() } else { 0 }),
         };
         let mut src_vertex: Vec<u32> = Vec::with_capacity(positions.len());
         let mut weld = Weld::new(positions.len().max(1), corners);
@@ -547,13 +567,27 @@ impl Importer {
                     } else {
                         smooth[k][jj]
                     };
+                    let uv = if has_uv {
+                        m.vertex_uv
+                            .indices
+                            .get(ix as usize)
+                            .and_then(|&i| uv_values.get(i as usize))
+                            .copied()
+                            .unwrap_or(Vec2::ZERO)
+                    } else {
+                        Vec2::ZERO
+                    };
                     corners[jj] = weld.vertex(
                         v,
                         normal,
+                        uv,
                         |o| {
                             o.positions
                                 .push(positions.get(v as usize).copied().unwrap_or_default());
                             o.normals.push(normal);
+                            if has_uv {
+                                o.uvs.push(uv);
+                            }
                             src_vertex.push(v);
                         },
                         &mut mesh,
@@ -673,6 +707,7 @@ mod tests {
                 weld.vertex(
                     v,
                     n,
+                    Vec2::ZERO,
                     |o| {
                         o.positions.push(Vec3::splat(v as f32));
                         o.normals.push(n);
@@ -685,5 +720,48 @@ mod tests {
         assert_eq!(got, want);
         assert_eq!(mesh.positions.len(), 40 + 8 * 3 + 1);
         assert_eq!(mesh.normals.len(), mesh.positions.len());
+    }
+
+    #[test]
+    fn weld_splits_where_uvs_differ() {
+        // Vertex 0 with one normal and 20 UVs (past the chain), each twice; vertex 1 with
+        // one UV. Numbering must match a map keyed by (vertex, normal, UV).
+        let mut corners = Vec::new();
+        for _ in 0..2 {
+            for k in 0..20u32 {
+                corners.push((0, Vec2::new(k as f32 * 0.5, -1.0)));
+                corners.push((1, Vec2::new(0.25, 0.75)));
+            }
+        }
+        let mut mesh = Mesh::default();
+        let mut weld = Weld::new(2, corners.len());
+        let got: Vec<u32> = corners
+            .iter()
+            .map(|&(v, uv)| {
+                weld.vertex(
+                    v,
+                    Vec3::Z,
+                    uv,
+                    |o| {
+                        o.positions.push(Vec3::splat(v as f32));
+                        o.normals.push(Vec3::Z);
+                        o.uvs.push(uv);
+                    },
+                    &mut mesh,
+                )
+            })
+            .collect();
+        let mut map = HashMap::new();
+        let want: Vec<u32> = corners
+            .iter()
+            .map(|&(v, uv)| {
+                let next = map.len() as u32;
+                *map.entry((v, uv.to_array().map(f32::to_bits)))
+                    .or_insert(next)
+            })
+            .collect();
+        assert_eq!(got, want);
+        assert_eq!(mesh.uvs.len(), 21);
+        assert_eq!(mesh.uvs[want[2] as usize], Vec2::new(0.5, -1.0));
     }
 }

@@ -38,7 +38,7 @@ pub fn linear_rgb(c: Vec4) -> Vec3 {
 
 /// The named float and colour properties of `m_SavedProperties`, in either layout: the
 /// modern `- _Name: value` list, or Unity ≤ 5.5's repeated `data: {first: {name}, second}`.
-fn props<'a>(saved: &'a Node, section: &str) -> Vec<(&'a str, &'a Node)> {
+pub(crate) fn props<'a>(saved: &'a Node, section: &str) -> Vec<(&'a str, &'a Node)> {
     let Some(sec) = saved.get(section) else {
         return vec![];
     };

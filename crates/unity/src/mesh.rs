@@ -15,6 +15,10 @@ pub struct Mesh {
     pub normals: Vec<Vec3>,
     /// Triangles of each sub-mesh (indices into `positions`).
     pub submeshes: Vec<Vec<[u32; 3]>>,
+    /// First UV channel, one per position, (0, 0) at the texture's bottom-left; empty when
+    /// the mesh has none. Unity space and file space agree on UVs: importing mirrors
+    /// positions, never texture coordinates.
+    pub uvs: Vec<Vec2>,
 }
 
 impl Mesh {

@@ -125,10 +125,15 @@ impl Emitter<'_, '_> {
             .as_ref()
             .map_err(|e| format!("{why}; fallback {name}: {e}"))?;
         let mut all = Mesh::default();
+        // UVs survive the merge only if every part has them (one per position or none).
+        let uvs = asset.model.meshes.iter().all(|m| !m.mesh.uvs.is_empty());
         for m in &asset.model.meshes {
             let base = all.positions.len() as u32;
             all.positions.extend(&m.mesh.positions);
             all.normals.extend(&m.mesh.normals);
+            if uvs {
+                all.uvs.extend(&m.mesh.uvs);
+            }
             for sm in &m.mesh.submeshes {
                 all.submeshes
                     .push(sm.iter().map(|t| t.map(|i| i + base)).collect());

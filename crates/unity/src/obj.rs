@@ -10,7 +10,7 @@
 use crate::material::linear_rgb;
 use crate::mesh::{smooth_normals, triangulate, Mesh};
 use crate::model::{Model, ModelMaterial, ModelMesh, ModelNode};
-use glam::{Quat, Vec3};
+use glam::{Quat, Vec2, Vec3};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -108,8 +108,9 @@ impl ObjModel {
     }
 }
 
-/// A face corner: position index and the file's normal index, if any.
-type Corner = (u32, Option<u32>);
+/// A face corner: position index, and the file's normal and texture-coordinate indices,
+/// if any.
+type Corner = (u32, Option<u32>, Option<u32>);
 
 struct GroupAcc {
     name: String,
@@ -171,6 +172,7 @@ pub fn parse(text: &str, path: &Path) -> Result<ObjModel, ObjError> {
 pub fn parse_in(text: &str, path: &Path, root: &Path) -> Result<ObjModel, ObjError> {
     let mut pos: Vec<Vec3> = Vec::new();
     let mut nrm: Vec<Vec3> = Vec::new();
+    let mut tex: Vec<Vec2> = Vec::new();
     let mut groups: Vec<GroupAcc> = Vec::new();
     let mut group_of: HashMap<String, usize> = HashMap::new();
     let mut current_group = "default".to_string();
@@ -214,6 +216,17 @@ pub fn parse_in(text: &str, path: &Path, root: &Path) -> Result<ObjModel, ObjErr
         match tag {
             "v" => pos.push(floats(it)?),
             "vn" => nrm.push(floats(it)?),
+            // Texture coordinates are not validated like positions: before UVs were read,
+            // a file with odd `vt` lines converted, and it still does (without them).
+            "vt" => {
+                let mut f = it.map(|s| s.parse::<f32>().ok());
+                let u = f.next().flatten();
+                let v = f.next().flatten().or(u.map(|_| 0.0));
+                tex.push(match (u, v) {
+                    (Some(u), Some(v)) => Vec2::new(u, v),
+                    _ => Vec2::NAN,
+                });
+            }
             // Unity's OBJ importer names meshes by `g` only: `o` is ignored (corpus:
             // COMP396 suzanne.obj has only `o Suzanne_Suzanne.001`, and its .meta calls
             // the mesh `default`).
@@ -237,7 +250,13 @@ pub fn parse_in(text: &str, path: &Path, root: &Path) -> Result<ObjModel, ObjErr
                         .ok_or_else(|| bad(lno, format!("bad face corner `{}`", shown(c))))?;
                     let v = resolve(vi, pos.len())
                         .ok_or_else(|| bad(lno, format!("vertex index {vi} out of range")))?;
-                    let _vt = parts.next();
+                    // A missing or out-of-range `vt` index leaves the corner without UV
+                    // rather than failing a file Unity imports.
+                    let t = parts
+                        .next()
+                        .and_then(|s| s.parse::<i64>().ok())
+                        .and_then(|ti| resolve(ti, tex.len()))
+                        .filter(|&ti| tex[ti as usize].is_finite());
                     let n = match parts.next().filter(|s| !s.is_empty()) {
                         Some(s) => {
                             let ni: i64 = s.parse().map_err(|_| {
@@ -249,7 +268,7 @@ pub fn parse_in(text: &str, path: &Path, root: &Path) -> Result<ObjModel, ObjErr
                         }
                         None => None,
                     };
-                    poly.push((v, n));
+                    poly.push((v, n, t));
                 }
                 if poly.len() < 3 {
                     if short_faces.0 == 0 {
@@ -312,7 +331,7 @@ pub fn parse_in(text: &str, path: &Path, root: &Path) -> Result<ObjModel, ObjErr
 
     let groups = groups
         .into_iter()
-        .map(|g| build_group(g, &pos, &nrm))
+        .map(|g| build_group(g, &pos, &nrm, &tex))
         .collect();
     Ok(ObjModel {
         path: path.to_path_buf(),
@@ -324,14 +343,14 @@ pub fn parse_in(text: &str, path: &Path, root: &Path) -> Result<ObjModel, ObjErr
 
 /// Triangulate a group's polygons and give every corner a normal (the file's, or a
 /// smoothed one split at 60° creases), then convert to Unity space.
-fn build_group(g: GroupAcc, pos: &[Vec3], nrm: &[Vec3]) -> ObjGroup {
+fn build_group(g: GroupAcc, pos: &[Vec3], nrm: &[Vec3], tex: &[Vec2]) -> ObjGroup {
     // Triangles as (position index, file normal index) corners, per sub-mesh.
     let mut subs_tris: Vec<Vec<[Corner; 3]>> = Vec::new();
     let mut materials = Vec::new();
     for (mtl, polys) in g.subs {
         let mut tris = Vec::new();
         for poly in polys {
-            let pts: Vec<Vec3> = poly.iter().map(|&(v, _)| pos[v as usize]).collect();
+            let pts: Vec<Vec3> = poly.iter().map(|&(v, ..)| pos[v as usize]).collect();
             for t in triangulate(&pts) {
                 tris.push(t.map(|k| poly[k]));
             }
@@ -348,22 +367,34 @@ fn build_group(g: GroupAcc, pos: &[Vec3], nrm: &[Vec3]) -> ObjGroup {
     } else {
         Vec::new()
     };
+    // A group with texture coordinates on any corner has one UV per vertex (zero where a
+    // corner has none, as Unity fills a missing channel entry).
+    let has_uv = subs_tris.iter().flatten().flatten().any(|c| c.2.is_some());
     let mut mesh = Mesh::default();
-    let mut vmap: HashMap<(u32, [u32; 3]), u32> = HashMap::new();
+    let mut vmap: HashMap<(u32, [u32; 3], [u32; 2]), u32> = HashMap::new();
     let mut k = 0usize;
     for tris in subs_tris {
         let mut out = Vec::with_capacity(tris.len());
         for t in tris {
             let mut tri = [0u32; 3];
-            for (j, &(v, n)) in t.iter().enumerate() {
+            for (j, &(v, n, ti)) in t.iter().enumerate() {
                 let normal = match n {
                     Some(ni) => nrm[ni as usize].normalize_or_zero(),
                     None => smooth[k][j],
                 };
-                let key = (v, normal.to_array().map(f32::to_bits));
+                let uv = ti.map_or(Vec2::ZERO, |ti| tex[ti as usize]);
+                // Vertices split where their UV differs, as at a texture seam.
+                let key = (
+                    v,
+                    normal.to_array().map(f32::to_bits),
+                    uv.to_array().map(f32::to_bits),
+                );
                 tri[j] = *vmap.entry(key).or_insert_with(|| {
                     mesh.positions.push(pos[v as usize]);
                     mesh.normals.push(normal);
+                    if has_uv {
+                        mesh.uvs.push(uv);
+                    }
                     (mesh.positions.len() - 1) as u32
                 });
             }
@@ -399,6 +430,36 @@ fn parse_mtl(text: &str, out: &mut HashMap<String, Vec3>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn texture_coordinates_split_vertices_at_seams() {
+        // Two triangles sharing the edge 1–3; corner 3 has a different vt in each face
+        // (a seam), corner 1 the same. Group B has no vt at all.
+        let text =
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0.5 0.25\nvt 0 1\n\
+                    g A\nf 1/1 2/2 3/3\nf 1/1 3/4 4/5\ng B\nf 1 2 3\ng C\nf 1/1 2/9 3/-1\n";
+        let m = parse(text, Path::new("t.obj")).unwrap();
+        let a = &m.groups[0].mesh;
+        assert_eq!(a.positions.len(), 5);
+        assert_eq!(a.uvs.len(), a.positions.len());
+        // Positions are mirrored (x → −x) on import; UVs are not.
+        let uv_at = |p: Vec3| -> Vec<Vec2> {
+            (0..a.positions.len())
+                .filter(|&i| a.positions[i] == p)
+                .map(|i| a.uvs[i])
+                .collect()
+        };
+        assert_eq!(uv_at(Vec3::ZERO), vec![Vec2::ZERO]);
+        assert_eq!(uv_at(Vec3::new(-1.0, 0.0, 0.0)), vec![Vec2::X]);
+        assert_eq!(
+            uv_at(Vec3::new(-1.0, 1.0, 0.0)),
+            vec![Vec2::ONE, Vec2::new(0.5, 0.25)]
+        );
+        assert!(m.groups[1].mesh.uvs.is_empty());
+        // An out-of-range vt index leaves that corner at (0, 0), as before UVs were read.
+        let c = &m.groups[2].mesh;
+        assert_eq!(c.uvs, vec![Vec2::ZERO, Vec2::ZERO, Vec2::Y]);
+    }
 
     #[test]
     fn groups_merge_by_name_and_faceless_groups_vanish() {

@@ -3,7 +3,7 @@
 //! counter-clockwise data and imported like an OBJ ([`Mesh::import_rh`]).
 
 use crate::mesh::Mesh;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use std::f32::consts::{PI, TAU};
 
 pub const BUILTIN_MESH_GUID: &str = "0000000000000000e000000000000000";
@@ -40,6 +40,8 @@ struct Builder {
     p: Vec<Vec3>,
     n: Vec<Vec3>,
     t: Vec<[u32; 3]>,
+    /// UV0 per vertex, for the primitives whose layout is known (else empty).
+    uv: Vec<Vec2>,
 }
 
 impl Builder {
@@ -58,6 +60,7 @@ impl Builder {
             positions: self.p,
             normals: self.n,
             submeshes: vec![self.t],
+            uvs: self.uv,
         }
     }
 }
@@ -116,6 +119,14 @@ fn quad() -> Mesh {
     let e = b.v(Vec3::new(0.5, -0.5, 0.0), n);
     // Counter-clockwise seen from −Z.
     b.quad(a, c, d, e);
+    // Unity's Quad maps the texture upright seen from its front (from −Z, +X to the
+    // right): (0, 0) at Unity's (−0.5, −0.5), which is this right-handed (+0.5, −0.5).
+    // The layouts of Cube, Sphere, Capsule, Cylinder and Plane are not established, so
+    // they have no UVs yet.
+    b.uv =
+        b.p.iter()
+            .map(|p| Vec2::new(0.5 - p.x, p.y + 0.5))
+            .collect();
     b.done()
 }
 
@@ -327,5 +338,19 @@ mod tests {
         }
         assert_eq!(name(10202), Some("Cube"));
         assert!(mesh(10303).is_none());
+    }
+
+    #[test]
+    fn quad_uvs_are_upright_from_the_front() {
+        let q = mesh(10210).unwrap();
+        assert_eq!(q.uvs.len(), q.positions.len());
+        // Unity space: the front is seen from −Z, where +X is to the right.
+        for (p, uv) in q.positions.iter().zip(&q.uvs) {
+            assert_eq!(*uv, Vec2::new(p.x + 0.5, p.y + 0.5), "{p}");
+        }
+        assert!(q.uvs.contains(&Vec2::ZERO) && q.uvs.contains(&Vec2::ONE));
+        for id in [10202, 10206, 10207, 10208, 10209] {
+            assert!(mesh(id).unwrap().uvs.is_empty(), "{id}");
+        }
     }
 }

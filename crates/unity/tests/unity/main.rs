@@ -12,3 +12,4 @@ mod fbx_corpus;
 mod fbx_scene;
 mod fbx_threads;
 mod support;
+mod textures;

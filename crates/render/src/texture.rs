@@ -1,0 +1,289 @@
+//! Sampling an albedo texture: wrap modes, point / bilinear / trilinear filtering over the
+//! mip chain, and the uv footprint of a ray cone at a hit.
+//!
+//! Conventions follow the GPU's: texel (i, j) has its centre at ((i + ½)/w, (j + ½)/h),
+//! v = 0 is the bottom row, and wrap modes act on integer texel coordinates, so a bilinear
+//! lookup at a border blends the two texels the wrap mode makes neighbours.
+
+use formats::texture::{Filter, Level, Texture, Tiling, Wrap};
+use glam::{Vec2, Vec3, Vec4};
+
+/// A texture ready to sample: its mip chain, built once.
+pub struct Sampler {
+    levels: Vec<Level>,
+    wrap_u: Wrap,
+    wrap_v: Wrap,
+    filter: Filter,
+}
+
+/// `a + (b − a)·f`: unlike `Vec4::lerp`'s `a(1 − f) + bf`, exactly `a` when `a == b`, so a
+/// flat texture filters to itself.
+fn mix(a: Vec4, b: Vec4, f: f32) -> Vec4 {
+    a + (b - a) * f
+}
+
+/// Integer texel coordinate `i` wrapped into [0, n).
+fn wrap(i: i64, n: u32, mode: Wrap) -> u32 {
+    let n = n as i64;
+    (match mode {
+        Wrap::Repeat => i.rem_euclid(n),
+        Wrap::Clamp => i.clamp(0, n - 1),
+        Wrap::Mirror => {
+            let t = i.rem_euclid(2 * n);
+            if t < n {
+                t
+            } else {
+                2 * n - 1 - t
+            }
+        }
+    }) as u32
+}
+
+impl Sampler {
+    pub fn new(texture: &Texture) -> Sampler {
+        Sampler {
+            levels: texture.mips(),
+            wrap_u: texture.wrap_u,
+            wrap_v: texture.wrap_v,
+            filter: texture.filter,
+        }
+    }
+
+    pub fn levels(&self) -> usize {
+        self.levels.len()
+    }
+
+    /// The continuous mip level for a footprint `width` in uv units: log2 of the footprint
+    /// in level-0 texels along the larger side, clamped to the chain.
+    pub fn lod(&self, width: f32) -> f32 {
+        let l0 = &self.levels[0];
+        let texels = width * l0.width.max(l0.height) as f32;
+        let max = (self.levels.len() - 1) as f32;
+        if texels.is_nan() || texels <= 1.0 {
+            0.0
+        } else {
+            texels.log2().min(max)
+        }
+    }
+
+    /// Linear RGBA at `uv` (already tiled) for a pixel footprint `width` in uv units.
+    /// Point and bilinear read the nearest mip level; trilinear blends the two around it.
+    pub fn sample(&self, uv: Vec2, width: f32) -> Vec4 {
+        let lod = self.lod(width);
+        match self.filter {
+            Filter::Point => self.point(self.nearest(lod), uv),
+            Filter::Bilinear => self.bilinear(self.nearest(lod), uv),
+            Filter::Trilinear => {
+                let lo = lod.floor() as usize;
+                let f = lod - lo as f32;
+                let a = self.bilinear(lo, uv);
+                if f == 0.0 || lo + 1 >= self.levels.len() {
+                    a
+                } else {
+                    mix(a, self.bilinear(lo + 1, uv), f)
+                }
+            }
+        }
+    }
+
+    /// [`Sampler::sample`] at a mesh uv through a material's tiling.
+    pub fn sample_tiled(&self, tiling: &Tiling, uv: Vec2, width: f32) -> Vec4 {
+        let t = tiling.apply(uv.to_array());
+        self.sample(Vec2::from_array(t), tiling.footprint(width))
+    }
+
+    fn nearest(&self, lod: f32) -> usize {
+        ((lod + 0.5).floor() as usize).min(self.levels.len() - 1)
+    }
+
+    fn fetch(&self, level: &Level, x: i64, y: i64) -> Vec4 {
+        let x = wrap(x, level.width, self.wrap_u);
+        let y = wrap(y, level.height, self.wrap_v);
+        Vec4::from_array(level.texel(x, y))
+    }
+
+    fn point(&self, level: usize, uv: Vec2) -> Vec4 {
+        let l = &self.levels[level];
+        let x = (uv.x as f64 * l.width as f64).floor() as i64;
+        let y = (uv.y as f64 * l.height as f64).floor() as i64;
+        self.fetch(l, x, y)
+    }
+
+    fn bilinear(&self, level: usize, uv: Vec2) -> Vec4 {
+        let l = &self.levels[level];
+        let x = uv.x as f64 * l.width as f64 - 0.5;
+        let y = uv.y as f64 * l.height as f64 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        let bottom = mix(self.fetch(l, x0, y0), self.fetch(l, x0 + 1, y0), fx);
+        let top = mix(self.fetch(l, x0, y0 + 1), self.fetch(l, x0 + 1, y0 + 1), fx);
+        mix(bottom, top, fy)
+    }
+}
+
+/// The uv-space footprint of a ray cone of `cone_width` (world units, at the hit) on a
+/// triangle with corners `p` and uvs `uv`, hit along unit direction `dir`: the cone's width
+/// scaled by the triangle's uv-per-world ratio (square root of the area ratio) and
+/// stretched by the incidence angle. Zero for a triangle with no area in either space.
+pub fn cone_footprint(cone_width: f32, dir: Vec3, p: [Vec3; 3], uv: [Vec2; 3]) -> f32 {
+    let n = (p[1] - p[0]).cross(p[2] - p[0]);
+    let world_area = n.length();
+    let uv_area = (uv[1] - uv[0]).perp_dot(uv[2] - uv[0]).abs();
+    if world_area <= 0.0 || uv_area <= 0.0 || !world_area.is_finite() {
+        return 0.0;
+    }
+    // Grazing hits would give an unbounded footprint: cap the stretch at 1/0.01.
+    let cos = (n.dot(dir).abs() / world_area).max(0.01);
+    cone_width * (uv_area / world_area).sqrt() / cos
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Linear values that 8-bit codes hit exactly (no sRGB curve).
+    fn texture(w: u32, h: u32, rgba: &[[u8; 4]], filter: Filter, wrap: Wrap) -> Texture {
+        Texture {
+            source: "t".into(),
+            width: w,
+            height: h,
+            texels: rgba.concat(),
+            srgb: false,
+            wrap_u: wrap,
+            wrap_v: wrap,
+            filter,
+            mipmaps: true,
+        }
+    }
+
+    /// Bottom row: red, green; top row: blue, white.
+    fn two_by_two(filter: Filter, wrap: Wrap) -> Sampler {
+        Sampler::new(&texture(
+            2,
+            2,
+            &[
+                [255, 0, 0, 255],
+                [0, 255, 0, 255],
+                [0, 0, 255, 255],
+                [255, 255, 255, 255],
+            ],
+            filter,
+            wrap,
+        ))
+    }
+
+    const RED: Vec4 = Vec4::new(1.0, 0.0, 0.0, 1.0);
+    const GREEN: Vec4 = Vec4::new(0.0, 1.0, 0.0, 1.0);
+    const BLUE: Vec4 = Vec4::new(0.0, 0.0, 1.0, 1.0);
+    const WHITE: Vec4 = Vec4::ONE;
+
+    #[test]
+    fn corners() {
+        for f in [Filter::Point, Filter::Bilinear, Filter::Trilinear] {
+            let s = two_by_two(f, Wrap::Clamp);
+            assert_eq!(s.sample(Vec2::new(0.25, 0.25), 0.0), RED, "{f:?}");
+            assert_eq!(s.sample(Vec2::new(0.75, 0.25), 0.0), GREEN, "{f:?}");
+            assert_eq!(s.sample(Vec2::new(0.25, 0.75), 0.0), BLUE, "{f:?}");
+            assert_eq!(s.sample(Vec2::new(0.75, 0.75), 0.0), WHITE, "{f:?}");
+            // Clamped, the outer corners are the corner texels too.
+            assert_eq!(s.sample(Vec2::new(0.0, 0.0), 0.0), RED, "{f:?}");
+            assert_eq!(s.sample(Vec2::new(1.0, 1.0), 0.0), WHITE, "{f:?}");
+        }
+    }
+
+    #[test]
+    fn bilinear_midpoints() {
+        let s = two_by_two(Filter::Bilinear, Wrap::Clamp);
+        assert_eq!(
+            s.sample(Vec2::new(0.5, 0.25), 0.0),
+            Vec4::new(0.5, 0.5, 0.0, 1.0)
+        );
+        assert_eq!(
+            s.sample(Vec2::new(0.25, 0.5), 0.0),
+            Vec4::new(0.5, 0.0, 0.5, 1.0)
+        );
+        assert_eq!(
+            s.sample(Vec2::new(0.5, 0.5), 0.0),
+            Vec4::new(0.5, 0.5, 0.5, 1.0)
+        );
+    }
+
+    #[test]
+    fn wrap_modes_outside_the_unit_square() {
+        // Point sampling the bottom row at u = −0.25 (texel −1) and u = 1.25 (texel 2).
+        let at = |wrap, u| two_by_two(Filter::Point, wrap).sample(Vec2::new(u, 0.25), 0.0);
+        assert_eq!(at(Wrap::Repeat, -0.25), GREEN);
+        assert_eq!(at(Wrap::Repeat, 1.25), RED);
+        assert_eq!(at(Wrap::Clamp, -0.25), RED);
+        assert_eq!(at(Wrap::Clamp, 1.25), GREEN);
+        assert_eq!(at(Wrap::Mirror, -0.25), RED);
+        assert_eq!(at(Wrap::Mirror, 1.25), GREEN);
+        // Bilinear at u = 0: repeat blends the two edge texels, clamp does not.
+        let b = |wrap| two_by_two(Filter::Bilinear, wrap).sample(Vec2::new(0.0, 0.25), 0.0);
+        assert_eq!(b(Wrap::Repeat), Vec4::new(0.5, 0.5, 0.0, 1.0));
+        assert_eq!(b(Wrap::Clamp), RED);
+        assert_eq!(b(Wrap::Mirror), RED);
+    }
+
+    #[test]
+    fn negative_tiling_mirrors_the_image() {
+        let s = two_by_two(Filter::Point, Wrap::Repeat);
+        let flip = Tiling {
+            scale: [-1.0, 1.0],
+            offset: [0.0, 0.0],
+        };
+        assert_eq!(s.sample_tiled(&flip, Vec2::new(0.25, 0.25), 0.0), GREEN);
+    }
+
+    #[test]
+    fn mip_level_for_footprint() {
+        let s = Sampler::new(&texture(
+            16,
+            16,
+            &vec![[9, 9, 9, 9]; 256],
+            Filter::Trilinear,
+            Wrap::Repeat,
+        ));
+        assert_eq!(s.levels(), 5);
+        assert_eq!(s.lod(0.25 / 16.0), 0.0);
+        assert_eq!(s.lod(4.0 / 16.0), 2.0);
+        assert_eq!(s.lod(100.0), 4.0);
+        assert_eq!(s.nearest(s.lod(4.0 / 16.0)), 2);
+    }
+
+    #[test]
+    fn constant_texture_is_constant_at_every_level() {
+        let c = [200, 17, 99, 128];
+        for filter in [Filter::Point, Filter::Bilinear, Filter::Trilinear] {
+            let mut t = texture(7, 5, &[c; 35], filter, Wrap::Mirror);
+            t.srgb = true;
+            let want = Vec4::from_array(t.texel(0, 0));
+            let s = Sampler::new(&t);
+            for k in 0..40 {
+                let width = 2f32.powf(k as f32 * 0.25 - 6.0);
+                let uv = Vec2::new(k as f32 * 0.37 - 3.0, k as f32 * -0.61 + 1.0);
+                assert_eq!(s.sample(uv, width), want, "{filter:?} width {width}");
+            }
+        }
+    }
+
+    #[test]
+    fn footprint_of_a_cone() {
+        // A 2 m square in XY mapped to the unit uv square: 0.5 uv per metre.
+        let p = [
+            Vec3::ZERO,
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(0.0, 2.0, 0.0),
+        ];
+        let uv = [Vec2::ZERO, Vec2::new(1.0, 0.0), Vec2::new(0.0, 1.0)];
+        let head_on = cone_footprint(0.1, Vec3::new(0.0, 0.0, -1.0), p, uv);
+        assert!((head_on - 0.05).abs() < 1e-7, "{head_on}");
+        // At 60° from the normal the cone's section stretches by 1/cos = 2.
+        let d = Vec3::new(0.0, 60f32.to_radians().sin(), -(60f32.to_radians().cos()));
+        let slanted = cone_footprint(0.1, d, p, uv);
+        assert!((slanted - 0.1).abs() < 1e-6, "{slanted}");
+        // No uv area: nothing to filter.
+        assert_eq!(cone_footprint(0.1, d, p, [Vec2::ZERO; 3]), 0.0);
+    }
+}

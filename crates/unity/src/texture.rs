@@ -1,0 +1,733 @@
+//! Albedo textures: which texture a `.mat` draws with, how its `.meta` TextureImporter
+//! says to import it, and decoding the image file into a [`formats::texture::Texture`] the
+//! way Unity's importer would hand it to the shader (power-of-two rounding, size limit,
+//! bottom row first).
+
+use crate::material::props;
+use crate::project::{ext, Project};
+use crate::yaml::{self, Node};
+use formats::texture::{Filter, Texture, Tiling, Wrap, MAX_SIDE};
+use image::{DynamicImage, ImageFormat, ImageReader, Limits};
+use std::io::Cursor;
+use std::path::Path;
+
+/// Shader guids whose albedo property is known.
+const URP_LIT: &str = "933532a4fcc9baf4fa0491de14d08ed7";
+const HDRP_LIT: &str = "6e4ae4064600d784cac1e41a9e6f2e59";
+const BUILTIN_SHADERS: &str = "0000000000000000f000000000000000";
+
+/// Albedo properties in the order tried when the shader is not one of the above: URP
+/// files keep a stale `_MainTex` beside `_BaseMap`, HDRP beside `_BaseColorMap`.
+const ALBEDO_PROPERTIES: [&str; 3] = ["_BaseColorMap", "_BaseMap", "_MainTex"];
+
+#[derive(Debug, thiserror::Error)]
+pub enum TextureError {
+    #[error("{property}: texture guid {guid} is not in the project")]
+    Unresolved { property: String, guid: String },
+    #[error("{path}: cannot read texture: {message}")]
+    Read { path: String, message: String },
+    #[error("{path}: a Git LFS pointer, not the texture itself")]
+    LfsPointer { path: String },
+    #[error("{path}: .{ext} textures are not supported (png, jpg, tga, tif, exr, psd are)")]
+    Unsupported { path: String, ext: String },
+    #[error("{path}: not a readable {format} image: {message}")]
+    Decode {
+        path: String,
+        format: String,
+        message: String,
+    },
+    #[error("{path}: {width}x{height} texels, larger than {MAX_SIDE} on a side")]
+    TooLarge {
+        path: String,
+        width: u32,
+        height: u32,
+    },
+}
+
+/// The albedo slot of a material: which property, which texture, what tiling.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AlbedoSlot {
+    pub property: String,
+    pub guid: String,
+    pub tiling: Tiling,
+}
+
+/// The albedo texture slot of a Material body, in either `m_TexEnvs` layout. `None` when
+/// the material's albedo property is empty (`{fileID: 0}`) or absent.
+pub fn albedo_slot(body: &Node) -> Option<AlbedoSlot> {
+    let saved = body.get("m_SavedProperties")?;
+    let envs = props(saved, "m_TexEnvs");
+    let slot = |name: &str| envs.iter().find(|(k, _)| *k == name).map(|(_, v)| *v);
+    let shader = body.get("m_Shader").and_then(|s| s.str_at("guid"));
+    let own = match shader {
+        Some(URP_LIT) => Some("_BaseMap"),
+        Some(HDRP_LIT) => Some("_BaseColorMap"),
+        Some(BUILTIN_SHADERS) => Some("_MainTex"),
+        _ => None,
+    };
+    // A known shader reads only its own property: an empty one means untextured even
+    // when a stale slot from an earlier shader still names a texture.
+    if let Some(name) = own {
+        if let Some(env) = slot(name) {
+            return texture_of(name, env);
+        }
+    }
+    ALBEDO_PROPERTIES
+        .iter()
+        .find_map(|name| slot(name).and_then(|env| texture_of(name, env)))
+}
+
+fn texture_of(property: &str, env: &Node) -> Option<AlbedoSlot> {
+    let tex = env.get("m_Texture")?;
+    if tex.i64_at("fileID").unwrap_or(0) == 0 {
+        return None;
+    }
+    let guid = tex.str_at("guid")?.trim().to_string();
+    let pair = |key: &str, default: f32| {
+        let n = env.get(key);
+        [
+            n.and_then(|n| n.f32_at("x")).unwrap_or(default),
+            n.and_then(|n| n.f32_at("y")).unwrap_or(default),
+        ]
+    };
+    Some(AlbedoSlot {
+        property: property.to_string(),
+        guid,
+        tiling: Tiling {
+            scale: pair("m_Scale", 1.0),
+            offset: pair("m_Offset", 0.0),
+        },
+    })
+}
+
+/// TextureImporter `nPOTScale`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Npot {
+    None,
+    ToNearest,
+    ToLarger,
+    ToSmaller,
+}
+
+/// What a texture's `.meta` says about importing it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Import {
+    pub srgb: bool,
+    pub wrap_u: Wrap,
+    pub wrap_v: Wrap,
+    pub filter: Filter,
+    pub mipmaps: bool,
+    pub max_size: u32,
+    pub npot: Npot,
+    /// The importer dilates colour into transparent texels; cut-out rendering will want it.
+    pub alpha_is_transparency: bool,
+}
+
+impl Default for Import {
+    fn default() -> Self {
+        Import {
+            srgb: true,
+            wrap_u: Wrap::Repeat,
+            wrap_v: Wrap::Repeat,
+            filter: Filter::Bilinear,
+            mipmaps: true,
+            max_size: 2048,
+            npot: Npot::ToNearest,
+            alpha_is_transparency: false,
+        }
+    }
+}
+
+/// Unity's wrap codes; −1 (unset) is repeat, and MirrorOnce (3) mirrors like Mirror.
+fn wrap_mode(code: i64) -> Option<Wrap> {
+    match code {
+        0 => Some(Wrap::Repeat),
+        1 => Some(Wrap::Clamp),
+        2 | 3 => Some(Wrap::Mirror),
+        _ => None,
+    }
+}
+
+impl Import {
+    /// The settings in `<texture>.meta`; Unity's defaults without one.
+    pub fn read(texture: &Path) -> Import {
+        let mut meta = texture.as_os_str().to_owned();
+        meta.push(".meta");
+        Import::parse(&std::fs::read_to_string(meta).unwrap_or_default())
+    }
+
+    pub fn parse(text: &str) -> Import {
+        let mut im = Import::default();
+        let root = yaml::parse(text);
+        let Some(imp) = root.get("TextureImporter") else {
+            return im;
+        };
+        let mips = imp.get("mipmaps");
+        let at = |key: &str| mips.and_then(|m| m.i64_at(key)).or_else(|| imp.i64_at(key));
+        if let Some(s) = at("sRGBTexture") {
+            im.srgb = s == 1;
+        } else if let Some(l) = at("linearTexture") {
+            im.srgb = l != 1;
+        }
+        if let Some(m) = at("enableMipMap") {
+            im.mipmaps = m != 0;
+        }
+        if let Some(ts) = imp.get("textureSettings") {
+            if let Some(w) = ts.i64_at("wrapMode").and_then(wrap_mode) {
+                (im.wrap_u, im.wrap_v) = (w, w);
+            }
+            if let Some(w) = ts.i64_at("wrapU").and_then(wrap_mode) {
+                im.wrap_u = w;
+            }
+            if let Some(w) = ts.i64_at("wrapV").and_then(wrap_mode) {
+                im.wrap_v = w;
+            }
+            im.filter = match ts.i64_at("filterMode") {
+                Some(0) => Filter::Point,
+                Some(2) => Filter::Trilinear,
+                _ => Filter::Bilinear,
+            };
+        }
+        // The default platform's entry is what the editor shows and uses; the top-level
+        // key is the older home of the same setting.
+        let platform = imp
+            .get("platformSettings")
+            .map(Node::as_seq)
+            .unwrap_or(&[])
+            .iter()
+            .find(|p| {
+                matches!(
+                    p.str_at("buildTarget"),
+                    Some("DefaultTexturePlatform") | Some("Default")
+                )
+            })
+            .and_then(|p| p.i64_at("maxTextureSize"));
+        if let Some(m) = platform.or_else(|| imp.i64_at("maxTextureSize")) {
+            if m > 0 {
+                im.max_size = m.min(MAX_SIDE as i64) as u32;
+            }
+        }
+        im.npot = match imp.i64_at("nPOTScale") {
+            Some(0) => Npot::None,
+            Some(2) => Npot::ToLarger,
+            Some(3) => Npot::ToSmaller,
+            _ => Npot::ToNearest,
+        };
+        // Sprite (8) and legacy GUI (2) textures are never rescaled to powers of two.
+        if matches!(imp.i64_at("textureType"), Some(2) | Some(8)) {
+            im.npot = Npot::None;
+        }
+        im.alpha_is_transparency = imp.i64_at("alphaIsTransparency") == Some(1);
+        im
+    }
+
+    /// The size Unity imports a `w`×`h` image at: each side rounded to a power of two as
+    /// `nPOTScale` says, then both scaled so the larger fits `maxTextureSize`.
+    pub fn imported_size(&self, w: u32, h: u32) -> (u32, u32) {
+        let (mut w, mut h) = (pot(w, self.npot), pot(h, self.npot));
+        let largest = w.max(h);
+        if largest > self.max_size {
+            let f = self.max_size as f64 / largest as f64;
+            w = ((w as f64 * f).round() as u32).max(1);
+            h = ((h as f64 * f).round() as u32).max(1);
+        }
+        (w, h)
+    }
+}
+
+fn pot(n: u32, mode: Npot) -> u32 {
+    if n.is_power_of_two() || mode == Npot::None {
+        return n;
+    }
+    let hi = n.next_power_of_two();
+    let lo = hi / 2;
+    match mode {
+        Npot::ToLarger => hi,
+        Npot::ToSmaller => lo,
+        // Ties go up, as the larger texture loses nothing.
+        _ if n - lo < hi - n => lo,
+        _ => hi,
+    }
+}
+
+/// A decoded albedo map with the material's tiling.
+#[derive(Clone, Debug)]
+pub struct Albedo {
+    pub property: String,
+    pub tiling: Tiling,
+    pub import: Import,
+    pub texture: Texture,
+}
+
+/// The albedo texture of a Material body, loaded: `Ok(None)` for an untextured material.
+pub fn load_albedo(project: &Project, body: &Node) -> Result<Option<Albedo>, TextureError> {
+    let Some(slot) = albedo_slot(body) else {
+        return Ok(None);
+    };
+    let path = project
+        .resolve(&slot.guid)
+        .ok_or_else(|| TextureError::Unresolved {
+            property: slot.property.clone(),
+            guid: slot.guid.clone(),
+        })?;
+    let import = Import::read(path);
+    let texture = load(path, &project.rel(path), &import)?;
+    Ok(Some(Albedo {
+        property: slot.property,
+        tiling: slot.tiling,
+        import,
+        texture,
+    }))
+}
+
+fn linear_to_srgb(c: f32) -> f32 {
+    let c = c.clamp(0.0, 1.0);
+    if c <= 0.003_130_8 {
+        c * 12.92
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// Decode the image at `path` (named `source` in the texture and in errors) and import it
+/// as `import` says.
+pub fn load(path: &Path, source: &str, import: &Import) -> Result<Texture, TextureError> {
+    let bytes = std::fs::read(path).map_err(|e| TextureError::Read {
+        path: source.to_string(),
+        message: e.to_string(),
+    })?;
+    decode(&bytes, &ext(path), source, import)
+}
+
+/// [`load`] on bytes already read, with the file's extension (lower case, no dot).
+pub fn decode(
+    bytes: &[u8],
+    extension: &str,
+    source: &str,
+    import: &Import,
+) -> Result<Texture, TextureError> {
+    if bytes.starts_with(b"version https://git-lfs.github.com/spec/") {
+        return Err(TextureError::LfsPointer {
+            path: source.to_string(),
+        });
+    }
+    let decode_err = |format: &str, message: String| TextureError::Decode {
+        path: source.to_string(),
+        format: format.to_string(),
+        message,
+    };
+    let too_large = |width, height| TextureError::TooLarge {
+        path: source.to_string(),
+        width,
+        height,
+    };
+    let (image, float) = if extension == "psd" {
+        let (w, h) = psd_size(bytes).ok_or_else(|| decode_err("PSD", "no PSD header".into()))?;
+        if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
+            return Err(too_large(w, h));
+        }
+        if !psd_complete(bytes, w, h) {
+            return Err(decode_err("PSD", "truncated".into()));
+        }
+        let rgba = decode_psd(bytes).map_err(|m| decode_err("PSD", m))?;
+        let img = image::RgbaImage::from_raw(w, h, rgba)
+            .ok_or_else(|| decode_err("PSD", "composite size does not match header".into()))?;
+        (DynamicImage::ImageRgba8(img), false)
+    } else {
+        let format = match extension {
+            "png" => ImageFormat::Png,
+            "jpg" | "jpeg" => ImageFormat::Jpeg,
+            "tga" => ImageFormat::Tga,
+            "tif" | "tiff" => ImageFormat::Tiff,
+            "exr" => ImageFormat::OpenExr,
+            _ => {
+                return Err(TextureError::Unsupported {
+                    path: source.to_string(),
+                    ext: extension.to_string(),
+                })
+            }
+        };
+        let name = format!("{format:?}").to_uppercase();
+        // Read the header alone first, so a lying size is refused before any allocation.
+        let (w, h) = ImageReader::with_format(Cursor::new(bytes), format)
+            .into_dimensions()
+            .map_err(|e| decode_err(&name, e.to_string()))?;
+        if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
+            return Err(too_large(w, h));
+        }
+        let mut reader = ImageReader::with_format(Cursor::new(bytes), format);
+        let mut limits = Limits::default();
+        limits.max_image_width = Some(MAX_SIDE);
+        limits.max_image_height = Some(MAX_SIDE);
+        reader.limits(limits);
+        let img = reader
+            .decode()
+            .map_err(|e| decode_err(&name, e.to_string()))?;
+        let float = matches!(
+            img,
+            DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_)
+        );
+        (img, float)
+    };
+    let (w, h) = import.imported_size(image.width(), image.height());
+    let filter = image::imageops::FilterType::Triangle;
+    // Float images hold linear light: stored sRGB-encoded, 8 bits lose least there.
+    let (rows, srgb) = if float {
+        let mut img = image.to_rgba32f();
+        if (w, h) != img.dimensions() {
+            img = image::imageops::resize(&img, w, h, filter);
+        }
+        let bytes: Vec<u8> = img
+            .pixels()
+            .flat_map(|p| {
+                let q = |c: f32| (c * 255.0 + 0.5) as u8;
+                [
+                    q(linear_to_srgb(p[0])),
+                    q(linear_to_srgb(p[1])),
+                    q(linear_to_srgb(p[2])),
+                    q(p[3].clamp(0.0, 1.0)),
+                ]
+            })
+            .collect();
+        (bytes, true)
+    } else {
+        let mut img = image.to_rgba8();
+        if (w, h) != img.dimensions() {
+            img = image::imageops::resize(&img, w, h, filter);
+        }
+        (img.into_raw(), import.srgb)
+    };
+    // Image files list the top row first; Unity's v = 0 is the bottom row.
+    let row = w as usize * 4;
+    let texels: Vec<u8> = rows.chunks_exact(row).rev().flatten().copied().collect();
+    let t = Texture {
+        source: source.to_string(),
+        width: w,
+        height: h,
+        texels,
+        srgb,
+        wrap_u: import.wrap_u,
+        wrap_v: import.wrap_v,
+        filter: import.filter,
+        mipmaps: import.mipmaps,
+    };
+    t.validate().map_err(|m| decode_err("image", m))?;
+    Ok(t)
+}
+
+/// Width and height from a PSD header (`8BPS`, big-endian height then width).
+fn psd_size(bytes: &[u8]) -> Option<(u32, u32)> {
+    if bytes.len() < 26 || &bytes[..4] != b"8BPS" {
+        return None;
+    }
+    Some((be32(bytes, 18)?, be32(bytes, 14)?))
+}
+
+fn be32(b: &[u8], i: usize) -> Option<u32> {
+    Some(u32::from_be_bytes(b.get(i..i + 4)?.try_into().ok()?))
+}
+
+/// Whether a PSD holds as many image-data bytes as its header promises: the `psd` crate
+/// reads a truncated composite as black instead of failing.
+fn psd_complete(bytes: &[u8], w: u32, h: u32) -> bool {
+    let be16 = |i: usize| {
+        bytes
+            .get(i..i + 2)
+            .map(|s| u16::from_be_bytes([s[0], s[1]]))
+    };
+    let (Some(channels), Some(depth)) = (be16(12), be16(22)) else {
+        return false;
+    };
+    let mut at = 26usize;
+    for _ in 0..3 {
+        let Some(len) = be32(bytes, at) else {
+            return false;
+        };
+        at = at.saturating_add(4).saturating_add(len as usize);
+    }
+    let rows = channels as u64 * h as u64;
+    let need = match be16(at) {
+        Some(0) => rows * w as u64 * (depth as u64).div_ceil(8),
+        // RLE: at least the table of packed row lengths.
+        Some(1) => rows * 2,
+        _ => return false,
+    };
+    (bytes.len() as u64).saturating_sub(at as u64 + 2) >= need
+}
+
+/// The flattened composite of a PSD as RGBA, top row first. The `psd` crate indexes
+/// without checking on some malformed files, so its panics are caught and reported as a
+/// decode error instead of taking the converter down.
+fn decode_psd(bytes: &[u8]) -> Result<Vec<u8>, String> {
+    match std::panic::catch_unwind(|| psd::Psd::from_bytes(bytes).map(|p| p.rgba())) {
+        Ok(Ok(rgba)) => Ok(rgba),
+        Ok(Err(e)) => Err(e.to_string()),
+        Err(_) => Err("malformed PSD".to_string()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use image::{Rgba, RgbaImage};
+
+    fn mat(text: &str) -> Node {
+        yaml::parse(text)
+    }
+
+    #[test]
+    fn albedo_slot_modern_layout_follows_the_shader() {
+        let urp = mat(
+            "m_Shader: {fileID: 4800000, guid: 933532a4fcc9baf4fa0491de14d08ed7, type: 3}
+m_SavedProperties:
+  m_TexEnvs:
+  - _BaseMap:
+      m_Texture: {fileID: 2800000, guid: aaaa, type: 3}
+      m_Scale: {x: -2, y: 3.5}
+      m_Offset: {x: 0.25, y: 0}
+  - _MainTex:
+      m_Texture: {fileID: 2800000, guid: bbbb, type: 3}
+      m_Scale: {x: 1, y: 1}
+      m_Offset: {x: 0, y: 0}
+",
+        );
+        let s = albedo_slot(&urp).unwrap();
+        assert_eq!(s.property, "_BaseMap");
+        assert_eq!(s.guid, "aaaa");
+        assert_eq!(s.tiling.scale, [-2.0, 3.5]);
+        assert_eq!(s.tiling.offset, [0.25, 0.0]);
+        // URP with an empty _BaseMap draws untextured, whatever the stale _MainTex says.
+        let empty = mat(
+            "m_Shader: {fileID: 4800000, guid: 933532a4fcc9baf4fa0491de14d08ed7, type: 3}
+m_SavedProperties:
+  m_TexEnvs:
+  - _BaseMap:
+      m_Texture: {fileID: 0}
+  - _MainTex:
+      m_Texture: {fileID: 2800000, guid: bbbb, type: 3}
+",
+        );
+        assert_eq!(albedo_slot(&empty), None);
+    }
+
+    #[test]
+    fn albedo_slot_legacy_layout() {
+        let old = mat(
+            "m_Shader: {fileID: 46, guid: 0000000000000000f000000000000000, type: 0}
+m_SavedProperties:
+  m_TexEnvs:
+    data:
+      first:
+        name: _BumpMap
+      second:
+        m_Texture: {fileID: 2800000, guid: cccc, type: 3}
+        m_Scale: {x: 1, y: 1}
+        m_Offset: {x: 0, y: 0}
+    data:
+      first:
+        name: _MainTex
+      second:
+        m_Texture: {fileID: 2800000, guid: dddd, type: 3}
+        m_Scale: {x: 10, y: 5}
+        m_Offset: {x: 0, y: 0.5}
+",
+        );
+        let s = albedo_slot(&old).unwrap();
+        assert_eq!((s.property.as_str(), s.guid.as_str()), ("_MainTex", "dddd"));
+        assert_eq!(s.tiling.scale, [10.0, 5.0]);
+        assert_eq!(s.tiling.offset, [0.0, 0.5]);
+    }
+
+    #[test]
+    fn import_settings() {
+        let im = Import::parse(
+            "TextureImporter:
+  mipmaps:
+    enableMipMap: 0
+    sRGBTexture: 0
+  maxTextureSize: 2048
+  textureSettings:
+    filterMode: 2
+    wrapU: 1
+    wrapV: 2
+  nPOTScale: 3
+  alphaIsTransparency: 1
+  platformSettings:
+  - buildTarget: DefaultTexturePlatform
+    maxTextureSize: 256
+",
+        );
+        assert_eq!(
+            im,
+            Import {
+                srgb: false,
+                wrap_u: Wrap::Clamp,
+                wrap_v: Wrap::Mirror,
+                filter: Filter::Trilinear,
+                mipmaps: false,
+                max_size: 256,
+                npot: Npot::ToSmaller,
+                alpha_is_transparency: true,
+            }
+        );
+        let old = Import::parse(
+            "TextureImporter:\n  linearTexture: 1\n  textureSettings:\n    filterMode: 0\n    wrapMode: 1\n",
+        );
+        assert!(!old.srgb);
+        assert_eq!((old.wrap_u, old.wrap_v), (Wrap::Clamp, Wrap::Clamp));
+        assert_eq!(old.filter, Filter::Point);
+        assert_eq!(Import::parse(""), Import::default());
+    }
+
+    #[test]
+    fn imported_sizes() {
+        let im = Import::default();
+        assert_eq!(im.imported_size(640, 200), (512, 256));
+        assert_eq!(im.imported_size(768, 96), (1024, 128));
+        assert_eq!(im.imported_size(4096, 1024), (2048, 512));
+        let none = Import {
+            npot: Npot::None,
+            max_size: 1000,
+            ..Import::default()
+        };
+        assert_eq!(none.imported_size(3000, 1500), (1000, 500));
+        assert_eq!(none.imported_size(300, 7), (300, 7));
+    }
+
+    fn encode(img: &RgbaImage, format: ImageFormat) -> Vec<u8> {
+        let mut out = Cursor::new(Vec::new());
+        img.write_to(&mut out, format).unwrap();
+        out.into_inner()
+    }
+
+    /// Top row (as written): red, green; bottom row: blue, grey 128.
+    fn four_colours() -> RgbaImage {
+        let mut img = RgbaImage::new(2, 2);
+        img.put_pixel(0, 0, Rgba([255, 0, 0, 255]));
+        img.put_pixel(1, 0, Rgba([0, 255, 0, 255]));
+        img.put_pixel(0, 1, Rgba([0, 0, 255, 255]));
+        img.put_pixel(1, 1, Rgba([128, 128, 128, 255]));
+        img
+    }
+
+    #[test]
+    fn texel_0_0_is_the_bottom_left() {
+        for (format, ext) in [
+            (ImageFormat::Png, "png"),
+            (ImageFormat::Tga, "tga"),
+            (ImageFormat::Tiff, "tif"),
+        ] {
+            let bytes = encode(&four_colours(), format);
+            let t = decode(&bytes, ext, "t", &Import::default()).unwrap();
+            assert_eq!((t.width, t.height), (2, 2), "{ext}");
+            assert_eq!(t.texel(0, 0), [0.0, 0.0, 1.0, 1.0], "{ext}");
+            assert_eq!(t.texel(0, 1), [1.0, 0.0, 0.0, 1.0], "{ext}");
+            assert_eq!(t.texel(1, 1), [0.0, 1.0, 0.0, 1.0], "{ext}");
+            let grey = t.texel(1, 0);
+            assert!((grey[0] - 0.2158).abs() < 1e-4, "{ext}: {grey:?}");
+            assert_eq!(grey[3], 1.0);
+        }
+        // sRGBTexture 0 keeps the code as a linear value.
+        let linear = Import {
+            srgb: false,
+            ..Import::default()
+        };
+        let t = decode(
+            &encode(&four_colours(), ImageFormat::Png),
+            "png",
+            "t",
+            &linear,
+        )
+        .unwrap();
+        assert_eq!(t.texel(1, 0)[0], 128.0 / 255.0);
+    }
+
+    #[test]
+    fn exr_is_linear_light() {
+        let mut img = image::Rgba32FImage::new(1, 1);
+        img.put_pixel(0, 0, Rgba([0.2158, 1.0, 0.0, 1.0]));
+        let mut out = Cursor::new(Vec::new());
+        DynamicImage::ImageRgba32F(img)
+            .write_to(&mut out, ImageFormat::OpenExr)
+            .unwrap();
+        let t = decode(out.get_ref(), "exr", "t", &Import::default()).unwrap();
+        assert!(t.srgb);
+        assert_eq!(&t.texels, &[128, 255, 0, 255]);
+    }
+
+    /// A minimal flattened PSD: RGB, 8 bits, no layers, raw image data (planar).
+    fn psd_2x2() -> Vec<u8> {
+        let mut b = b"8BPS".to_vec();
+        b.extend(1u16.to_be_bytes());
+        b.extend([0; 6]);
+        b.extend(3u16.to_be_bytes()); // channels
+        b.extend(2u32.to_be_bytes()); // height
+        b.extend(2u32.to_be_bytes()); // width
+        b.extend(8u16.to_be_bytes()); // depth
+        b.extend(3u16.to_be_bytes()); // RGB
+        b.extend(0u32.to_be_bytes()); // colour mode data
+        b.extend(0u32.to_be_bytes()); // image resources
+        b.extend(0u32.to_be_bytes()); // layers and masks
+        b.extend(0u16.to_be_bytes()); // raw
+        b.extend([255, 0, 0, 128]); // R plane, top row first
+        b.extend([0, 255, 0, 128]); // G
+        b.extend([0, 0, 255, 128]); // B
+        b
+    }
+
+    #[test]
+    fn psd_composite() {
+        let t = decode(&psd_2x2(), "psd", "t.psd", &Import::default()).unwrap();
+        assert_eq!(&t.texels[..4], &[0, 0, 255, 255]);
+        assert_eq!(&t.texels[12..], &[0, 255, 0, 255]);
+    }
+
+    #[test]
+    fn unreadable_files_are_errors() {
+        let png = encode(&four_colours(), ImageFormat::Png);
+        let im = Import::default();
+        let truncated = decode(&png[..png.len() / 2], "png", "a.png", &im);
+        assert!(
+            matches!(truncated, Err(TextureError::Decode { .. })),
+            "{truncated:?}"
+        );
+        let lying = decode(&png, "jpg", "a.jpg", &im);
+        assert!(
+            matches!(lying, Err(TextureError::Decode { .. })),
+            "{lying:?}"
+        );
+        let lfs = decode(
+            b"version https://git-lfs.github.com/spec/v1\noid sha256:00\nsize 12\n",
+            "tif",
+            "a.tif",
+            &im,
+        );
+        assert!(matches!(lfs, Err(TextureError::LfsPointer { .. })));
+        assert!(matches!(
+            decode(b"DDS ", "dds", "a.dds", &im),
+            Err(TextureError::Unsupported { .. })
+        ));
+        // An uncompressed TGA header claiming 60000×60000 texels and holding none.
+        let mut tga = vec![0u8, 0, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0];
+        tga.extend(60000u16.to_le_bytes());
+        tga.extend(60000u16.to_le_bytes());
+        tga.extend([32, 8]);
+        let huge = decode(&tga, "tga", "a.tga", &im);
+        assert!(
+            matches!(huge, Err(TextureError::TooLarge { width: 60000, .. })),
+            "{huge:?}"
+        );
+        let mut psd = psd_2x2();
+        psd[14..18].copy_from_slice(&70000u32.to_be_bytes());
+        assert!(matches!(
+            decode(&psd, "psd", "a.psd", &im),
+            Err(TextureError::TooLarge { .. })
+        ));
+        for cut in [10, 30, 40, 45, 51] {
+            let r = decode(&psd_2x2()[..cut], "psd", "a.psd", &im);
+            assert!(r.is_err(), "{cut}");
+        }
+        let err = truncated.unwrap_err().to_string();
+        assert!(err.starts_with("a.png: "), "{err}");
+    }
+}

@@ -1,0 +1,295 @@
+//! One albedo texture as the soup stores it, and how a material uses it.
+//!
+//! Texels are RGBA, 8 bits per channel, rows bottom to top (texel (0, 0) is the image's
+//! bottom-left corner, Unity's UV origin). Colour channels are sRGB-encoded when
+//! [`Texture::srgb`] is set (Unity's `sRGBTexture`), otherwise linear; alpha is always
+//! linear. Eight bits are what Unity's importer keeps of an albedo map anyway, so the soup
+//! holds exactly the values Unity samples, at a quarter of the size of linear `f32`, and
+//! the lookup through [`decode_u8`] is exact (a table, not a re-quantisation).
+//!
+//! Mip levels are not stored: they follow from the texels, so the renderer builds them
+//! once at load ([`Texture::mips`]), in linear `f32` so averaging conserves energy.
+
+use serde::{Deserialize, Serialize};
+
+/// Largest width or height accepted (Unity's own import limit).
+pub const MAX_SIDE: u32 = 16384;
+
+/// Texture address mode per axis (TextureImporter `wrapU`/`wrapV`: 0, 1, 2).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Wrap {
+    #[default]
+    Repeat,
+    Clamp,
+    Mirror,
+}
+
+/// TextureImporter `filterMode`: 0 point, 1 bilinear, 2 trilinear.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Filter {
+    Point,
+    #[default]
+    Bilinear,
+    Trilinear,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Texture {
+    /// Asset path relative to the project (for messages).
+    pub source: String,
+    pub width: u32,
+    pub height: u32,
+    /// `width · height · 4` bytes, RGBA, bottom row first.
+    pub texels: Vec<u8>,
+    /// Colour channels are sRGB-encoded (alpha never is).
+    pub srgb: bool,
+    pub wrap_u: Wrap,
+    pub wrap_v: Wrap,
+    pub filter: Filter,
+    /// TextureImporter `enableMipMap`: without it every lookup reads level 0.
+    pub mipmaps: bool,
+}
+
+/// How a material maps its albedo texture: uv' = uv · scale + offset (`m_Scale`,
+/// `m_Offset`; negative scales occur).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Tiling {
+    pub scale: [f32; 2],
+    pub offset: [f32; 2],
+}
+
+impl Default for Tiling {
+    fn default() -> Self {
+        Tiling {
+            scale: [1.0, 1.0],
+            offset: [0.0, 0.0],
+        }
+    }
+}
+
+impl Tiling {
+    pub fn apply(&self, uv: [f32; 2]) -> [f32; 2] {
+        [
+            uv[0] * self.scale[0] + self.offset[0],
+            uv[1] * self.scale[1] + self.offset[1],
+        ]
+    }
+
+    /// A footprint width in uv becomes one in uv' (the larger axis scale, so tiling never
+    /// under-filters).
+    pub fn footprint(&self, width: f32) -> f32 {
+        width * self.scale[0].abs().max(self.scale[1].abs())
+    }
+}
+
+/// One mip level: linear RGBA, bottom row first.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Level {
+    pub width: u32,
+    pub height: u32,
+    pub texels: Vec<[f32; 4]>,
+}
+
+impl Level {
+    pub fn texel(&self, x: u32, y: u32) -> [f32; 4] {
+        self.texels[(y as usize) * (self.width as usize) + x as usize]
+    }
+}
+
+/// sRGB → linear for every 8-bit code, computed once.
+fn srgb_table() -> &'static [f32; 256] {
+    static TABLE: std::sync::OnceLock<[f32; 256]> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| {
+        let mut t = [0.0; 256];
+        for (i, v) in t.iter_mut().enumerate() {
+            let c = i as f64 / 255.0;
+            *v = if c <= 0.04045 {
+                c / 12.92
+            } else {
+                ((c + 0.055) / 1.055).powf(2.4)
+            } as f32;
+        }
+        t
+    })
+}
+
+/// An 8-bit channel as a linear value.
+pub fn decode_u8(code: u8, srgb: bool) -> f32 {
+    if srgb {
+        srgb_table()[code as usize]
+    } else {
+        code as f32 / 255.0
+    }
+}
+
+impl Texture {
+    pub fn validate(&self) -> Result<(), String> {
+        if self.width == 0 || self.height == 0 {
+            return Err(format!(
+                "texture {}: empty ({}x{})",
+                self.source, self.width, self.height
+            ));
+        }
+        if self.width > MAX_SIDE || self.height > MAX_SIDE {
+            return Err(format!(
+                "texture {}: {}x{} is larger than {MAX_SIDE} on a side",
+                self.source, self.width, self.height
+            ));
+        }
+        let want = self.width as usize * self.height as usize * 4;
+        if self.texels.len() != want {
+            return Err(format!(
+                "texture {}: {} texel bytes for {}x{} (want {want})",
+                self.source,
+                self.texels.len(),
+                self.width,
+                self.height
+            ));
+        }
+        Ok(())
+    }
+
+    /// Texel (x, y) as linear RGBA (y = 0 is the bottom row).
+    pub fn texel(&self, x: u32, y: u32) -> [f32; 4] {
+        let i = ((y as usize) * (self.width as usize) + x as usize) * 4;
+        let t = &self.texels[i..i + 4];
+        [
+            decode_u8(t[0], self.srgb),
+            decode_u8(t[1], self.srgb),
+            decode_u8(t[2], self.srgb),
+            decode_u8(t[3], false),
+        ]
+    }
+
+    /// Level 0 and, when mip-mapped, every halving down to 1×1. Each texel of a level is
+    /// the mean of the (2×2, or 3 wide/high where a side is odd) texels it covers, summed
+    /// in f64 so that a constant texture stays exactly constant at every level.
+    pub fn mips(&self) -> Vec<Level> {
+        let mut levels = vec![Level {
+            width: self.width,
+            height: self.height,
+            texels: (0..self.height)
+                .flat_map(|y| (0..self.width).map(move |x| (x, y)))
+                .map(|(x, y)| self.texel(x, y))
+                .collect(),
+        }];
+        if !self.mipmaps {
+            return levels;
+        }
+        while let Some(prev) = levels.last().filter(|l| l.width > 1 || l.height > 1) {
+            levels.push(halve(prev));
+        }
+        levels
+    }
+}
+
+/// Source index range [first, last] that destination index `i` covers along one axis.
+fn span(i: u32, src: u32, dst: u32) -> (u32, u32) {
+    if src == 1 {
+        return (0, 0);
+    }
+    let first = 2 * i;
+    // An odd side folds its last texel into the last destination texel.
+    let last = if i + 1 == dst && src % 2 == 1 {
+        src - 1
+    } else {
+        first + 1
+    };
+    (first, last)
+}
+
+fn halve(src: &Level) -> Level {
+    let (w, h) = ((src.width / 2).max(1), (src.height / 2).max(1));
+    let mut texels = Vec::with_capacity(w as usize * h as usize);
+    for y in 0..h {
+        let (y0, y1) = span(y, src.height, h);
+        for x in 0..w {
+            let (x0, x1) = span(x, src.width, w);
+            let mut sum = [0f64; 4];
+            for sy in y0..=y1 {
+                for sx in x0..=x1 {
+                    let t = src.texel(sx, sy);
+                    for c in 0..4 {
+                        sum[c] += t[c] as f64;
+                    }
+                }
+            }
+            let n = ((x1 - x0 + 1) * (y1 - y0 + 1)) as f64;
+            texels.push(sum.map(|s| (s / n) as f32));
+        }
+    }
+    Level {
+        width: w,
+        height: h,
+        texels,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tex(w: u32, h: u32, texels: Vec<u8>) -> Texture {
+        Texture {
+            source: "t.png".into(),
+            width: w,
+            height: h,
+            texels,
+            srgb: true,
+            wrap_u: Wrap::Repeat,
+            wrap_v: Wrap::Repeat,
+            filter: Filter::Trilinear,
+            mipmaps: true,
+        }
+    }
+
+    #[test]
+    fn validation() {
+        assert!(tex(2, 1, vec![0; 8]).validate().is_ok());
+        assert!(tex(2, 1, vec![0; 7]).validate().is_err());
+        assert!(tex(0, 1, vec![]).validate().is_err());
+        assert!(tex(MAX_SIDE + 1, 1, vec![0; (MAX_SIDE as usize + 1) * 4])
+            .validate()
+            .is_err());
+    }
+
+    #[test]
+    fn srgb_mid_grey_is_0_2158_linear() {
+        assert!((decode_u8(128, true) - 0.2158).abs() < 1e-4);
+        assert_eq!(decode_u8(255, true), 1.0);
+        assert_eq!(decode_u8(0, true), 0.0);
+        assert_eq!(decode_u8(51, false), 51.0 / 255.0);
+    }
+
+    #[test]
+    fn mip_chain_sizes_and_constant_levels() {
+        let t = tex(5, 3, [200, 10, 77, 255].repeat(15));
+        let mips = t.mips();
+        let sizes: Vec<_> = mips.iter().map(|l| (l.width, l.height)).collect();
+        assert_eq!(sizes, vec![(5, 3), (2, 1), (1, 1)]);
+        let c = t.texel(0, 0);
+        for l in &mips {
+            assert!(l.texels.iter().all(|&x| x == c), "{}x{}", l.width, l.height);
+        }
+    }
+
+    #[test]
+    fn mip_averages_in_linear() {
+        let mut t = tex(2, 1, vec![255, 255, 255, 255, 0, 0, 0, 0]);
+        t.srgb = true;
+        let m = t.mips();
+        assert_eq!(m[1].texels, vec![[0.5, 0.5, 0.5, 0.5]]);
+        t.mipmaps = false;
+        assert_eq!(t.mips().len(), 1);
+    }
+
+    #[test]
+    fn tiling() {
+        let t = Tiling {
+            scale: [-2.0, 0.5],
+            offset: [1.0, 0.25],
+        };
+        assert_eq!(t.apply([0.25, 0.5]), [0.5, 0.5]);
+        assert_eq!(t.footprint(0.1), 0.2);
+    }
+}
