@@ -321,9 +321,9 @@ impl Soup {
         Ok(soup)
     }
 
-    /// Write atomically (temp file + rename).
+    /// Write atomically (temp file + rename), the bytes of [`Soup::to_bytes`] streamed.
     pub fn write(&self, path: &Path) -> Result<(), FormatError> {
-        envelope::write_atomic(path, &self.to_bytes(path)?)
+        envelope::write_encoded(self, MAGIC, VERSION, path)
     }
 
     pub fn read(path: &Path) -> Result<Self, FormatError> {
