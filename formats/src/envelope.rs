@@ -258,6 +258,8 @@ struct ChunkWriter {
 
 impl ChunkWriter {
     /// Hand the filled buffer to the writing thread and continue in an emptied one.
+    #[cold]
+    #[inline(never)]
     fn send(&mut self) -> std::io::Result<()> {
         if self.buf.is_empty() {
             return Ok(());
@@ -273,13 +275,22 @@ impl ChunkWriter {
     }
 }
 
+// bincode writes each number through `write_all`: the default's retry loop around `write`
+// made the four-byte appends a third of the whole conversion, hence both inlined here.
 impl Write for ChunkWriter {
+    #[inline]
     fn write(&mut self, data: &[u8]) -> std::io::Result<usize> {
+        self.write_all(data)?;
+        Ok(data.len())
+    }
+
+    #[inline]
+    fn write_all(&mut self, data: &[u8]) -> std::io::Result<()> {
         if self.buf.len() + data.len() > CHUNK {
             self.send()?;
         }
         self.buf.extend_from_slice(data);
-        Ok(data.len())
+        Ok(())
     }
 
     fn flush(&mut self) -> std::io::Result<()> {
