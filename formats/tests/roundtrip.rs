@@ -95,6 +95,16 @@ fn streamed_soup_file_is_the_encoded_bytes() {
         .map(|i| format!("warning {i} {}", "x".repeat(i)))
         .collect();
     s.seal();
+    // The geometry hash is over the coordinates as f32 little-endian, however it is computed.
+    let mut le = Vec::new();
+    for t in &s.triangles {
+        for v in t {
+            for c in v.to_array() {
+                le.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+    }
+    assert_eq!(&s.geometry_hash, blake3::hash(&le).as_bytes());
     s.write(&path).unwrap();
     let bytes = std::fs::read(&path).unwrap();
     assert!(bytes.len() > 4 << 20, "{} bytes", bytes.len());
