@@ -7,6 +7,7 @@ use crate::layer::layer;
 use crate::mesh::Mesh;
 use formats::{CastShadows, Object};
 use glam::{Mat3, Mat4, Vec3};
+use rayon::prelude::*;
 
 impl Emitter<'_, '_> {
     /// Draw the mesh of MeshFilter `mf` with the materials of MeshRenderer `mr`, both on
@@ -42,7 +43,6 @@ impl Emitter<'_, '_> {
         if mesh.positions.iter().any(|p| !p.is_finite()) {
             return Err(self.non_finite(go, format!("mesh {source} has a NaN or infinite vertex")));
         }
-        let normal_m = Mat3::from_mat4(world).inverse().transpose();
         let flip_winding = world.determinant() < 0.0;
         let slots = &g.objs[renderer].materials;
         let obj_index = self.soup.objects.len() as u32;
@@ -59,6 +59,7 @@ impl Emitter<'_, '_> {
             },
             receive_shadows: r.i64_at("m_ReceiveShadows") != Some(0),
         });
+        let placed = Placed::new(mesh, world);
         let mut origins: Vec<(u32, String)> = Vec::new();
         let mut emitted = 0usize;
         for (si, tris) in mesh.submeshes.iter().enumerate() {
@@ -75,33 +76,7 @@ impl Emitter<'_, '_> {
             if !origins.iter().any(|(m, _)| *m == mat) {
                 origins.push((mat, origin));
             }
-            for t in tris {
-                let p = t.map(|i| flip(world.transform_point3(mesh.positions[i as usize])));
-                let n = t.map(|i| {
-                    let n = flip((normal_m * mesh.normals[i as usize]).normalize_or_zero());
-                    if n == Vec3::ZERO {
-                        Vec3::Y
-                    } else {
-                        n
-                    }
-                });
-                if degenerate(p) {
-                    self.soup.dropped_degenerate += 1;
-                    continue;
-                }
-                // The flip to right-handed space reverses the winding once; a mirroring
-                // transform (negative determinant) reverses it again.
-                let (p, n) = if flip_winding {
-                    (p, n)
-                } else {
-                    ([p[0], p[2], p[1]], [n[0], n[2], n[1]])
-                };
-                self.soup.triangles.push(p);
-                self.soup.normals.push(n);
-                self.soup.tri_material.push(mat);
-                self.soup.tri_object.push(obj_index);
-                emitted += 1;
-            }
+            emitted += self.place(&placed, tris, flip_winding, mat, obj_index);
         }
         if emitted == 0 {
             // Keep object indices dense in what renders: drop an object without triangles.
@@ -110,6 +85,113 @@ impl Emitter<'_, '_> {
             self.material_origins.push(origins);
         }
         Ok(())
+    }
+}
+
+/// Sub-meshes and meshes smaller than this are placed on the calling thread: waking the
+/// pool costs more than transforming a few thousand triangles, and real scenes have
+/// hundreds of small objects.
+const PARALLEL_MIN: usize = 8192;
+
+/// A mesh's vertices in world space, soup handedness. Each vertex is transformed once
+/// rather than once per corner (a closed mesh has about six corners per vertex); a corner
+/// then copies the very values the per-corner transform computed.
+struct Placed {
+    positions: Vec<Vec3>,
+    normals: Vec<Vec3>,
+}
+
+impl Placed {
+    fn new(mesh: &Mesh, world: Mat4) -> Self {
+        let normal_m = Mat3::from_mat4(world).inverse().transpose();
+        let position = |p: &Vec3| flip(world.transform_point3(*p));
+        let normal = |n: &Vec3| {
+            let n = flip((normal_m * *n).normalize_or_zero());
+            if n == Vec3::ZERO {
+                Vec3::Y
+            } else {
+                n
+            }
+        };
+        if mesh.positions.len() < PARALLEL_MIN {
+            Placed {
+                positions: mesh.positions.iter().map(position).collect(),
+                normals: mesh.normals.iter().map(normal).collect(),
+            }
+        } else {
+            Placed {
+                positions: mesh.positions.par_iter().map(position).collect(),
+                normals: mesh.normals.par_iter().map(normal).collect(),
+            }
+        }
+    }
+}
+
+impl Emitter<'_, '_> {
+    /// Append sub-mesh `tris` of the `placed` mesh to the soup; how many triangles it kept
+    /// (degenerate ones are dropped and counted).
+    ///
+    /// Large sub-meshes are gathered on all threads straight into the soup's vectors
+    /// (rayon's indexed `par_extend` writes in place, in order), positions and normals as
+    /// two passes, so the output is the same as a sequential loop's. Degenerate triangles
+    /// are found afterwards and squeezed out in order; they are rare.
+    fn place(
+        &mut self,
+        placed: &Placed,
+        tris: &[[u32; 3]],
+        flip_winding: bool,
+        mat: u32,
+        obj_index: u32,
+    ) -> usize {
+        // The flip to right-handed space reverses the winding once; a mirroring transform
+        // (negative determinant) reverses it again.
+        let wind = |v: [Vec3; 3]| {
+            if flip_winding {
+                v
+            } else {
+                [v[0], v[2], v[1]]
+            }
+        };
+        let position = |t: &[u32; 3]| wind(t.map(|i| placed.positions[i as usize]));
+        let normal = |t: &[u32; 3]| wind(t.map(|i| placed.normals[i as usize]));
+        let soup = &mut self.soup;
+        let start = soup.triangles.len();
+        let n = tris.len();
+        let dropped = if n < PARALLEL_MIN {
+            soup.triangles.extend(tris.iter().map(position));
+            soup.normals.extend(tris.iter().map(normal));
+            soup.triangles[start..]
+                .iter()
+                .filter(|p| degenerate(**p))
+                .count()
+        } else {
+            soup.triangles
+                .par_extend(tris.par_iter().with_min_len(PARALLEL_MIN / 2).map(position));
+            soup.normals
+                .par_extend(tris.par_iter().with_min_len(PARALLEL_MIN / 2).map(normal));
+            soup.triangles[start..]
+                .par_iter()
+                .with_min_len(PARALLEL_MIN / 2)
+                .filter(|p| degenerate(**p))
+                .count()
+        };
+        if dropped > 0 {
+            let mut kept = start;
+            for i in start..start + n {
+                if !degenerate(soup.triangles[i]) {
+                    soup.triangles[kept] = soup.triangles[i];
+                    soup.normals[kept] = soup.normals[i];
+                    kept += 1;
+                }
+            }
+            soup.triangles.truncate(kept);
+            soup.normals.truncate(kept);
+            soup.dropped_degenerate += dropped as u64;
+        }
+        let kept = n - dropped;
+        soup.tri_material.extend(std::iter::repeat_n(mat, kept));
+        soup.tri_object.extend(std::iter::repeat_n(obj_index, kept));
+        kept
     }
 }
 
