@@ -30,16 +30,7 @@ const SPHERE: usize = 720;
 const CAPSULE: usize = 768;
 
 fn corpus() -> Option<PathBuf> {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/corpus/unity");
-    if p.is_dir() {
-        Some(p)
-    } else {
-        eprintln!(
-            "SKIPPED: corpus tests, because {} does not exist (the corpus lives beside the repo in ../shared)",
-            p.display()
-        );
-        None
-    }
+    crate::support::corpus("corpus tests")
 }
 
 /// The soup of a corpus scene (path relative to the corpus), `None` without the corpus.

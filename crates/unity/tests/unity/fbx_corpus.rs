@@ -18,19 +18,7 @@ use unity::model::Model;
 use unity::yaml::Node;
 
 fn corpus() -> Option<PathBuf> {
-    let p = std::env::var_os("UNITRACE_CORPUS")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/corpus"))
-        .join("unity");
-    if p.is_dir() {
-        Some(p)
-    } else {
-        eprintln!(
-            "SKIPPED: FBX corpus tests, because {} does not exist (the corpus lives beside the repo in ../shared, or set UNITRACE_CORPUS)",
-            p.display()
-        );
-        None
-    }
+    crate::support::corpus("FBX corpus tests")
 }
 
 fn is_fbx(p: &Path) -> bool {

@@ -4,6 +4,24 @@
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
+/// The real Unity projects beside the repository (`../shared/corpus/unity`, or
+/// `$UNITRACE_CORPUS/unity`); `None`, after saying loudly that `what` is skipped, when absent.
+pub fn corpus(what: &str) -> Option<PathBuf> {
+    let p = std::env::var_os("UNITRACE_CORPUS")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/corpus"))
+        .join("unity");
+    if p.is_dir() {
+        Some(p)
+    } else {
+        eprintln!(
+            "SKIPPED: {what}, because {} does not exist (the corpus lives beside the repo in ../shared, or set UNITRACE_CORPUS)",
+            p.display()
+        );
+        None
+    }
+}
+
 pub const HEADER: &str = "%YAML 1.1\n%TAG !u! tag:unity3d.com,2011:\n";
 pub const CUBE: i64 = 10202;
 pub const SPHERE: i64 = 10207;

@@ -3,21 +3,12 @@
 //! makes the loader panic.
 
 use formats::texture::{Filter, Wrap};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use unity::project::Project;
 use unity::texture::{load, load_albedo, Import, TextureError};
 
 fn corpus() -> Option<PathBuf> {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/corpus/unity");
-    if p.is_dir() {
-        Some(p)
-    } else {
-        eprintln!(
-            "SKIPPED: corpus texture tests, because {} does not exist (the corpus lives beside the repo in ../shared)",
-            p.display()
-        );
-        None
-    }
+    crate::support::corpus("corpus texture tests")
 }
 
 /// (file, imported width, height): PNG 8-bit RGB and 16-bit RGBA, JPEG baseline and
