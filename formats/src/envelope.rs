@@ -172,7 +172,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FormatError> {
 ///
 /// A soup of two million triangles is 168 MB; building it in memory first cost a fresh
 /// allocation (page faults), a copy into the framed buffer and a serial hash before the
-/// first byte reached the file. Here the serialiser fills [`CHUNK`]-sized buffers that a
+/// first byte reached the file. Here the serialiser fills `CHUNK`-sized buffers that a
 /// second thread hashes and writes while the next one fills. The header's length and
 /// checksum are known only at the end, so the header is written zeroed and overwritten in
 /// place before the rename: a reader never sees the file until it is complete.
