@@ -422,20 +422,20 @@ mod tests {
         }
     }
 
+    /// The left and right 2×2 halves of a 4×2 image.
+    fn halves() -> (Window, Window) {
+        let w = |x0| Window {
+            x0,
+            y0: 0,
+            x1: x0 + 2,
+            y1: 2,
+        };
+        (w(0), w(2))
+    }
+
     #[test]
     fn merge_refuses_a_crop_that_holds_another_window_than_it_names() {
-        let left = Window {
-            x0: 0,
-            y0: 0,
-            x1: 2,
-            y1: 2,
-        };
-        let right = Window {
-            x0: 2,
-            y0: 0,
-            x1: 4,
-            y1: 2,
-        };
+        let (left, right) = halves();
         let a = crop(left, &[("crop", "0,0,2,2")]);
         let b = crop(right, &[("crop", "0,0,2,2")]);
         let err = merge_labelled(&[("a.exr".into(), &a), ("b.exr".into(), &b)])
@@ -451,18 +451,7 @@ mod tests {
 
     #[test]
     fn merge_names_the_input_of_another_soup_or_tree() {
-        let left = Window {
-            x0: 0,
-            y0: 0,
-            x1: 2,
-            y1: 2,
-        };
-        let right = Window {
-            x0: 2,
-            y0: 0,
-            x1: 4,
-            y1: 2,
-        };
+        let (left, right) = halves();
         for key in ["soupDigest", "treeParams", "version"] {
             let a = crop(left, &[(key, "1")]);
             let b = crop(right, &[(key, "2")]);
