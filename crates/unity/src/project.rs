@@ -51,6 +51,8 @@ pub struct Project {
     /// `Packages/manifest.json` names the High Definition Render Pipeline, whose lights
     /// are in physical units.
     pub hdrp: bool,
+    /// `root` canonicalised once: `rel` runs for every object and message.
+    canonical_root: PathBuf,
     files: Mutex<HashMap<PathBuf, FileResult>>,
     models: Mutex<HashMap<PathBuf, ModelResult>>,
     mats: Mutex<HashMap<PathBuf, MatResult>>,
@@ -94,7 +96,9 @@ impl Project {
         let guids = GuidIndex::build(&assets);
         let hdrp = std::fs::read_to_string(root.join("Packages").join("manifest.json"))
             .is_ok_and(|m| m.contains("com.unity.render-pipelines.high-definition"));
+        let canonical_root = root.canonicalize().unwrap_or_else(|_| root.clone());
         Project {
+            canonical_root,
             root,
             assets,
             guids,
@@ -110,12 +114,8 @@ impl Project {
     /// messages).
     pub fn rel(&self, p: &Path) -> String {
         let canon = p.canonicalize().unwrap_or_else(|_| p.to_path_buf());
-        let root = self
-            .root
-            .canonicalize()
-            .unwrap_or_else(|_| self.root.clone());
         canon
-            .strip_prefix(&root)
+            .strip_prefix(&self.canonical_root)
             .unwrap_or(p)
             .to_string_lossy()
             .replace('\\', "/")
