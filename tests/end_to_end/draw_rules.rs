@@ -95,5 +95,5 @@ fn back_faces_masked_layers_and_lod1_show_the_background() {
     assert_ne!(rgb(32, 24), bg, "the Quad seen from the front is drawn");
     assert_eq!(rgb(48, 24), bg, "the layer the camera leaves out");
     assert_eq!(rgb(32, 12), bg, "LOD1 is not drawn");
-    assert!(r["rays"]["continuation"].as_u64().unwrap() > 0, "{r}");
+    assert!(r["rays"]["pass_through"].as_u64().unwrap() > 0, "{r}");
 }

@@ -153,12 +153,26 @@ impl Accel {
     /// Closest hit with t in [tmin, tmax], or None. Ties in t go to the lower triangle
     /// index. NaN/infinite rays, zero directions and tmin > tmax are misses.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        self.tree().closest(ray)
+        self.tree().closest(ray, |_| true)
     }
 
     /// Whether anything blocks the ray in [tmin, tmax]; stops at the first blocker.
     pub fn occluded(&self, ray: &Ray) -> bool {
-        self.tree().any(ray)
+        self.tree().any(ray, |_| true)
+    }
+
+    /// The closest hit that `accept` takes (it is asked about each hit that would be the
+    /// closest so far, soup index and barycentrics filled in): what surfaces that are not
+    /// drawn from every side or at every texel need, without restarting the traversal for
+    /// each refused hit. Ties go to the lower index among accepted hits.
+    pub fn intersect_filtered(&self, ray: &Ray, accept: impl FnMut(&Hit) -> bool) -> Option<Hit> {
+        self.tree().closest(ray, accept)
+    }
+
+    /// Whether a hit that `blocks` takes lies in [tmin, tmax]; stops at the first one.
+    /// Hits reach `blocks` in traversal order, not sorted by t.
+    pub fn occluded_filtered(&self, ray: &Ray, blocks: impl FnMut(&Hit) -> bool) -> bool {
+        self.tree().any(ray, blocks)
     }
 
     /// Bytes held for queries: nodes, leaf lists and triangle data.

@@ -305,20 +305,28 @@ impl Tree<'_> {
 
     /// Closest hit in [tmin, tmax]; ties in t go to the lower triangle index (so the
     /// answer is the brute-force loop's, whatever the leaf order).
+    /// `accept` sees each candidate that would become the best hit (soup index, t, u, v)
+    /// and may refuse it (a culled face, a cut-out texel); refused hits are passed through
+    /// inside the same traversal, with no restart from the root.
     #[inline(always)]
-    pub fn closest(&self, ray: &Ray) -> Option<Hit> {
+    pub fn closest<F: FnMut(&Hit) -> bool>(&self, ray: &Ray, mut accept: F) -> Option<Hit> {
         let s = setup(ray, self.bounds)?;
         // One instantiation per dominant axis: the triangle test's permutation is then a
         // constant (see `triangle::intersect_along`).
         match s.pre.kz {
-            0 => self.closest_along::<0>(ray, &s),
-            1 => self.closest_along::<1>(ray, &s),
-            _ => self.closest_along::<2>(ray, &s),
+            0 => self.closest_along::<0, F>(ray, &s, &mut accept),
+            1 => self.closest_along::<1, F>(ray, &s, &mut accept),
+            _ => self.closest_along::<2, F>(ray, &s, &mut accept),
         }
     }
 
     #[inline(always)]
-    fn closest_along<const KZ: usize>(&self, ray: &Ray, s: &Setup) -> Option<Hit> {
+    fn closest_along<const KZ: usize, F: FnMut(&Hit) -> bool>(
+        &self,
+        ray: &Ray,
+        s: &Setup,
+        accept: &mut F,
+    ) -> Option<Hit> {
         let mut best = Hit::MISS;
         let mut best_t = ray.tmax;
         let mut stack = new_stack();
@@ -337,14 +345,14 @@ impl Tree<'_> {
                     let (lanes, hits) = self.test4::<KZ>(s, ray, group, bound);
                     for (p, h) in lanes.into_iter().zip(hits) {
                         if let Some(h) = h {
-                            keep_closer(&mut best, &mut best_t, self.soup_index(p), h);
+                            keep_closer(&mut best, &mut best_t, self.soup_index(p), h, accept);
                         }
                     }
                 }
             } else {
                 for &p in leaf {
                     if let Some(h) = test::<KZ>(s, ray, self.tri(p), triangle::widen(best_t)) {
-                        keep_closer(&mut best, &mut best_t, self.soup_index(p), h);
+                        keep_closer(&mut best, &mut best_t, self.soup_index(p), h, accept);
                     }
                 }
             }
@@ -366,21 +374,27 @@ impl Tree<'_> {
         }
     }
 
-    /// Whether any triangle is hit in [tmin, tmax]; stops at the first one found.
+    /// Whether any triangle that `blocks` (soup index, t, u, v) is hit in [tmin, tmax];
+    /// stops at the first one found, in whatever order the cells give them.
     #[inline(always)]
-    pub fn any(&self, ray: &Ray) -> bool {
+    pub fn any<F: FnMut(&Hit) -> bool>(&self, ray: &Ray, mut blocks: F) -> bool {
         let Some(s) = setup(ray, self.bounds) else {
             return false;
         };
         match s.pre.kz {
-            0 => self.any_along::<0>(ray, &s),
-            1 => self.any_along::<1>(ray, &s),
-            _ => self.any_along::<2>(ray, &s),
+            0 => self.any_along::<0, F>(ray, &s, &mut blocks),
+            1 => self.any_along::<1, F>(ray, &s, &mut blocks),
+            _ => self.any_along::<2, F>(ray, &s, &mut blocks),
         }
     }
 
     #[inline(always)]
-    fn any_along<const KZ: usize>(&self, ray: &Ray, s: &Setup) -> bool {
+    fn any_along<const KZ: usize, F: FnMut(&Hit) -> bool>(
+        &self,
+        ray: &Ray,
+        s: &Setup,
+        blocks: &mut F,
+    ) -> bool {
         let mut stack = new_stack();
         let mut sp = 0;
         let (mut node_i, mut t0, mut t1) = (0u32, s.t0, s.t1);
@@ -402,15 +416,21 @@ impl Tree<'_> {
             let leaf = self.leaf(node);
             if leaf.len() >= 2 {
                 for group in leaf.chunks(4) {
-                    let (_, hits) = self.test4::<KZ>(s, ray, group, ray.tmax);
-                    if hits.iter().any(Option::is_some) {
-                        return true;
+                    let (lanes, hits) = self.test4::<KZ>(s, ray, group, ray.tmax);
+                    for (p, h) in lanes.into_iter().zip(hits) {
+                        if let Some(h) = h {
+                            if blocks(&candidate(self.soup_index(p), h)) {
+                                return true;
+                            }
+                        }
                     }
                 }
             } else {
                 for &p in leaf {
-                    if test::<KZ>(s, ray, self.tri(p), ray.tmax).is_some() {
-                        return true;
+                    if let Some(h) = test::<KZ>(s, ray, self.tri(p), ray.tmax) {
+                        if blocks(&candidate(self.soup_index(p), h)) {
+                            return true;
+                        }
                     }
                 }
             }
@@ -427,15 +447,30 @@ impl Tree<'_> {
 /// a lower index. Candidates are tested against `widen(best_t)` (see `triangle::widen`),
 /// and four-wide groups against the bound at the group's start, so `h.t <= best_t` here is
 /// the exact test.
+/// `accept` is asked only about a hit that would be kept.
 #[inline(always)]
-pub(crate) fn keep_closer(best: &mut Hit, best_t: &mut f32, prim: u32, h: RawHit) {
+pub(crate) fn keep_closer<F: FnMut(&Hit) -> bool>(
+    best: &mut Hit,
+    best_t: &mut f32,
+    prim: u32,
+    h: RawHit,
+    accept: &mut F,
+) {
     if h.t <= *best_t && (h.t < *best_t || prim < best.prim) {
-        *best_t = h.t;
-        *best = Hit {
-            t: h.t,
-            prim,
-            u: h.u,
-            v: h.v,
-        };
+        let c = candidate(prim, h);
+        if accept(&c) {
+            *best_t = h.t;
+            *best = c;
+        }
+    }
+}
+
+#[inline(always)]
+fn candidate(prim: u32, h: RawHit) -> Hit {
+    Hit {
+        t: h.t,
+        prim,
+        u: h.u,
+        v: h.v,
     }
 }

@@ -10,11 +10,11 @@ pub struct RayCounts {
     pub shadow: u64,
     pub soft_shadow: u64,
     pub reflection: u64,
-    /// Camera and reflection rays traced again past a face their material culls or a
-    /// shadows-only object.
-    pub continuation: u64,
-    /// Shadow rays traced again past a surface that casts no shadow that way.
-    pub shadow_continuation: u64,
+    /// Hits that camera and reflection rays passed through inside their traversal: faces
+    /// their material culls, shadows-only objects (not rays: no query is restarted).
+    pub pass_through: u64,
+    /// Hits that shadow rays passed through: surfaces that cast no shadow that way.
+    pub shadow_pass_through: u64,
     /// Samples whose radiance was NaN or infinite and were replaced by 0 (not a ray kind).
     #[serde(skip)]
     pub sanitized: u64,
@@ -26,17 +26,12 @@ impl RayCounts {
         self.shadow += o.shadow;
         self.soft_shadow += o.soft_shadow;
         self.reflection += o.reflection;
-        self.continuation += o.continuation;
-        self.shadow_continuation += o.shadow_continuation;
+        self.pass_through += o.pass_through;
+        self.shadow_pass_through += o.shadow_pass_through;
         self.sanitized += o.sanitized;
     }
     pub fn total(&self) -> u64 {
-        self.camera
-            + self.shadow
-            + self.soft_shadow
-            + self.reflection
-            + self.continuation
-            + self.shadow_continuation
+        self.camera + self.shadow + self.soft_shadow + self.reflection
     }
 }
 
@@ -46,8 +41,8 @@ pub struct SharedCounts {
     shadow: AtomicU64,
     soft_shadow: AtomicU64,
     reflection: AtomicU64,
-    continuation: AtomicU64,
-    shadow_continuation: AtomicU64,
+    pass_through: AtomicU64,
+    shadow_pass_through: AtomicU64,
     sanitized: AtomicU64,
 }
 
@@ -57,9 +52,9 @@ impl SharedCounts {
         self.shadow.fetch_add(c.shadow, Relaxed);
         self.soft_shadow.fetch_add(c.soft_shadow, Relaxed);
         self.reflection.fetch_add(c.reflection, Relaxed);
-        self.continuation.fetch_add(c.continuation, Relaxed);
-        self.shadow_continuation
-            .fetch_add(c.shadow_continuation, Relaxed);
+        self.pass_through.fetch_add(c.pass_through, Relaxed);
+        self.shadow_pass_through
+            .fetch_add(c.shadow_pass_through, Relaxed);
         self.sanitized.fetch_add(c.sanitized, Relaxed);
     }
     pub fn load(&self) -> RayCounts {
@@ -68,8 +63,8 @@ impl SharedCounts {
             shadow: self.shadow.load(Relaxed),
             soft_shadow: self.soft_shadow.load(Relaxed),
             reflection: self.reflection.load(Relaxed),
-            continuation: self.continuation.load(Relaxed),
-            shadow_continuation: self.shadow_continuation.load(Relaxed),
+            pass_through: self.pass_through.load(Relaxed),
+            shadow_pass_through: self.shadow_pass_through.load(Relaxed),
             sanitized: self.sanitized.load(Relaxed),
         }
     }

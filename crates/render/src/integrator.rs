@@ -268,27 +268,21 @@ impl<'a> Integrator<'a> {
         l
     }
 
-    /// The closest hit camera and reflection rays see, continuing past culled faces and
-    /// shadows-only objects (each continuation counted).
+    /// The closest hit camera and reflection rays see, passing through culled faces and
+    /// shadows-only objects inside one traversal (each pass-through counted).
     fn first_visible(&self, ray: &Ray, counts: &mut RayCounts) -> Option<Hit> {
-        let mut hit = self.accel.intersect(ray)?;
         if !self.culling {
-            return Some(hit);
+            return self.accel.intersect(ray);
         }
-        let mut r = *ray;
-        loop {
+        self.accel.intersect_filtered(ray, |hit| {
             let prim = hit.prim as usize;
             let obj = &self.soup.objects[self.soup.tri_object[prim] as usize];
             let cull = self.soup.materials[self.soup.tri_material[prim] as usize].cull;
             let through = !obj.visible()
-                || (cull != Cull::None && cull.skips(winding(self.soup, prim), r.dir));
-            if !through {
-                return Some(hit);
-            }
-            counts.continuation += 1;
-            r.tmin = hit.t.next_up();
-            hit = self.accel.intersect(&r)?;
-        }
+                || (cull != Cull::None && cull.skips(winding(self.soup, prim), ray.dir));
+            counts.pass_through += through as u64;
+            !through
+        })
     }
 
     /// Whether the hit triangle `prim` blocks a shadow ray travelling along `dir` (towards
@@ -332,15 +326,11 @@ impl<'a> Integrator<'a> {
         if !self.shadow_filter {
             return self.accel.occluded(&ray);
         }
-        let mut r = ray;
-        while let Some(hit) = self.accel.intersect(&r) {
-            if self.casts(hit.prim as usize, r.dir) {
-                return true;
-            }
-            counts.shadow_continuation += 1;
-            r.tmin = hit.t.next_up();
-        }
-        false
+        self.accel.occluded_filtered(&ray, |hit| {
+            let casts = self.casts(hit.prim as usize, ray.dir);
+            counts.shadow_pass_through += !casts as u64;
+            casts
+        })
     }
 
     /// Fraction of `soft_samples` stratified shadow rays that reach the light's extent: a

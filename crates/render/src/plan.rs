@@ -52,7 +52,7 @@ pub struct AntiAliasing {
 }
 
 /// Which surfaces camera and reflection rays pass through: faces their material culls and
-/// shadows-only objects. Each pass-through costs a continuation ray.
+/// shadows-only objects, refused inside the traversal (counted as pass-throughs).
 #[derive(Clone, Debug, Serialize)]
 pub struct CullPlan {
     pub enabled: bool,
@@ -64,8 +64,8 @@ pub struct CullPlan {
 }
 
 /// Whether shadow rays must look past surfaces that do not cast (`m_CastShadows` off, or
-/// a face the material culls seen from the light): then they loop closest-hit queries
-/// instead of stopping at the first blocker.
+/// a face the material culls seen from the light): then each hit a shadow ray finds is
+/// asked whether it casts, and the ray stops at the first that does.
 #[derive(Clone, Debug, Serialize)]
 pub struct ShadowCastPlan {
     pub enabled: bool,
@@ -384,7 +384,7 @@ fn draw_rules(soup: &Soup, used: &[bool], lights: &[LightPlan]) -> (CullPlan, Sh
         } else {
             format!(
                 "{non_casting} objects cast no shadow, {culled_in_shadow_pass} materials cull \
-                 faces in the shadow pass: shadow rays continue past them (closest-hit loop)"
+                 faces in the shadow pass: shadow rays pass through them inside the traversal"
             )
         } + &if not_receiving > 0 {
             format!("; {not_receiving} objects receive no shadows")

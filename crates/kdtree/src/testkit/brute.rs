@@ -16,6 +16,15 @@ use glam::{DVec3, Vec3};
 /// Closest hit in [tmin, tmax] with the tree's watertight test; ties in t go to the lower
 /// triangle index, as in the tree.
 pub fn intersect(triangles: &[[Vec3; 3]], ray: &Ray) -> Option<Hit> {
+    intersect_filtered(triangles, ray, |_| true)
+}
+
+/// [`intersect`] over the hits `accept` takes, asked as the tree asks it.
+pub fn intersect_filtered(
+    triangles: &[[Vec3; 3]],
+    ray: &Ray,
+    mut accept: impl FnMut(&Hit) -> bool,
+) -> Option<Hit> {
     if !(ray.tmin <= ray.tmax) || ray.tmax == f32::NEG_INFINITY || ray.tmin == f32::INFINITY {
         return None;
     }
@@ -25,7 +34,7 @@ pub fn intersect(triangles: &[[Vec3; 3]], ray: &Ray) -> Option<Hit> {
     for (i, t) in triangles.iter().enumerate() {
         let tri = [t[0].to_array(), t[1].to_array(), t[2].to_array()];
         if let Some(h) = triangle::intersect(&pre, &tri, ray.tmin, triangle::widen(best_t)) {
-            keep_closer(&mut best, &mut best_t, i as u32, h);
+            keep_closer(&mut best, &mut best_t, i as u32, h, &mut accept);
         }
     }
     (!best.is_miss()).then_some(best)

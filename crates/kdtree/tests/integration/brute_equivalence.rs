@@ -1,7 +1,7 @@
 //! The tree answers exactly what testing every triangle answers: same triangle, or the
 //! same t within 1e-6 relative for ties.
 
-use formats::BuildParams;
+use formats::{BuildParams, Hit};
 use glam::Vec3;
 use kdtree::testkit::{self, brute};
 use kdtree::{Accel, Ray};
@@ -9,7 +9,28 @@ use proptest::prelude::*;
 
 fn check(tris: &[[Vec3; 3]], accel: &Accel, ray: &Ray) -> Result<(), TestCaseError> {
     let want = brute::intersect(tris, ray);
-    let got = accel.intersect(ray);
+    same_hit(ray, want, accel.intersect(ray))?;
+    prop_assert_eq!(
+        accel.occluded(ray),
+        want.is_some(),
+        "any-hit disagrees with closest-hit for {:?}",
+        ray
+    );
+    // A filter that refuses every third triangle, as culled faces or cut-out texels are
+    // refused: the tree passes through them exactly as the brute-force loop does.
+    let keep = |h: &formats::Hit| !h.prim.is_multiple_of(3);
+    let want = brute::intersect_filtered(tris, ray, keep);
+    same_hit(ray, want, accel.intersect_filtered(ray, keep))?;
+    prop_assert_eq!(
+        accel.occluded_filtered(ray, keep),
+        want.is_some(),
+        "filtered any-hit disagrees with filtered closest-hit for {:?}",
+        ray
+    );
+    Ok(())
+}
+
+fn same_hit(ray: &Ray, want: Option<Hit>, got: Option<Hit>) -> Result<(), TestCaseError> {
     match (want, got) {
         (None, None) => {}
         (Some(w), Some(g)) => {
@@ -23,12 +44,6 @@ fn check(tris: &[[Vec3; 3]], accel: &Accel, ray: &Ray) -> Result<(), TestCaseErr
         }
         _ => prop_assert!(false, "ray {ray:?}: brute {want:?}, tree {got:?}"),
     }
-    prop_assert_eq!(
-        accel.occluded(ray),
-        want.is_some(),
-        "any-hit disagrees with closest-hit for {:?}",
-        ray
-    );
     Ok(())
 }
 

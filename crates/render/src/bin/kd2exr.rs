@@ -259,13 +259,13 @@ fn run(a: RenderArgs) -> Result<()> {
         opts.width, opts.height, window, opts.spp, opts.depth, out.seconds, mrays, load_seconds
     );
     eprintln!(
-        "kd2exr: rays: camera {}, shadow {}, soft_shadow {}, reflection {}, continuation {}, shadow_continuation {} (total {})",
+        "kd2exr: rays: camera {}, shadow {}, soft_shadow {}, reflection {}, pass_through {}, shadow_pass_through {} (total {})",
         c.camera,
         c.shadow,
         c.soft_shadow,
         c.reflection,
-        c.continuation,
-        c.shadow_continuation,
+        c.pass_through,
+        c.shadow_pass_through,
         c.total()
     );
     if c.sanitized > 0 {

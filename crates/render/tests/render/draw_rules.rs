@@ -36,10 +36,12 @@ fn a_one_sided_quad_seen_from_behind_shows_the_wall_behind_it() {
     // The quad covers the middle half of the view; the camera sees its back.
     assert_eq!(out.frame.pixel(10, 10), WALL);
     assert_eq!(out.frame.pixel(0, 0), WALL);
+    // One refused hit per pixel on the quad, two on the 10 pixels of its diagonal, where
+    // the ray meets both of its triangles at the same t.
     assert_eq!(
-        out.counts.continuation,
-        10 * 10,
-        "one continuation per pixel on the quad"
+        out.counts.pass_through,
+        10 * 10 + 10,
+        "pass-throughs on the quad"
     );
     assert!(plan.culling.enabled);
     assert!(
@@ -58,7 +60,7 @@ fn a_two_sided_quad_seen_from_behind_shows() {
     let (out, plan) = render(&soup, &kd, &opts(20, 20));
     assert_eq!(out.frame.pixel(10, 10), QUAD);
     assert_eq!(out.frame.pixel(0, 0), WALL);
-    assert_eq!(out.counts.continuation, 0);
+    assert_eq!(out.counts.pass_through, 0);
     assert!(plan
         .culling
         .reason
@@ -73,7 +75,7 @@ fn a_front_culled_quad_facing_the_camera_is_invisible_and_back_culled_one_shows(
     let (soup, kd) = quad_over_wall(Cull::Back, true).build();
     let (out, _) = render(&soup, &kd, &opts(20, 20));
     assert_eq!(out.frame.pixel(10, 10), QUAD);
-    assert_eq!(out.counts.continuation, 0);
+    assert_eq!(out.counts.pass_through, 0);
 }
 
 #[test]
@@ -86,7 +88,7 @@ fn two_sided_scenes_pay_nothing_for_culling() {
     let (out, plan) = render(&soup, &kd, &opts(8, 8));
     assert!(!plan.culling.enabled);
     assert!(!plan.shadow_casting.enabled);
-    assert_eq!(out.counts.continuation + out.counts.shadow_continuation, 0);
+    assert_eq!(out.counts.pass_through + out.counts.shadow_pass_through, 0);
 }
 
 /// A white floor lit by a sun travelling along (−1, −1, 0) and a 1 m blocker quad at
@@ -163,7 +165,7 @@ fn a_one_sided_blocker_facing_away_from_the_light_casts_no_shadow_unless_two_sid
         1e-5,
         "the light sees the blocker's back",
     );
-    assert!(out.counts.shadow_continuation > 0);
+    assert!(out.counts.shadow_pass_through > 0);
     let mut s = shadowed(Cull::Back, false);
     s.scene.soup.objects[s.blocker as usize].cast_shadows = CastShadows::TwoSided;
     let (v, _, _) = pixel(s, IN_SHADOW);
@@ -184,10 +186,11 @@ fn a_shadows_only_blocker_is_invisible_but_its_shadow_is_on_the_floor() {
         1e-5,
         "under",
     );
+    // One refused hit per pixel on the blocker's top, two on its diagonal's 5 pixels.
     assert_eq!(
-        out.counts.continuation,
-        5 * 5,
-        "a continuation per pixel on the blocker"
+        out.counts.pass_through,
+        5 * 5 + 5,
+        "pass-throughs on the blocker"
     );
 }
 
