@@ -16,9 +16,10 @@ pub use error::FormatError;
 pub use kd::{BuildParams, KdFile, KdNode, TreeStats};
 pub use rays::{Hit, RayRecord};
 pub use soup::{
-    Ambient, AmbientMode, Camera, CastShadows, ClearFlags, Cull, Environment, Light, LightKind,
-    Material, Object, Projection, Shadows, Soup,
+    Alpha, Ambient, AmbientMode, Camera, CastShadows, ClearFlags, Cull, Environment, Light,
+    LightKind, Material, Object, Projection, Shadows, Soup,
 };
+pub use texture::{Texture, TextureRef, Tiling};
 
 /// BLAKE3 digest, used for geometry hashes and payload checksums.
 pub type Digest = [u8; 32];

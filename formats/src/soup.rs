@@ -2,13 +2,14 @@
 //! scene. Right-handed, Y up, metres: Unity's left-handed positions with X negated, so an
 //! OBJ placed at the identity in Unity keeps its file's coordinates. Colours are linear RGB.
 
+use crate::texture::{Texture, TextureRef};
 use crate::{envelope, Digest, FormatError};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 pub const MAGIC: &[u8; 8] = b"UTSOUP\0\0";
-pub const VERSION: u32 = 2;
+pub const VERSION: u32 = 3;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Soup {
@@ -16,12 +17,18 @@ pub struct Soup {
     pub triangles: Vec<[Vec3; 3]>,
     /// Per-vertex shading normals (unit length), parallel to `triangles`.
     pub normals: Vec<[Vec3; 3]>,
+    /// Per-vertex texture coordinates (the mesh's first UV channel, Unity's convention:
+    /// (0, 0) is the image's bottom-left), parallel to `triangles` when any material has a
+    /// texture, empty otherwise; (0, 0) where a mesh has none.
+    pub uvs: Vec<[Vec2; 3]>,
     /// Index into `materials`, one per triangle.
     pub tri_material: Vec<u32>,
     /// Index into `objects`, one per triangle.
     pub tri_object: Vec<u32>,
     pub objects: Vec<Object>,
     pub materials: Vec<Material>,
+    /// Every distinct texture image the materials use, once, at the size Unity imports it.
+    pub textures: Vec<Texture>,
     pub lights: Vec<Light>,
     pub camera: Camera,
     pub environment: Environment,
@@ -119,6 +126,34 @@ pub struct Material {
     /// `_Cull`: the faces camera, reflection and (for casters that are `On`) shadow rays
     /// pass through.
     pub cull: Cull,
+    /// The albedo map (`_MainTex`, `_BaseMap`, `_BaseColorMap`, or the model's own
+    /// texture), multiplied with `color`.
+    pub albedo_map: Option<TextureRef>,
+    /// The alpha of the tint colour (`_Color.a`, `_BaseColor.a`), multiplied with the
+    /// map's alpha where the material uses alpha.
+    pub opacity: f32,
+    /// How the material's alpha is used.
+    pub alpha: Alpha,
+}
+
+/// The shader's blend mode as far as rays care (Standard `_Mode`, URP `_Surface` and
+/// `_AlphaClip`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Alpha {
+    /// Alpha is ignored.
+    Opaque,
+    /// Texels with alpha below `cutoff` (`_Cutoff`) are holes, for every ray.
+    Cutout { cutoff: f32 },
+    /// Transparent or Fade: alpha is the fraction of light the surface stops; the rest
+    /// continues through it.
+    Blend,
+}
+
+impl Material {
+    /// Whether rays need the alpha at a hit to know if it is there at all.
+    pub fn uses_alpha(&self) -> bool {
+        self.alpha != Alpha::Opaque
+    }
 }
 
 impl Material {
@@ -133,6 +168,9 @@ impl Material {
             reflectivity: None,
             emission: Vec3::ZERO,
             cull: Cull::Back,
+            albedo_map: None,
+            opacity: 1.0,
+            alpha: Alpha::Opaque,
         }
     }
 
@@ -338,10 +376,12 @@ impl Soup {
         Soup {
             triangles: vec![],
             normals: vec![],
+            uvs: vec![],
             tri_material: vec![],
             tri_object: vec![],
             objects: vec![],
             materials: vec![],
+            textures: vec![],
             lights: vec![],
             camera: Camera::default(),
             environment: Environment::default(),
@@ -389,6 +429,7 @@ impl Soup {
                 self.objects.len()
             ));
         }
+        self.validate_textures()?;
         if let Some(i) = self.objects.iter().position(|o| o.layer >= 32) {
             return Err(format!(
                 "object {i} is on layer {}; Unity has 32",
@@ -404,6 +445,59 @@ impl Soup {
         }
         if geometry_hash(&self.triangles) != self.geometry_hash {
             return Err("geometry hash does not match the triangles".into());
+        }
+        Ok(())
+    }
+
+    /// Textures, the materials' references to them, alpha settings and UVs: everything a
+    /// texture lookup indexes or divides by.
+    fn validate_textures(&self) -> Result<(), String> {
+        for t in &self.textures {
+            t.validate()?;
+        }
+        let n = self.triangles.len();
+        let textured = self.materials.iter().any(|m| m.albedo_map.is_some());
+        if !(self.uvs.is_empty() || self.uvs.len() == n) || (textured && self.uvs.len() != n) {
+            return Err(format!(
+                "{n} triangles but {} UV triples{}",
+                self.uvs.len(),
+                if textured {
+                    " (a material has a texture)"
+                } else {
+                    ""
+                }
+            ));
+        }
+        for (i, m) in self.materials.iter().enumerate() {
+            if let Some(r) = &m.albedo_map {
+                if r.texture as usize >= self.textures.len() {
+                    return Err(format!(
+                        "material {i} names texture {} of {}",
+                        r.texture,
+                        self.textures.len()
+                    ));
+                }
+                if !r.tiling.is_finite() {
+                    return Err(format!("material {i} has a non-finite texture tiling"));
+                }
+            }
+            let cutoff_ok = match m.alpha {
+                Alpha::Cutout { cutoff } => cutoff.is_finite(),
+                Alpha::Opaque | Alpha::Blend => true,
+            };
+            if !(0.0..=1.0).contains(&m.opacity) || !cutoff_ok {
+                return Err(format!(
+                    "material {i} has opacity {} and alpha {:?}",
+                    m.opacity, m.alpha
+                ));
+            }
+        }
+        if let Some(i) = self
+            .uvs
+            .iter()
+            .position(|t| t.iter().any(|v| !v.is_finite()))
+        {
+            return Err(format!("triangle {i} has a non-finite UV"));
         }
         Ok(())
     }

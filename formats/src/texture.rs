@@ -58,6 +58,14 @@ pub struct Tiling {
     pub offset: [f32; 2],
 }
 
+/// A material's use of one of the soup's textures.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TextureRef {
+    /// Index into `Soup::textures`.
+    pub texture: u32,
+    pub tiling: Tiling,
+}
+
 impl Default for Tiling {
     fn default() -> Self {
         Tiling {
@@ -68,6 +76,10 @@ impl Default for Tiling {
 }
 
 impl Tiling {
+    pub fn is_finite(&self) -> bool {
+        self.scale.iter().chain(&self.offset).all(|c| c.is_finite())
+    }
+
     pub fn apply(&self, uv: [f32; 2]) -> [f32; 2] {
         [
             uv[0] * self.scale[0] + self.offset[0],

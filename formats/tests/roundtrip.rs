@@ -1,5 +1,6 @@
+use formats::texture::{Filter, Wrap};
 use formats::*;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use std::path::Path;
 
 fn sample_soup() -> Soup {
@@ -17,7 +18,33 @@ fn sample_soup() -> Soup {
         receive_shadows: false,
         ..Object::new("Cube", "builtin:Cube")
     }];
-    s.materials = vec![Material::unity_default()];
+    s.uvs = vec![
+        [Vec2::ZERO, Vec2::X, Vec2::Y],
+        [Vec2::ONE, Vec2::new(0.25, 0.5), Vec2::new(-1.0, 2.0)],
+    ];
+    s.materials = vec![Material {
+        albedo_map: Some(TextureRef {
+            texture: 0,
+            tiling: Tiling {
+                scale: [2.0, -1.0],
+                offset: [0.5, 0.0],
+            },
+        }),
+        opacity: 0.75,
+        alpha: Alpha::Cutout { cutoff: 0.5 },
+        ..Material::unity_default()
+    }];
+    s.textures = vec![Texture {
+        source: "Assets/T.png".into(),
+        width: 2,
+        height: 1,
+        texels: vec![255, 0, 0, 255, 0, 128, 0, 64],
+        srgb: true,
+        wrap_u: Wrap::Mirror,
+        wrap_v: Wrap::Clamp,
+        filter: Filter::Point,
+        mipmaps: false,
+    }];
     s.lights = vec![Light {
         name: "Point Light".into(),
         kind: LightKind::Spot {
@@ -67,7 +94,7 @@ fn soup_round_trips_through_a_file() {
     assert_eq!(Soup::read(&path).unwrap(), s);
     let bytes = std::fs::read(&path).unwrap();
     assert_eq!(&bytes[..8], b"UTSOUP\0\0");
-    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 2);
+    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 3);
     // Nothing but the artifact is left in the folder (the temp file was renamed).
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
 }
@@ -92,6 +119,7 @@ fn streamed_soup_file_is_the_encoded_bytes() {
         })
         .collect();
     s.normals = vec![[Vec3::Y; 3]; n];
+    s.uvs = vec![[Vec2::X, Vec2::Y, Vec2::ONE]; n];
     s.tri_material = vec![0; n];
     s.tri_object = vec![0; n];
     s.warnings = (0..2000)
@@ -324,13 +352,13 @@ fn atomic_outputs_get_the_umask_permissions_not_the_temporary_files() {
 }
 
 #[test]
-fn a_version_1_soup_is_refused_with_the_versions_named() {
+fn a_version_2_soup_is_refused_with_the_versions_named() {
     let p = Path::new("old.soup");
     let mut b = sample_soup().to_bytes(p).unwrap();
-    b[8..12].copy_from_slice(&1u32.to_le_bytes());
+    b[8..12].copy_from_slice(&2u32.to_le_bytes());
     let msg = Soup::from_bytes(&b, p).unwrap_err().to_string();
     assert!(
-        msg.contains("soup format version 1, this build reads version 2"),
+        msg.contains("soup format version 2, this build reads version 3"),
         "{msg}"
     );
     assert!(msg.contains("re-run the stage that made it"), "{msg}");
@@ -380,6 +408,48 @@ fn an_object_on_layer_32_is_corrupt() {
         .unwrap_err()
         .to_string();
     assert!(msg.contains("layer 32"), "{msg}");
+}
+
+/// Each texture cross-reference a lookup would index or divide by is checked on read.
+#[test]
+fn bad_texture_references_are_corrupt() {
+    let p = Path::new("tex.soup");
+    let refused = |edit: &dyn Fn(&mut Soup), want: &str| {
+        let mut s = sample_soup();
+        edit(&mut s);
+        let msg = Soup::from_bytes(&s.to_bytes(p).unwrap(), p)
+            .unwrap_err()
+            .to_string();
+        assert!(msg.contains(want), "{want}: {msg}");
+    };
+    refused(
+        &|s| s.uvs.pop().map(drop).unwrap(),
+        "2 triangles but 1 UV triples",
+    );
+    refused(&|s| s.uvs.clear(), "(a material has a texture)");
+    refused(
+        &|s| s.uvs[1][2].y = f32::NAN,
+        "triangle 1 has a non-finite UV",
+    );
+    refused(
+        &|s| s.materials[0].albedo_map.as_mut().unwrap().texture = 1,
+        "material 0 names texture 1 of 1",
+    );
+    refused(
+        &|s| s.materials[0].albedo_map.as_mut().unwrap().tiling.offset[1] = f32::INFINITY,
+        "non-finite texture tiling",
+    );
+    refused(&|s| s.materials[0].opacity = 1.5, "opacity 1.5");
+    refused(
+        &|s| s.textures[0].texels.pop().map(drop).unwrap(),
+        "7 texel bytes",
+    );
+    refused(&|s| s.textures[0].height = 0, "empty (2x0)");
+    // Without a textured material the UVs may be left out.
+    let mut s = sample_soup();
+    s.materials[0].albedo_map = None;
+    s.uvs.clear();
+    assert_eq!(Soup::from_bytes(&s.to_bytes(p).unwrap(), p).unwrap(), s);
 }
 
 #[test]

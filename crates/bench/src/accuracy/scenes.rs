@@ -3,7 +3,7 @@
 
 use anyhow::{bail, Context, Result};
 use formats::{
-    Ambient, AmbientMode, Camera, ClearFlags, Cull, Environment, Light, LightKind, Material,
+    Alpha, Ambient, AmbientMode, Camera, ClearFlags, Cull, Environment, Light, LightKind, Material,
     Object, Projection, Shadows, Soup,
 };
 use glam::Vec3;
@@ -66,6 +66,9 @@ fn material(name: &str, color: Vec3, metallic: f32, smoothness: f32) -> Material
         emission: Vec3::ZERO,
         // Two-sided: the analytic references draw both faces.
         cull: Cull::None,
+        albedo_map: None,
+        opacity: 1.0,
+        alpha: Alpha::Opaque,
     }
 }
 

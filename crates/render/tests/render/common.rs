@@ -1,7 +1,7 @@
 //! Small scenes built in code for the renderer's tests: quads, boxes, lights, cameras.
 
 use formats::{
-    Camera, Cull, KdFile, Light, LightKind, Material, Object, Projection, Shadows, Soup,
+    Alpha, Camera, Cull, KdFile, Light, LightKind, Material, Object, Projection, Shadows, Soup,
 };
 use glam::Vec3;
 use render::{render_scene, Plan, RenderOptions, Rendered};
@@ -118,6 +118,9 @@ pub fn diffuse(c: Vec3) -> Material {
         reflectivity: None,
         emission: Vec3::ZERO,
         cull: Cull::None,
+        albedo_map: None,
+        opacity: 1.0,
+        alpha: Alpha::Opaque,
     }
 }
 
@@ -131,6 +134,9 @@ pub fn mirror(reflectivity: f32) -> Material {
         reflectivity: Some(reflectivity),
         emission: Vec3::ZERO,
         cull: Cull::None,
+        albedo_map: None,
+        opacity: 1.0,
+        alpha: Alpha::Opaque,
     }
 }
 
@@ -144,6 +150,9 @@ pub fn emissive(e: Vec3) -> Material {
         reflectivity: None,
         emission: e,
         cull: Cull::None,
+        albedo_map: None,
+        opacity: 1.0,
+        alpha: Alpha::Opaque,
     }
 }
 
