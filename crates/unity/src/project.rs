@@ -113,12 +113,22 @@ impl Project {
     /// A path relative to the project root, with forward slashes (for names and
     /// messages).
     pub fn rel(&self, p: &Path) -> String {
-        let canon = p.canonicalize().unwrap_or_else(|_| p.to_path_buf());
-        canon
-            .strip_prefix(&self.canonical_root)
-            .unwrap_or(p)
-            .to_string_lossy()
-            .replace('\\', "/")
+        // Asset paths are built under `root`, so the file system is asked only about a path
+        // from elsewhere (through a symlink, or a scene named by a path outside the root).
+        let rel = match p
+            .strip_prefix(&self.root)
+            .or_else(|_| p.strip_prefix(&self.canonical_root))
+        {
+            Ok(r) => r.to_path_buf(),
+            Err(_) => {
+                let canon = p.canonicalize().unwrap_or_else(|_| p.to_path_buf());
+                match canon.strip_prefix(&self.canonical_root) {
+                    Ok(r) => r.to_path_buf(),
+                    Err(_) => p.to_path_buf(),
+                }
+            }
+        };
+        rel.to_string_lossy().replace('\\', "/")
     }
 
     pub fn resolve(&self, guid: &str) -> Option<&PathBuf> {
