@@ -44,6 +44,8 @@ pub(crate) struct Emitter<'g, 'p> {
     pub(crate) meshes: HashMap<String, Option<Arc<Mesh>>>,
     /// Material source key → soup material index.
     pub(crate) materials: HashMap<String, u32>,
+    /// Texture file and import settings → soup texture index, or why it cannot be read.
+    pub(crate) textures: HashMap<String, Result<u32, String>>,
     /// Per soup object: each soup material it uses and where the slot's material came
     /// from.
     pub(crate) material_origins: Vec<Vec<(u32, String)>>,
@@ -82,6 +84,7 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
         world: HashMap::new(),
         meshes: HashMap::new(),
         materials: HashMap::new(),
+        textures: HashMap::new(),
         material_origins: Vec::new(),
         extracted: HashMap::new(),
         camera_mask: crate::layer::EVERYTHING,
