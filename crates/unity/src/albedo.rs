@@ -8,7 +8,7 @@ use crate::emit::Emitter;
 use crate::texture::{albedo_slot, load, Import};
 use crate::yaml::Node;
 use formats::texture::{TextureRef, Tiling};
-use std::path::{Path, PathBuf};
+use std::path::{Component, Path, PathBuf};
 
 impl Emitter<'_, '_> {
     /// The albedo map of Material `body`; `what` names the material in warnings.
@@ -69,7 +69,9 @@ impl Emitter<'_, '_> {
         let dir = model.parent()?;
         let relative = written.replace('\\', "/");
         if !relative.starts_with('/') && !relative.contains(':') {
-            let p = dir.join(&relative);
+            // Folded lexically, so the file has one name however a model spells its way
+            // there (textures are shared by path).
+            let p = fold(&dir.join(&relative));
             if p.is_file() && p.starts_with(&project.assets) {
                 return Some(p);
             }
@@ -88,5 +90,33 @@ impl Emitter<'_, '_> {
             }
         }
         project.find_by_name(name).cloned()
+    }
+}
+
+/// `path` without `.` and `..` components (a `..` drops the component before it).
+fn fold(path: &Path) -> PathBuf {
+    let mut out = PathBuf::new();
+    for c in path.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                out.pop();
+            }
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fold_removes_dot_components() {
+        assert_eq!(
+            fold(Path::new("/p/Assets/Models/./../Textures/a.png")),
+            PathBuf::from("/p/Assets/Textures/a.png")
+        );
     }
 }

@@ -419,3 +419,49 @@ fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
         }
     }
 }
+
+/// CreateWithVR's TravisRoom: five FBX logs use their own material, whose texture Unity
+/// finds in the `Textures/` folder beside the models' folder; it is the image two `.mat`
+/// files name too, stored once. GDSJam's target material is cut out at its own cutoff.
+#[test]
+fn corpus_model_textures_are_found_and_shared() {
+    let Some(root) = corpus() else { return };
+    let soup = unity::convert(
+        &root.join("thespeedyboy__CreateWithVR2021/Assets/Scenes/TravisRoom.unity"),
+        &unity::Options::default(),
+    )
+    .unwrap();
+    let swatch = "Assets/_Course Library/Source Files/Textures/InteriorColourSwatch.png";
+    let users: Vec<&formats::Material> = soup
+        .materials
+        .iter()
+        .filter(|m| {
+            m.albedo_map
+                .is_some_and(|r| soup.textures[r.texture as usize].source == swatch)
+        })
+        .collect();
+    let own = users.iter().filter(|m| m.source.contains(".FBX#")).count();
+    assert_eq!((users.len(), own), (7, 5));
+    assert!(users
+        .windows(2)
+        .all(|w| w[0].albedo_map.unwrap().texture == w[1].albedo_map.unwrap().texture));
+    assert_eq!(
+        soup.textures.iter().filter(|t| t.source == swatch).count(),
+        1
+    );
+    let glass = users
+        .iter()
+        .find(|m| m.name == "Material_Main_Transparent")
+        .unwrap();
+    assert_eq!(glass.alpha, formats::Alpha::Blend);
+    assert_eq!(soup.uvs.len(), soup.triangles.len());
+
+    let soup = unity::convert(
+        &root.join("Pjaerr__GDSJam-Reflection/Assets/Scenes/Tutorial.unity"),
+        &unity::Options::default(),
+    )
+    .unwrap();
+    let target = soup.materials.iter().find(|m| m.name == "target").unwrap();
+    assert_eq!(target.alpha, formats::Alpha::Cutout { cutoff: 0.579 });
+    assert!(target.albedo_map.is_some());
+}
