@@ -195,3 +195,40 @@ fn square_on<'b>(b: &'b mut Builder, look: &str) -> &'b mut Builder {
         .mesh(look, unity::QUAD, look, Xform::at(0.0, 0.0, 0.0))
         .light("Sun", Xform::at(0.0, 3.0, -3.0), sun())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn text(p: &Project, path: &str) -> String {
+        String::from_utf8(p.files[path].clone()).unwrap()
+    }
+
+    #[test]
+    fn materials_and_metas_say_what_the_inspector_would() {
+        let p = project();
+        let cut = text(&p, "Assets/Materials/Cutout.mat");
+        assert!(cut.contains("  m_ValidKeywords:\n  - _ALPHATEST_ON\n"));
+        assert!(cut.contains("  m_CustomRenderQueue: 2450\n"));
+        assert!(cut.contains("    - _Mode: 1\n") && cut.contains("    - _Cutoff: 0.5\n"));
+        let guid = p.guid("Assets/Textures/HalfCut.png");
+        assert!(cut.contains(&format!(
+            "    - _MainTex:\n        m_Texture: {{fileID: 2800000, guid: {guid}, type: 3}}\n"
+        )));
+        let tiled = text(&p, "Assets/Materials/Tiled.mat");
+        assert!(tiled.contains("        m_Scale: {x: 2, y: 1}\n        m_Offset: {x: 0.5, y: 0}\n"));
+        let glass = text(&p, "Assets/Materials/HalfRed.mat");
+        assert!(glass.contains("    - _Mode: 3\n") && glass.contains("    - _ZWrite: 0\n"));
+        assert!(glass.contains("    - _Color: {r: 1, g: 0, b: 0, a: 0.5}\n"));
+        let meta = text(&p, "Assets/Textures/Quadrants.png.meta");
+        assert!(meta.contains("    enableMipMap: 0\n") && meta.contains("    filterMode: 0\n"));
+        let scenes = p.files.keys().filter(|k| k.ends_with(".unity")).count();
+        assert_eq!(scenes, 5);
+        // Top row first in the file: red at the top-left.
+        let img = image::load_from_memory(&p.files["Assets/Textures/Quadrants.png"])
+            .unwrap()
+            .to_rgba8();
+        assert_eq!(img.get_pixel(0, 0).0, QUADRANTS[0]);
+        assert_eq!(img.get_pixel(1, 1).0, QUADRANTS[3]);
+    }
+}
