@@ -64,7 +64,17 @@ impl Emitter<'_, '_> {
     /// machine): that path relative to the model, then the file name next to the model,
     /// in a `Textures/` folder beside it or beside any folder above it inside Assets, and
     /// last anywhere in Assets by name.
-    pub(crate) fn model_texture(&self, model: &Path, written: &str) -> Option<PathBuf> {
+    pub(crate) fn model_texture(&mut self, model: &Path, written: &str) -> Option<PathBuf> {
+        let key = (model.to_path_buf(), written.to_string());
+        if let Some(found) = self.model_textures.get(&key) {
+            return found.clone();
+        }
+        let found = self.find_model_texture(model, written);
+        self.model_textures.insert(key, found.clone());
+        found
+    }
+
+    fn find_model_texture(&self, model: &Path, written: &str) -> Option<PathBuf> {
         let project = self.g.project;
         let dir = model.parent()?;
         let relative = written.replace('\\', "/");
