@@ -69,6 +69,12 @@ fn seeds() -> Vec<(PathBuf, Vec<u8>)> {
             fuzz.join("unity_texture/seed-psd.bin"),
             texture_seed(5, &psd()),
         ),
+        // Raw image data followed by more bytes (the psd crate once wrote them out of
+        // bounds).
+        (
+            fuzz.join("unity_texture/seed-psd-trailing.bin"),
+            texture_seed(5, &[psd(), vec![0; 20]].concat()),
+        ),
         // The PNG with a size limit of 1 texel, so the downscale runs.
         (
             fuzz.join("unity_texture/seed-png-max1.bin"),
