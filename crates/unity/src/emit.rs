@@ -44,6 +44,11 @@ pub(crate) struct Emitter<'g, 'p> {
     pub(crate) meshes: HashMap<String, Option<Arc<Mesh>>>,
     /// Material source key → soup material index.
     pub(crate) materials: HashMap<String, u32>,
+    /// Texture file and import settings → soup texture index, or why it cannot be read.
+    pub(crate) textures: HashMap<String, Result<u32, String>>,
+    /// (model, texture name as the model writes it) → the file found for it: the search
+    /// walks folders, and every instance of a model asks again.
+    pub(crate) model_textures: HashMap<(std::path::PathBuf, String), Option<std::path::PathBuf>>,
     /// Per soup object: each soup material it uses and where the slot's material came
     /// from.
     pub(crate) material_origins: Vec<Vec<(u32, String)>>,
@@ -82,6 +87,8 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
         world: HashMap::new(),
         meshes: HashMap::new(),
         materials: HashMap::new(),
+        textures: HashMap::new(),
+        model_textures: HashMap::new(),
         material_origins: Vec::new(),
         extracted: HashMap::new(),
         camera_mask: crate::layer::EVERYTHING,

@@ -6,6 +6,7 @@
 //! [`graph`] builds the object graph with prefab instances expanded, [`emit`] walks it
 //! into a [`formats::Soup`]. Every asset read goes through [`project::Project`].
 
+pub mod albedo;
 pub mod camera;
 pub mod docs;
 pub mod embedded;

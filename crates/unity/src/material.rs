@@ -8,8 +8,9 @@ use crate::model::Model;
 use crate::project::ModelError;
 use crate::reference::Ref;
 use crate::yaml::Node;
-use formats::{Cull, Material};
+use formats::{Alpha, Cull, Material};
 use glam::{Vec3, Vec4};
+use std::borrow::Cow;
 use std::path::Path;
 
 /// The GUID of Unity's built-in extra resources (Default-Material and its kin).
@@ -84,6 +85,10 @@ pub fn convert(body: &Node, source: &str) -> (Material, Vec<String>) {
 
     if let Some(c) = color("_BaseColor").or_else(|| color("_Color")) {
         m.color = linear_rgb(c);
+        // Alpha is stored linear, never sRGB-encoded.
+        if c.w.is_finite() {
+            m.opacity = c.w.clamp(0.0, 1.0);
+        }
     } else {
         notes.push("no _Color or _BaseColor; white".to_string());
     }
@@ -99,6 +104,7 @@ pub fn convert(body: &Node, source: &str) -> (Material, Vec<String>) {
         Some(1) => m.cull = Cull::Front,
         _ => {}
     }
+    m.alpha = alpha_mode(body, &float);
     if let Some(x) = float("_Reflectivity") {
         m.reflectivity = Some(x.clamp(0.0, 1.0));
     }
@@ -138,6 +144,53 @@ pub fn convert(body: &Node, source: &str) -> (Material, Vec<String>) {
         m.source = source;
     }
     (m, notes)
+}
+
+/// Built-in shaders (under [`BUILTIN_EXTRA_GUID`]) by fileID.
+const STANDARD: i64 = 46;
+const STANDARD_SPECULAR: i64 = 45;
+const UNLIT_TRANSPARENT: i64 = 10750;
+const UNLIT_TRANSPARENT_CUTOUT: i64 = 10751;
+const SPRITES_DEFAULT: i64 = 10753;
+
+/// Scriptable pipelines' Lit shaders.
+const URP_LIT: &str = "933532a4fcc9baf4fa0491de14d08ed7";
+const HDRP_LIT: &str = "6e4ae4064600d784cac1e41a9e6f2e59";
+
+/// How the material's shader uses alpha, from the properties its inspector writes:
+/// Standard's `_Mode` (0 Opaque, 1 Cutout, 2 Fade, 3 Transparent), URP Lit's `_Surface`
+/// (1 Transparent) and `_AlphaClip`, HDRP Lit's `_SurfaceType` and `_AlphaCutoffEnable`,
+/// and the fixed modes of the built-in Unlit and Sprite shaders. Other shaders are opaque:
+/// their properties mean what their author chose.
+pub fn alpha_mode(body: &Node, float: &dyn Fn(&str) -> Option<f32>) -> Alpha {
+    let on = |n: &str| float(n).is_some_and(|x| x.round() as i64 == 1);
+    let cutout = |key: &str| {
+        let c = float(key).filter(|c| c.is_finite()).unwrap_or(0.5);
+        Alpha::Cutout {
+            cutoff: c.clamp(0.0, 1.0),
+        }
+    };
+    let shader = body.get("m_Shader");
+    let guid = shader.and_then(|s| s.str_at("guid"));
+    let id = shader.and_then(|s| s.i64_at("fileID"));
+    match (guid, id) {
+        (Some(BUILTIN_EXTRA_GUID), Some(STANDARD | STANDARD_SPECULAR)) => {
+            match float("_Mode").map(|x| x.round() as i64) {
+                Some(1) => cutout("_Cutoff"),
+                Some(2 | 3) => Alpha::Blend,
+                _ => Alpha::Opaque,
+            }
+        }
+        (Some(BUILTIN_EXTRA_GUID), Some(UNLIT_TRANSPARENT | SPRITES_DEFAULT)) => Alpha::Blend,
+        (Some(BUILTIN_EXTRA_GUID), Some(UNLIT_TRANSPARENT_CUTOUT)) => cutout("_Cutoff"),
+        // A transparent surface that also clips is drawn as blended: below the cutoff its
+        // alpha lets most light through anyway.
+        (Some(URP_LIT), _) if on("_Surface") => Alpha::Blend,
+        (Some(URP_LIT), _) if on("_AlphaClip") => cutout("_Cutoff"),
+        (Some(HDRP_LIT), _) if on("_SurfaceType") => Alpha::Blend,
+        (Some(HDRP_LIT), _) if on("_AlphaCutoffEnable") => cutout("_AlphaCutoff"),
+        _ => Alpha::Opaque,
+    }
 }
 
 impl Emitter<'_, '_> {
@@ -228,7 +281,9 @@ impl Emitter<'_, '_> {
         }
         match f.doc(id) {
             Some((docs::MATERIAL, body)) => {
-                let (m, _notes) = convert(&body, &src);
+                let body = self.inherit(&body, &src);
+                let (mut m, _notes) = convert(&body, &src);
+                m.albedo_map = self.mat_albedo(&body, &src);
                 (self.add_material(key, || m), format!("override {src}"))
             }
             _ => {
@@ -248,10 +303,12 @@ impl Emitter<'_, '_> {
         let mat = self.g.project.mat(path);
         match mat.as_ref() {
             Ok(Some(b)) => {
-                let (m, notes) = convert(b, &rel);
+                let b = self.inherit(b, &rel);
+                let (mut m, notes) = convert(&b, &rel);
                 for n in notes {
                     self.soup.warnings.push(format!("{rel}: {n}"));
                 }
+                m.albedo_map = self.mat_albedo(&b, &rel);
                 self.add_material(key, || m)
             }
             Ok(None) => self.warn_default(what, format!("{rel} holds no Material")),
@@ -318,8 +375,15 @@ impl Emitter<'_, '_> {
         }
         let key = format!("objmat:{rel}:{name}");
         let own = asset.model.material(name);
-        let origin = match own.and_then(|m| m.texture.as_deref()) {
-            Some(t) => format!("model's own {rel}#{name}, texture {t}"),
+        let texture = own
+            .and_then(|m| m.texture.as_deref())
+            .map(|t| (t, self.model_texture(path, t)));
+        let origin = match &texture {
+            Some((_, Some(found))) => format!(
+                "model's own {rel}#{name}, texture {}",
+                self.g.project.rel(found)
+            ),
+            Some((t, None)) => format!("model's own {rel}#{name}, texture {t} not found"),
             None => format!("model's own {rel}#{name}"),
         };
         if let Some(&i) = self.materials.get(&key) {
@@ -331,6 +395,17 @@ impl Emitter<'_, '_> {
                 m.name = name.to_string();
                 m.source = format!("{rel}#{name}");
                 m.color = own.color;
+                let src = m.source.clone();
+                m.albedo_map = match texture {
+                    Some((_, Some(found))) => self.texture_ref(&found, Default::default(), &src),
+                    Some((t, None)) => {
+                        self.soup.warnings.push(format!(
+                            "{src}: texture {t} is not next to the model, in a Textures folder or anywhere in Assets; drawn with its tint alone"
+                        ));
+                        None
+                    }
+                    None => None,
+                };
                 (self.add_material(key, || m), origin)
             }
             // A sub-mesh without a material name: Unity's importer gives it its default
@@ -399,6 +474,86 @@ impl Emitter<'_, '_> {
     }
 }
 
+/// How many `m_Parent` links a variant may follow (a cycle or a deep chain ends there).
+const MAX_VARIANT_DEPTH: usize = 16;
+
+/// The `m_SavedProperties` sections a variant inherits entry by entry.
+const PROPERTY_SECTIONS: [&str; 4] = ["m_TexEnvs", "m_Ints", "m_Floats", "m_Colors"];
+
+impl Emitter<'_, '_> {
+    /// A Material body with what its parents set and it does not (a material variant,
+    /// `m_Parent`, Unity 2022+, stores only its overrides); the body itself when it has no
+    /// parent. `what` names the material in warnings.
+    pub(crate) fn inherit<'b>(&mut self, body: &'b Node, what: &str) -> Cow<'b, Node> {
+        let mut merged = Cow::Borrowed(body);
+        let mut current = Cow::Borrowed(body);
+        for _ in 0..MAX_VARIANT_DEPTH {
+            let Some(guid) = current
+                .get("m_Parent")
+                .filter(|p| p.i64_at("fileID").unwrap_or(0) != 0)
+                .and_then(|p| p.str_at("guid"))
+            else {
+                return merged;
+            };
+            let parent = self.g.project.resolve(guid).map(|p| self.g.project.mat(p));
+            let Some(Ok(Some(parent))) = parent.as_deref() else {
+                self.soup.warnings.push(format!(
+                    "{what}: parent material {guid} is not a readable material of the project; only the variant's own properties used"
+                ));
+                return merged;
+            };
+            merged = Cow::Owned(with_parent(&merged, parent));
+            current = Cow::Owned(parent.clone());
+        }
+        self.soup.warnings.push(format!(
+            "{what}: more than {MAX_VARIANT_DEPTH} parent materials (a cycle?); the rest ignored"
+        ));
+        merged
+    }
+}
+
+/// `child` with each saved property of `parent` that it does not set itself.
+fn with_parent(child: &Node, parent: &Node) -> Node {
+    let empty = Node::Map(vec![]);
+    let parent_saved = parent.get("m_SavedProperties").unwrap_or(&empty);
+    let mut out = child.clone();
+    let Node::Map(top) = &mut out else {
+        return out;
+    };
+    if !top.iter().any(|(k, _)| k == "m_SavedProperties") {
+        top.push(("m_SavedProperties".into(), Node::Map(vec![])));
+    }
+    let Some((_, Node::Map(saved))) = top.iter_mut().find(|(k, _)| k == "m_SavedProperties") else {
+        return out;
+    };
+    for section in PROPERTY_SECTIONS {
+        let inherited: Vec<(String, Node)> = props(parent_saved, section)
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v.clone()))
+            .collect();
+        if inherited.is_empty() {
+            continue;
+        }
+        // Rewritten in the modern list layout, which `props` reads like the legacy one.
+        let wrapped = Node::Map(saved.clone());
+        let mut entries: Vec<(String, Node)> = props(&wrapped, section)
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v.clone()))
+            .collect();
+        for (k, v) in inherited {
+            if !entries.iter().any(|(own, _)| *own == k) {
+                entries.push((k, v));
+            }
+        }
+        let list = Node::Seq(entries.into_iter().map(|kv| Node::Map(vec![kv])).collect());
+        match saved.iter_mut().find(|(k, _)| k == section) {
+            Some((_, sec)) => *sec = list,
+            None => saved.push((section.to_string(), list)),
+        }
+    }
+    out
+}
+
 /// A material name as Unity writes it into a file name: characters no file system
 /// allows become `_`.
 fn sanitize(name: &str) -> String {
@@ -415,7 +570,7 @@ fn sanitize(name: &str) -> String {
 
 /// The file `name` in `dir`, ASCII case ignored (projects made on Windows or macOS do
 /// not keep case).
-fn file_in(dir: &Path, name: &str) -> Option<std::path::PathBuf> {
+pub(crate) fn file_in(dir: &Path, name: &str) -> Option<std::path::PathBuf> {
     let exact = dir.join(name);
     if exact.is_file() {
         return Some(exact);
@@ -462,5 +617,72 @@ mod tests {
         let (m, _) = convert(legacy.get("Material").unwrap(), "c.mat");
         assert_eq!(m.metallic, 1.0);
         assert!((m.color.x - srgb_to_linear(0.2)).abs() < 1e-7);
+    }
+
+    fn alpha_of(text: &str) -> (Alpha, f32) {
+        let (m, _) = convert(parse(text).get("Material").unwrap(), "a.mat");
+        (m.alpha, m.opacity)
+    }
+
+    #[test]
+    fn alpha_modes_by_shader() {
+        let standard = |mode: &str, rest: &str| {
+            format!("Material:\n  m_Shader: {{fileID: 46, guid: 0000000000000000f000000000000000, type: 0}}\n  m_SavedProperties:\n    m_Floats:\n    - _Mode: {mode}\n{rest}    m_Colors:\n    - _Color: {{r: 1, g: 1, b: 1, a: 0.25}}\n")
+        };
+        assert_eq!(alpha_of(&standard("0", "")), (Alpha::Opaque, 0.25));
+        assert_eq!(
+            alpha_of(&standard("1", "    - _Cutoff: 0.3\n")).0,
+            Alpha::Cutout { cutoff: 0.3 }
+        );
+        assert_eq!(
+            alpha_of(&standard("1", "")).0,
+            Alpha::Cutout { cutoff: 0.5 }
+        );
+        assert_eq!(alpha_of(&standard("2", "")).0, Alpha::Blend);
+        assert_eq!(alpha_of(&standard("3", "")).0, Alpha::Blend);
+        let urp = |floats: &str| {
+            format!("Material:\n  m_Shader: {{fileID: 4800000, guid: 933532a4fcc9baf4fa0491de14d08ed7, type: 3}}\n  m_SavedProperties:\n    m_Floats:\n{floats}")
+        };
+        assert_eq!(
+            alpha_of(&urp(
+                "    - _Surface: 0\n    - _AlphaClip: 1\n    - _Cutoff: 0.7\n"
+            ))
+            .0,
+            Alpha::Cutout { cutoff: 0.7 }
+        );
+        assert_eq!(
+            alpha_of(&urp("    - _Surface: 1\n    - _AlphaClip: 0\n")).0,
+            Alpha::Blend
+        );
+        assert_eq!(
+            alpha_of(&urp("    - _Surface: 0\n    - _AlphaClip: 0\n")),
+            (Alpha::Opaque, 1.0)
+        );
+        let hdrp = "Material:\n  m_Shader: {fileID: 4800000, guid: 6e4ae4064600d784cac1e41a9e6f2e59, type: 3}\n  m_SavedProperties:\n    m_Floats:\n    - _AlphaCutoffEnable: 1\n    - _AlphaCutoff: 0.25\n";
+        assert_eq!(alpha_of(hdrp).0, Alpha::Cutout { cutoff: 0.25 });
+        let unlit = |id: i64| {
+            format!("Material:\n  m_Shader: {{fileID: {id}, guid: 0000000000000000f000000000000000, type: 0}}\n")
+        };
+        assert_eq!(alpha_of(&unlit(10750)).0, Alpha::Blend);
+        assert_eq!(alpha_of(&unlit(10751)).0, Alpha::Cutout { cutoff: 0.5 });
+        assert_eq!(alpha_of(&unlit(10752)).0, Alpha::Opaque);
+        // A custom shader's _Mode means what its author chose.
+        let custom = "Material:\n  m_Shader: {fileID: 4800000, guid: 1234, type: 3}\n  m_SavedProperties:\n    m_Floats:\n    - _Mode: 1\n";
+        assert_eq!(alpha_of(custom).0, Alpha::Opaque);
+    }
+
+    #[test]
+    fn a_variant_keeps_its_own_properties_and_inherits_the_rest() {
+        let parent = parse("Material:\n  m_SavedProperties:\n    m_TexEnvs:\n    - _BaseMap:\n        m_Texture: {fileID: 2800000, guid: aaaa, type: 3}\n    m_Floats:\n    - _Smoothness: 0.9\n    - _Metallic: 0.5\n    m_Colors:\n    - _BaseColor: {r: 1, g: 0, b: 0, a: 1}\n");
+        let child = parse("Material:\n  m_SavedProperties:\n    m_TexEnvs:\n    - _BaseMap:\n        m_Texture: {fileID: 2800000, guid: bbbb, type: 3}\n    m_Floats:\n    - _Metallic: 0.25\n    m_Colors: []\n");
+        let merged = with_parent(
+            child.get("Material").unwrap(),
+            parent.get("Material").unwrap(),
+        );
+        let (m, _) = convert(&merged, "v.mat");
+        assert_eq!((m.metallic, m.smoothness), (0.25, 0.9));
+        assert_eq!(m.color, Vec3::new(1.0, 0.0, 0.0));
+        let slot = crate::texture::albedo_slot(&merged).unwrap();
+        assert_eq!(slot.guid, "bbbb");
     }
 }

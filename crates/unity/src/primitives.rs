@@ -32,7 +32,40 @@ pub fn mesh(file_id: i64) -> Option<Mesh> {
         10210 => quad(),
         _ => return None,
     };
-    Some(m.import_rh())
+    let mut m = m.import_rh();
+    match file_id {
+        10202 => m.uvs = m.positions.iter().zip(&m.normals).map(cube_uv).collect(),
+        10209 => m.uvs = m.positions.iter().map(plane_uv).collect(),
+        _ => {}
+    }
+    Some(m)
+}
+
+/// Unity's Cube layout, in Unity space: every face spans the whole texture, upright seen
+/// from outside on the four sides facing ±X and +Z, turned half a turn on the −Z face
+/// (the one a default camera sees); the top runs u along −X, v along −Z, the bottom u
+/// along −X, v along +Z.
+fn cube_uv((p, n): (&Vec3, &Vec3)) -> Vec2 {
+    let (x, y, z) = (p.x + 0.5, p.y + 0.5, p.z + 0.5);
+    if n.x > 0.5 {
+        Vec2::new(z, y)
+    } else if n.x < -0.5 {
+        Vec2::new(1.0 - z, y)
+    } else if n.y > 0.5 {
+        Vec2::new(1.0 - x, 1.0 - z)
+    } else if n.y < -0.5 {
+        Vec2::new(1.0 - x, z)
+    } else if n.z > 0.5 {
+        Vec2::new(1.0 - x, y)
+    } else {
+        Vec2::new(1.0 - x, 1.0 - y)
+    }
+}
+
+/// Unity's Plane layout, in Unity space: (0, 0) at the (+5, 0, +5) corner, u along −X and
+/// v along −Z, so seen from above with +Z up the texture is turned half a turn.
+fn plane_uv(p: &Vec3) -> Vec2 {
+    Vec2::new(0.5 - p.x / 10.0, 0.5 - p.z / 10.0)
 }
 
 #[derive(Default)]
@@ -121,8 +154,8 @@ fn quad() -> Mesh {
     b.quad(a, c, d, e);
     // Unity's Quad maps the texture upright seen from its front (from −Z, +X to the
     // right): (0, 0) at Unity's (−0.5, −0.5), which is this right-handed (+0.5, −0.5).
-    // The layouts of Cube, Sphere, Capsule, Cylinder and Plane are not established, so
-    // they have no UVs yet.
+    // The layouts of Sphere, Capsule and Cylinder are not established, so they have no
+    // UVs yet; Cube and Plane get theirs in Unity space (see `mesh`).
     b.uv =
         b.p.iter()
             .map(|p| Vec2::new(0.5 - p.x, p.y + 0.5))
@@ -349,8 +382,63 @@ mod tests {
             assert_eq!(*uv, Vec2::new(p.x + 0.5, p.y + 0.5), "{p}");
         }
         assert!(q.uvs.contains(&Vec2::ZERO) && q.uvs.contains(&Vec2::ONE));
-        for id in [10202, 10206, 10207, 10208, 10209] {
+        for id in [10206, 10207, 10208] {
             assert!(mesh(id).unwrap().uvs.is_empty(), "{id}");
         }
+    }
+
+    /// The UV of the Unity-space corner `p` of the face with normal `n`.
+    fn uv_at(m: &Mesh, p: Vec3, n: Vec3) -> Vec2 {
+        let i = (0..m.positions.len())
+            .find(|&i| m.positions[i] == p && m.normals[i] == n)
+            .unwrap_or_else(|| panic!("no corner {p} on face {n}"));
+        m.uvs[i]
+    }
+
+    #[test]
+    fn cube_uvs_as_unity_lays_them_out() {
+        let c = mesh(10202).unwrap();
+        assert_eq!(c.uvs.len(), 24);
+        let h = 0.5;
+        // (face normal, corner, uv) in Unity space.
+        let cases = [
+            (Vec3::Z, Vec3::new(h, -h, h), Vec2::new(0.0, 0.0)),
+            (Vec3::Z, Vec3::new(-h, -h, h), Vec2::new(1.0, 0.0)),
+            (Vec3::Z, Vec3::new(h, h, h), Vec2::new(0.0, 1.0)),
+            (Vec3::Y, Vec3::new(h, h, h), Vec2::new(0.0, 0.0)),
+            (Vec3::Y, Vec3::new(-h, h, h), Vec2::new(1.0, 0.0)),
+            (Vec3::Y, Vec3::new(h, h, -h), Vec2::new(0.0, 1.0)),
+            (Vec3::NEG_Z, Vec3::new(h, h, -h), Vec2::new(0.0, 0.0)),
+            (Vec3::NEG_Z, Vec3::new(-h, h, -h), Vec2::new(1.0, 0.0)),
+            (Vec3::NEG_Z, Vec3::new(h, -h, -h), Vec2::new(0.0, 1.0)),
+            (Vec3::NEG_Y, Vec3::new(h, -h, -h), Vec2::new(0.0, 0.0)),
+            (Vec3::NEG_Y, Vec3::new(h, -h, h), Vec2::new(0.0, 1.0)),
+            (Vec3::NEG_Y, Vec3::new(-h, -h, h), Vec2::new(1.0, 1.0)),
+            (Vec3::NEG_X, Vec3::new(-h, -h, h), Vec2::new(0.0, 0.0)),
+            (Vec3::NEG_X, Vec3::new(-h, h, h), Vec2::new(0.0, 1.0)),
+            (Vec3::NEG_X, Vec3::new(-h, h, -h), Vec2::new(1.0, 1.0)),
+            (Vec3::X, Vec3::new(h, -h, -h), Vec2::new(0.0, 0.0)),
+            (Vec3::X, Vec3::new(h, h, -h), Vec2::new(0.0, 1.0)),
+            (Vec3::X, Vec3::new(h, h, h), Vec2::new(1.0, 1.0)),
+        ];
+        for (n, p, uv) in cases {
+            assert_eq!(uv_at(&c, p, n), uv, "face {n} corner {p}");
+        }
+    }
+
+    #[test]
+    fn plane_uvs_as_unity_lays_them_out() {
+        let p = mesh(10209).unwrap();
+        assert_eq!(p.uvs.len(), 121);
+        assert_eq!(uv_at(&p, Vec3::new(5.0, 0.0, 5.0), Vec3::Y), Vec2::ZERO);
+        assert_eq!(uv_at(&p, Vec3::new(-5.0, 0.0, -5.0), Vec3::Y), Vec2::ONE);
+        assert_eq!(
+            uv_at(&p, Vec3::new(-5.0, 0.0, 5.0), Vec3::Y),
+            Vec2::new(1.0, 0.0)
+        );
+        assert_eq!(
+            uv_at(&p, Vec3::new(0.0, 0.0, 0.0), Vec3::Y),
+            Vec2::splat(0.5)
+        );
     }
 }

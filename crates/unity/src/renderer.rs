@@ -6,7 +6,7 @@ use crate::emit::{flip, EmitError, Emitter};
 use crate::layer::layer;
 use crate::mesh::Mesh;
 use formats::{CastShadows, Object};
-use glam::{Mat3, Mat4, Vec3};
+use glam::{Mat3, Mat4, Vec2, Vec3};
 use rayon::prelude::*;
 
 impl Emitter<'_, '_> {
@@ -95,14 +95,16 @@ const PARALLEL_MIN: usize = 8192;
 
 /// A mesh's vertices in world space, soup handedness. Each vertex is transformed once
 /// rather than once per corner (a closed mesh has about six corners per vertex); a corner
-/// then copies the very values the per-corner transform computed.
-struct Placed {
+/// then copies the very values the per-corner transform computed. Texture coordinates do
+/// not move with the mesh, so they are the mesh's own.
+struct Placed<'m> {
     positions: Vec<Vec3>,
     normals: Vec<Vec3>,
+    uvs: &'m [Vec2],
 }
 
-impl Placed {
-    fn new(mesh: &Mesh, world: Mat4) -> Self {
+impl<'m> Placed<'m> {
+    fn new(mesh: &'m Mesh, world: Mat4) -> Self {
         let normal_m = Mat3::from_mat4(world).inverse().transpose();
         let position = |p: &Vec3| flip(world.transform_point3(*p));
         let normal = |n: &Vec3| {
@@ -117,11 +119,13 @@ impl Placed {
             Placed {
                 positions: mesh.positions.iter().map(position).collect(),
                 normals: mesh.normals.iter().map(normal).collect(),
+                uvs: &mesh.uvs,
             }
         } else {
             Placed {
                 positions: mesh.positions.par_iter().map(position).collect(),
                 normals: mesh.normals.par_iter().map(normal).collect(),
+                uvs: &mesh.uvs,
             }
         }
     }
@@ -135,6 +139,11 @@ impl Emitter<'_, '_> {
     /// (rayon's indexed `par_extend` writes in place, in order), positions and normals as
     /// two passes, so the output is the same as a sequential loop's. Degenerate triangles
     /// are found afterwards and squeezed out in order; they are rare.
+    ///
+    /// UVs cost a third pass, so they are gathered only once a textured material has been
+    /// seen: until then `soup.uvs` stays empty (and an untextured soup never pays), from
+    /// then on every triangle gets a triple — its mesh's UVs when its material is
+    /// textured, zeros otherwise, since nothing samples them.
     fn place(
         &mut self,
         placed: &Placed,
@@ -145,21 +154,42 @@ impl Emitter<'_, '_> {
     ) -> usize {
         // The flip to right-handed space reverses the winding once; a mirroring transform
         // (negative determinant) reverses it again.
-        let wind = |v: [Vec3; 3]| {
+        fn wind<T: Copy>(flip_winding: bool, v: [T; 3]) -> [T; 3] {
             if flip_winding {
                 v
             } else {
                 [v[0], v[2], v[1]]
             }
-        };
-        let position = |t: &[u32; 3]| wind(t.map(|i| placed.positions[i as usize]));
-        let normal = |t: &[u32; 3]| wind(t.map(|i| placed.normals[i as usize]));
+        }
+        let position = |t: &[u32; 3]| wind(flip_winding, t.map(|i| placed.positions[i as usize]));
+        let normal = |t: &[u32; 3]| wind(flip_winding, t.map(|i| placed.normals[i as usize]));
+        let textured = self.soup.materials[mat as usize].albedo_map.is_some();
         let soup = &mut self.soup;
         let start = soup.triangles.len();
+        if textured && soup.uvs.len() < start {
+            soup.uvs.resize(start, [Vec2::ZERO; 3]);
+        }
+        let uvs_on = textured || !soup.uvs.is_empty();
+        // A mesh without UVs (or with fewer than positions) samples texel (0, 0).
+        let mesh_uvs = if textured && placed.uvs.len() == placed.positions.len() {
+            placed.uvs
+        } else {
+            &[]
+        };
+        let uv = |t: &[u32; 3]| {
+            if mesh_uvs.is_empty() {
+                [Vec2::ZERO; 3]
+            } else {
+                wind(flip_winding, t.map(|i| mesh_uvs[i as usize]))
+            }
+        };
         let n = tris.len();
         let dropped = if n < PARALLEL_MIN {
             soup.triangles.extend(tris.iter().map(position));
             soup.normals.extend(tris.iter().map(normal));
+            if uvs_on {
+                soup.uvs.extend(tris.iter().map(uv));
+            }
             soup.triangles[start..]
                 .iter()
                 .filter(|p| degenerate(**p))
@@ -169,6 +199,10 @@ impl Emitter<'_, '_> {
                 .par_extend(tris.par_iter().with_min_len(PARALLEL_MIN / 2).map(position));
             soup.normals
                 .par_extend(tris.par_iter().with_min_len(PARALLEL_MIN / 2).map(normal));
+            if uvs_on {
+                soup.uvs
+                    .par_extend(tris.par_iter().with_min_len(PARALLEL_MIN / 2).map(uv));
+            }
             soup.triangles[start..]
                 .par_iter()
                 .with_min_len(PARALLEL_MIN / 2)
@@ -181,11 +215,17 @@ impl Emitter<'_, '_> {
                 if !degenerate(soup.triangles[i]) {
                     soup.triangles[kept] = soup.triangles[i];
                     soup.normals[kept] = soup.normals[i];
+                    if uvs_on {
+                        soup.uvs[kept] = soup.uvs[i];
+                    }
                     kept += 1;
                 }
             }
             soup.triangles.truncate(kept);
             soup.normals.truncate(kept);
+            if uvs_on {
+                soup.uvs.truncate(kept);
+            }
             soup.dropped_degenerate += dropped as u64;
         }
         let kept = n - dropped;

@@ -326,10 +326,10 @@ pub fn decode(
         if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
             return Err(too_large(w, h));
         }
-        if !psd_complete(bytes, w, h) {
+        let Some(end) = psd_end(bytes, w, h) else {
             return Err(decode_err("PSD", "truncated".into()));
-        }
-        let rgba = decode_psd(bytes).map_err(|m| decode_err("PSD", m))?;
+        };
+        let rgba = decode_psd(&bytes[..end]).map_err(|m| decode_err("PSD", m))?;
         let img = image::RgbaImage::from_raw(w, h, rgba)
             .ok_or_else(|| decode_err("PSD", "composite size does not match header".into()))?;
         (DynamicImage::ImageRgba8(img), false)
@@ -427,32 +427,39 @@ fn be32(b: &[u8], i: usize) -> Option<u32> {
     Some(u32::from_be_bytes(b.get(i..i + 4)?.try_into().ok()?))
 }
 
-/// Whether a PSD holds as many image-data bytes as its header promises: the `psd` crate
-/// reads a truncated composite as black instead of failing.
-fn psd_complete(bytes: &[u8], w: u32, h: u32) -> bool {
+/// How much of a PSD to hand the `psd` crate, or `None` when it holds fewer image-data
+/// bytes than its header promises (the crate reads a truncated composite as black instead
+/// of failing). Raw image data is cut where the header says it ends: the crate writes
+/// bytes past that end out of bounds.
+fn psd_end(bytes: &[u8], w: u32, h: u32) -> Option<usize> {
     let be16 = |i: usize| {
         bytes
             .get(i..i + 2)
             .map(|s| u16::from_be_bytes([s[0], s[1]]))
     };
-    let (Some(channels), Some(depth)) = (be16(12), be16(22)) else {
-        return false;
-    };
+    let (channels, depth) = (be16(12)?, be16(22)?);
     let mut at = 26usize;
     for _ in 0..3 {
-        let Some(len) = be32(bytes, at) else {
-            return false;
-        };
-        at = at.saturating_add(4).saturating_add(len as usize);
+        at = at
+            .saturating_add(4)
+            .saturating_add(be32(bytes, at)? as usize);
     }
     let rows = channels as u64 * h as u64;
-    let need = match be16(at) {
-        Some(0) => rows * w as u64 * (depth as u64).div_ceil(8),
+    let (need, raw) = match be16(at)? {
+        0 => (rows * w as u64 * (depth as u64).div_ceil(8), true),
         // RLE: at least the table of packed row lengths.
-        Some(1) => rows * 2,
-        _ => return false,
+        1 => (rows * 2, false),
+        _ => return None,
     };
-    (bytes.len() as u64).saturating_sub(at as u64 + 2) >= need
+    let data = at as u64 + 2;
+    if (bytes.len() as u64).saturating_sub(data) < need {
+        return None;
+    }
+    Some(if raw {
+        (data + need) as usize
+    } else {
+        bytes.len()
+    })
 }
 
 /// The flattened composite of a PSD as RGBA, top row first. The `psd` crate indexes
@@ -680,6 +687,12 @@ m_SavedProperties:
         let t = decode(&psd_2x2(), "psd", "t.psd", &Import::default()).unwrap();
         assert_eq!(&t.texels[..4], &[0, 0, 255, 255]);
         assert_eq!(&t.texels[12..], &[0, 255, 0, 255]);
+        // Bytes after the raw image data are ignored (the fuzzer's find: the psd crate
+        // wrote them past the end of its buffer).
+        let mut padded = psd_2x2();
+        padded.extend([0; 20]);
+        let p = decode(&padded, "psd", "t.psd", &Import::default()).unwrap();
+        assert_eq!(p, t);
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! One small project per rendering effect (what `just gallery` renders), built from Unity's
 //! built-in primitives: each isolates one thing the renderer must get right.
 
-use crate::material::{write_material, MatDesc};
+use crate::material::{write_material, write_surface, MatDesc, Surface};
 use crate::meta;
 use crate::project::Project;
 use crate::unity::{
@@ -33,6 +33,49 @@ impl Builder {
             mats,
             objects: Vec::new(),
         }
+    }
+
+    /// Add a look that draws with a texture or alpha.
+    pub fn look(&mut self, m: &MatDesc, surface: &Surface) -> &mut Self {
+        let path = format!("Assets/Materials/{}.mat", m.name);
+        let guid = self
+            .project
+            .add_asset(&path, write_surface(m, surface), meta::material);
+        self.mats.insert(m.name, guid);
+        self
+    }
+
+    /// Add an image file at `path` with its TextureImporter `.meta`; returns its GUID.
+    pub fn texture(&mut self, path: &str, bytes: Vec<u8>, import: &meta::TextureImport) -> String {
+        let guid = self.project.guid(path);
+        self.project.files.insert(path.to_string(), bytes);
+        self.project
+            .add(&format!("{path}.meta"), meta::texture(&guid, import));
+        guid
+    }
+
+    /// The GUID an asset at `path` of this project gets.
+    pub fn guid(&self, path: &str) -> String {
+        self.project.guid(path)
+    }
+
+    /// Write the objects added so far as `Assets/Scenes/<scene_name>.unity` and start the
+    /// next scene of the same project.
+    pub fn scene(&mut self, scene_name: &str, ambient: Ambient) -> &mut Self {
+        let path = format!("Assets/Scenes/{scene_name}.unity");
+        let key = format!("{}/{scene_name}", self.project.name);
+        let scene = SceneDesc {
+            ambient,
+            objects: std::mem::take(&mut self.objects),
+        };
+        self.project
+            .add_asset(&path, unity::write_scene(&key, &scene), meta::scene);
+        self
+    }
+
+    /// The project with every scene written by [`Builder::scene`].
+    pub fn done(self) -> Project {
+        self.project.finish()
     }
 
     pub fn camera(&mut self, xform: Xform, desc: CameraDesc) -> &mut Self {

@@ -16,6 +16,85 @@ pub struct MatDesc {
     pub emission: Option<[f32; 3]>,
 }
 
+/// What a look draws with beyond its colours: its albedo texture and how it uses alpha.
+#[derive(Clone, Debug)]
+pub struct Surface {
+    /// `_MainTex`: the texture's GUID with its tiling.
+    pub main_tex: Option<TexSlot>,
+    /// The `_Color` alpha.
+    pub alpha: f32,
+    /// The Standard shader's rendering mode (the inspector's other settings follow it).
+    pub mode: Mode,
+    /// `_Cutoff`, the alpha threshold in [`Mode::Cutout`].
+    pub cutoff: f32,
+}
+
+impl Default for Surface {
+    fn default() -> Self {
+        Surface {
+            main_tex: None,
+            alpha: 1.0,
+            mode: Mode::Opaque,
+            cutoff: 0.5,
+        }
+    }
+}
+
+/// A texture in a material slot: uv' = uv · scale + offset.
+#[derive(Clone, Debug)]
+pub struct TexSlot {
+    pub guid: String,
+    pub scale: [f32; 2],
+    pub offset: [f32; 2],
+}
+
+impl TexSlot {
+    pub fn new(guid: &str) -> Self {
+        TexSlot {
+            guid: guid.to_string(),
+            scale: [1.0, 1.0],
+            offset: [0.0, 0.0],
+        }
+    }
+}
+
+/// Standard's `_Mode`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mode {
+    Opaque = 0,
+    Cutout = 1,
+    Fade = 2,
+    Transparent = 3,
+}
+
+impl Mode {
+    /// The keyword, render queue, RenderType tag and blend state the inspector writes
+    /// for the mode.
+    fn inspector(self) -> (Option<&'static str>, i32, Option<&'static str>, [f32; 3]) {
+        match self {
+            Mode::Opaque => (None, -1, None, [1.0, 0.0, 1.0]),
+            Mode::Cutout => (
+                Some("_ALPHATEST_ON"),
+                2450,
+                Some("TransparentCutout"),
+                [1.0, 0.0, 1.0],
+            ),
+            Mode::Fade => (
+                Some("_ALPHABLEND_ON"),
+                3000,
+                Some("Transparent"),
+                [5.0, 10.0, 0.0],
+            ),
+            Mode::Transparent => (
+                Some("_ALPHAPREMULTIPLY_ON"),
+                3000,
+                Some("Transparent"),
+                [1.0, 10.0, 0.0],
+            ),
+        }
+    }
+}
+
 impl MatDesc {
     /// A non-metallic matte colour.
     pub fn matte(name: &'static str, color: [f32; 3]) -> Self {
@@ -55,12 +134,27 @@ const TEXTURES: [&str; 9] = [
 ];
 
 pub fn write_material(m: &MatDesc) -> String {
+    write_surface(m, &Surface::default())
+}
+
+/// A look with a texture or alpha ([`Surface`]).
+pub fn write_surface(m: &MatDesc, surface: &Surface) -> String {
     let mut s =
         String::from("%YAML 1.1\n%TAG !u! tag:unity3d.com,2011:\n--- !u!21 &2100000\nMaterial:\n");
-    let keywords = if m.emission.is_some() {
-        "\n  - _EMISSION"
+    let (mode_keyword, queue, render_type, [src, dst, zwrite]) = surface.mode.inspector();
+    let mut keywords: Vec<&str> = mode_keyword.into_iter().collect();
+    if m.emission.is_some() {
+        keywords.push("_EMISSION");
+    }
+    keywords.sort();
+    let keywords = if keywords.is_empty() {
+        " []".to_string()
     } else {
-        " []"
+        keywords.iter().map(|k| format!("\n  - {k}")).collect()
+    };
+    let tags = match render_type {
+        Some(t) => format!("\n    RenderType: {t}"),
+        None => " {}".to_string(),
     };
     // Emissive materials default to realtime GI emission (1); others to "emissive is
     // black" (4), exactly as the inspector sets them.
@@ -81,8 +175,8 @@ pub fn write_material(m: &MatDesc) -> String {
   m_LightmapFlags: {lightmap_flags}
   m_EnableInstancingVariants: 0
   m_DoubleSidedGI: 0
-  m_CustomRenderQueue: -1
-  stringTagMap: {{}}
+  m_CustomRenderQueue: {queue}
+  stringTagMap:{tags}
   disabledShaderPasses: []
   m_LockedProperties: 
   m_SavedProperties:
@@ -92,34 +186,46 @@ pub fn write_material(m: &MatDesc) -> String {
         name = m.name
     );
     for t in TEXTURES {
+        let (texture, scale, offset) = match &surface.main_tex {
+            Some(slot) if t == "_MainTex" => (
+                format!("{{fileID: 2800000, guid: {}, type: 3}}", slot.guid),
+                slot.scale,
+                slot.offset,
+            ),
+            _ => ("{fileID: 0}".to_string(), [1.0, 1.0], [0.0, 0.0]),
+        };
         let _ = write!(
             s,
             "    - {t}:
-        m_Texture: {{fileID: 0}}
-        m_Scale: {{x: 1, y: 1}}
-        m_Offset: {{x: 0, y: 0}}
-"
+        m_Texture: {texture}
+        m_Scale: {{x: {}, y: {}}}
+        m_Offset: {{x: {}, y: {}}}
+",
+            num(scale[0]),
+            num(scale[1]),
+            num(offset[0]),
+            num(offset[1])
         );
     }
     s += "    m_Ints: []\n    m_Floats:\n";
     // Unity keeps properties sorted by name; `_Reflectivity` slots in among them.
     let mut floats: Vec<(&str, f32)> = vec![
         ("_BumpScale", 1.0),
-        ("_Cutoff", 0.5),
+        ("_Cutoff", surface.cutoff),
         ("_DetailNormalMapScale", 1.0),
-        ("_DstBlend", 0.0),
+        ("_DstBlend", dst),
         ("_GlossMapScale", 1.0),
         ("_Glossiness", m.glossiness),
         ("_GlossyReflections", 1.0),
         ("_Metallic", m.metallic),
-        ("_Mode", 0.0),
+        ("_Mode", surface.mode as i32 as f32),
         ("_OcclusionStrength", 1.0),
         ("_Parallax", 0.02),
         ("_SmoothnessTextureChannel", 0.0),
         ("_SpecularHighlights", 1.0),
-        ("_SrcBlend", 1.0),
+        ("_SrcBlend", src),
         ("_UVSec", 0.0),
-        ("_ZWrite", 1.0),
+        ("_ZWrite", zwrite),
     ];
     if let Some(r) = m.reflectivity {
         floats.push(("_Reflectivity", r));
@@ -136,7 +242,7 @@ pub fn write_material(m: &MatDesc) -> String {
     - _EmissionColor: {}
   m_BuildTextureStacks: []
 ",
-        rgba(m.color, 1.0),
+        rgba(m.color, surface.alpha),
         rgba(emission, 1.0)
     );
     s

@@ -25,6 +25,129 @@ pub fn folder(guid: &str) -> String {
     )
 }
 
+/// How a texture is imported: the TextureImporter settings the generated scenes vary.
+#[derive(Clone, Copy, Debug)]
+pub struct TextureImport {
+    /// `filterMode`: 0 point, 1 bilinear, 2 trilinear.
+    pub filter: u8,
+    pub mipmaps: bool,
+    pub srgb: bool,
+    /// `wrapU`/`wrapV`: 0 repeat, 1 clamp.
+    pub wrap: u8,
+    pub alpha_is_transparency: bool,
+}
+
+/// A texture's `.meta`: TextureImporter as Unity 2022.3 writes it for a Default texture.
+pub fn texture(guid: &str, im: &TextureImport) -> String {
+    let b = |x: bool| x as u8;
+    format!(
+        "fileFormatVersion: 2
+guid: {guid}
+TextureImporter:
+  internalIDToNameTable: []
+  externalObjects: {{}}
+  serializedVersion: 12
+  mipmaps:
+    mipMapMode: 0
+    enableMipMap: {mips}
+    sRGBTexture: {srgb}
+    linearTexture: 0
+    fadeOut: 0
+    borderMipMap: 0
+    mipMapsPreserveCoverage: 0
+    alphaTestReferenceValue: 0.5
+    mipMapFadeDistanceStart: 1
+    mipMapFadeDistanceEnd: 3
+  bumpmap:
+    convertToNormalMap: 0
+    externalNormalMap: 0
+    heightScale: 0.25
+    normalMapFilter: 0
+    flipGreenChannel: 0
+  isReadable: 0
+  streamingMipmaps: 0
+  streamingMipmapsPriority: 0
+  vTOnly: 0
+  ignoreMipmapLimit: 0
+  grayScaleToAlpha: 0
+  generateCubemap: 6
+  cubemapConvolution: 0
+  seamlessCubemap: 0
+  textureFormat: 1
+  maxTextureSize: 2048
+  textureSettings:
+    serializedVersion: 2
+    filterMode: {filter}
+    aniso: 1
+    mipBias: 0
+    wrapU: {wrap}
+    wrapV: {wrap}
+    wrapW: {wrap}
+  nPOTScale: 1
+  lightmap: 0
+  compressionQuality: 50
+  spriteMode: 0
+  spriteExtrude: 1
+  spriteMeshType: 1
+  alignment: 0
+  spritePivot: {{x: 0.5, y: 0.5}}
+  spritePixelsToUnits: 100
+  spriteBorder: {{x: 0, y: 0, z: 0, w: 0}}
+  spriteGenerateFallbackPhysicsShape: 1
+  alphaUsage: 1
+  alphaIsTransparency: {ait}
+  spriteTessellationDetail: -1
+  textureType: 0
+  textureShape: 1
+  singleChannelComponent: 0
+  flipbookRows: 1
+  flipbookColumns: 1
+  maxTextureSizeSet: 0
+  compressionQualitySet: 0
+  textureFormatSet: 0
+  ignorePngGamma: 0
+  applyGammaDecoding: 0
+  swizzle: 50462976
+  cookieLightType: 0
+  platformSettings:
+  - serializedVersion: 3
+    buildTarget: DefaultTexturePlatform
+    maxTextureSize: 2048
+    resizeAlgorithm: 0
+    textureFormat: -1
+    textureCompression: 1
+    compressionQuality: 50
+    crunchedCompression: 0
+    allowsAlphaSplitting: 0
+    overridden: 0
+    ignorePlatformSupport: 0
+    androidETC2FallbackOverride: 0
+    forceMaximumCompressionQuality_BC6H_BC7: 0
+  spriteSheet:
+    serializedVersion: 2
+    sprites: []
+    outline: []
+    physicsShape: []
+    bones: []
+    spriteID: 
+    internalID: 0
+    vertices: []
+    indices: 
+    edges: []
+    weights: []
+    secondaryTextures: []
+    nameFileIdTable: {{}}
+  mipmapLimitGroupName: 
+  pSDRemoveMatte: 0
+{TAIL}",
+        mips = b(im.mipmaps),
+        srgb = b(im.srgb),
+        filter = im.filter,
+        wrap = im.wrap,
+        ait = b(im.alpha_is_transparency),
+    )
+}
+
 // Unity writes these three keys with a trailing space when they are empty.
 const TAIL: &str = "  userData: \n  assetBundleName: \n  assetBundleVariant: \n";
 

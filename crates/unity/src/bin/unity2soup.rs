@@ -22,6 +22,7 @@ struct Args {
     #[arg(long)]
     strict: bool,
     /// List every converted object (triangles, source, materials, layer, shadows), every
+    /// material (texture, tiling, opacity, alpha mode), every
     /// renderer Unity's draw rules skip (camera culling mask, LOD above 0), light and
     /// warning on stderr.
     #[arg(long)]
@@ -78,6 +79,7 @@ fn run(args: &Args) -> anyhow::Result<()> {
             "triangles": soup.triangles.len(),
             "lights": soup.lights.len(),
             "materials": soup.materials.len(),
+            "textures": soup.textures.len(),
             "warnings": soup.warnings,
             "dropped_degenerate": soup.dropped_degenerate,
             "skipped": report.skipped,
@@ -128,6 +130,28 @@ fn list(report: &unity::Report) {
             } else {
                 ", receives none"
             }
+        );
+    }
+    for m in &soup.materials {
+        let texture = match &m.albedo_map {
+            Some(r) => {
+                let t = &soup.textures[r.texture as usize];
+                format!(
+                    "texture {} {}x{} scale ({}, {}) offset ({}, {})",
+                    t.source,
+                    t.width,
+                    t.height,
+                    r.tiling.scale[0],
+                    r.tiling.scale[1],
+                    r.tiling.offset[0],
+                    r.tiling.offset[1]
+                )
+            }
+            None => "no texture".to_string(),
+        };
+        eprintln!(
+            "material {:?} ({}): {texture}, opacity {}, alpha {:?}",
+            m.name, m.source, m.opacity, m.alpha
         );
     }
     for s in &report.skipped {

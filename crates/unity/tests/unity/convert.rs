@@ -520,6 +520,45 @@ fn degenerate_triangles_are_dropped_and_counted() {
     assert_eq!(soup.dropped_degenerate, 2);
 }
 
+/// UVs follow the positions through the winding flip and the squeezing out of degenerate
+/// triangles: each kept corner keeps its own vertex's UV.
+#[test]
+fn uvs_follow_their_corners_past_dropped_triangles() {
+    let obj = "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nvt 0 0\nvt 0.25 0\nvt 0.5 0\nvt 0 1\n\
+               f 1/1 2/2 3/3\nf 1/1 1/1 4/4\nf 1/1 2/2 4/4\n";
+    let textures = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/textures/Assets");
+    let read = |rel: &str| std::fs::read_to_string(textures.join(rel)).unwrap();
+    let mat_meta = read("Materials/Quadrants.mat.meta");
+    let mat_guid = mat_meta
+        .lines()
+        .find_map(|l| l.strip_prefix("guid: "))
+        .unwrap()
+        .to_string();
+    let sc = mesh_scene("D", 4300000, OBJ_GUID, &[(2100000, &mat_guid)]);
+    let (_d, scene) = obj_project("Assets/d.obj", obj, "Assets/s.unity", &sc.text);
+    let assets = scene.parent().unwrap();
+    for rel in ["Materials/Quadrants.mat", "Textures/Quadrants.png"] {
+        std::fs::create_dir_all(assets.join(rel).parent().unwrap()).unwrap();
+        std::fs::copy(textures.join(rel), assets.join(rel)).unwrap();
+        let meta = format!("{rel}.meta");
+        std::fs::copy(textures.join(&meta), assets.join(&meta)).unwrap();
+    }
+    let soup = convert(&scene);
+    assert_eq!((soup.triangles.len(), soup.dropped_degenerate), (1, 2));
+    assert_eq!(soup.uvs.len(), 1);
+    assert!(soup.materials[0].albedo_map.is_some());
+    // The soup keeps the OBJ's x (Unity negates it, the soup negates it back).
+    for (p, uv) in soup.triangles[0].iter().zip(soup.uvs[0]) {
+        let want = match (p.x, p.y) {
+            (0.0, 0.0) => glam::Vec2::new(0.0, 0.0),
+            (1.0, 0.0) => glam::Vec2::new(0.25, 0.0),
+            (0.0, 1.0) => glam::Vec2::new(0.0, 1.0),
+            _ => panic!("unexpected corner {p}"),
+        };
+        assert_eq!(uv, want, "corner {p}");
+    }
+}
+
 #[test]
 fn strict_turns_warnings_into_an_error() {
     let mut sc = Scene::default();

@@ -11,5 +11,6 @@ mod fbx_ascii;
 mod fbx_corpus;
 mod fbx_scene;
 mod fbx_threads;
+mod fuzz_seeds;
 mod support;
 mod textures;

@@ -1,6 +1,7 @@
 //! Albedo textures of the corpus projects: every format they ship decodes at the size
 //! Unity imports it, materials name the right slot and tiling, and no material's texture
-//! makes the loader panic.
+//! makes the loader panic; the generated `textures` scenes convert into exactly the
+//! texels, UVs, tiling and alpha they were written with.
 
 use formats::texture::{Filter, Wrap};
 use std::path::PathBuf;
@@ -233,4 +234,234 @@ fn corpus_embedded_meshes_have_uv0() {
         decoded += 1;
     }
     assert_eq!(decoded, 4);
+}
+
+/// The generated `textures` project (scenegen writes it into scenes/).
+fn textures_scene(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes/textures/Assets/Scenes")
+        .join(format!("{name}.unity"))
+}
+
+fn convert(scene: &std::path::Path) -> formats::Soup {
+    unity::convert(scene, &unity::Options::default()).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Texel bytes, bottom row first, of the quadrant texture: blue, white / red, green.
+const QUADRANT_TEXELS: [u8; 16] = [
+    0, 0, 255, 255, 255, 255, 255, 255, 255, 0, 0, 255, 0, 255, 0, 255,
+];
+
+/// Every corner of a Quad at the origin carries Unity's Quad UV of its position (the soup
+/// negates Unity's x, so u = 0.5 − x there).
+fn assert_quad_uvs(soup: &formats::Soup, triangles: std::ops::Range<usize>) {
+    for t in triangles {
+        for k in 0..3 {
+            let (p, uv) = (soup.triangles[t][k], soup.uvs[t][k]);
+            assert_eq!(
+                [uv.x, uv.y],
+                [0.5 - p.x, p.y + 0.5],
+                "triangle {t} corner {k} at {p}"
+            );
+        }
+    }
+}
+
+#[test]
+fn quadrant_texture_point_filtered_upright_on_the_quad() {
+    let soup = convert(&textures_scene("Quadrants"));
+    assert!(soup.warnings.is_empty(), "{:?}", soup.warnings);
+    assert_eq!(soup.textures.len(), 1);
+    let t = &soup.textures[0];
+    assert_eq!((t.width, t.height), (2, 2));
+    assert_eq!(t.texels, QUADRANT_TEXELS);
+    assert!(t.srgb && !t.mipmaps);
+    assert_eq!(t.filter, Filter::Point);
+    assert_eq!((t.wrap_u, t.wrap_v), (Wrap::Repeat, Wrap::Repeat));
+    assert_eq!(t.source, "Assets/Textures/Quadrants.png");
+    let m = &soup.materials[0];
+    let map = m.albedo_map.unwrap();
+    assert_eq!(map.texture, 0);
+    assert_eq!(map.tiling, formats::texture::Tiling::default());
+    assert_eq!((m.alpha, m.opacity), (formats::Alpha::Opaque, 1.0));
+    assert_eq!(soup.uvs.len(), 2);
+    assert_quad_uvs(&soup, 0..2);
+    // The soup survives its own reader's validation.
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("q.soup");
+    soup.write(&path).unwrap();
+    assert_eq!(formats::Soup::read(&path).unwrap(), soup);
+}
+
+#[test]
+fn uniform_grey_texture_is_srgb_128() {
+    let soup = convert(&textures_scene("Grey"));
+    let t = &soup.textures[0];
+    assert_eq!((t.width, t.height), (4, 4));
+    assert!(t.texels.chunks(4).all(|c| c == [128, 128, 128, 255]));
+    assert_eq!(t.filter, Filter::Bilinear);
+    assert!(t.mipmaps && t.srgb);
+    assert!((t.texel(2, 3)[0] - 0.2158).abs() < 1e-4);
+    assert_eq!(soup.materials[0].color, glam::Vec3::ONE);
+}
+
+#[test]
+fn tiling_and_offset_reach_the_material() {
+    let soup = convert(&textures_scene("Tiling"));
+    assert_eq!(soup.textures[0].texels, QUADRANT_TEXELS);
+    let tiling = soup.materials[0].albedo_map.unwrap().tiling;
+    assert_eq!(tiling.scale, [2.0, 1.0]);
+    assert_eq!(tiling.offset, [0.5, 0.0]);
+    assert_quad_uvs(&soup, 0..2);
+}
+
+#[test]
+fn cutout_quad_before_a_plain_wall() {
+    let soup = convert(&textures_scene("Cutout"));
+    assert!(soup.warnings.is_empty(), "{:?}", soup.warnings);
+    let cut = soup
+        .materials
+        .iter()
+        .position(|m| m.name == "Cutout")
+        .unwrap();
+    let m = &soup.materials[cut];
+    assert_eq!(m.alpha, formats::Alpha::Cutout { cutoff: 0.5 });
+    let t = &soup.textures[m.albedo_map.unwrap().texture as usize];
+    // Left column alpha 0, right column opaque, in both rows.
+    assert_eq!(
+        t.texels,
+        [255, 200, 0, 0, 255, 200, 0, 255, 255, 200, 0, 0, 255, 200, 0, 255]
+    );
+    // The wall comes first and is untextured: its corners are zero, the Quad's are its own.
+    assert_eq!(soup.uvs.len(), soup.triangles.len());
+    let quad: Vec<usize> = (0..soup.triangles.len())
+        .filter(|&i| soup.tri_material[i] as usize == cut)
+        .collect();
+    assert_eq!(quad, vec![2, 3]);
+    assert!(soup.uvs[..2]
+        .iter()
+        .flatten()
+        .all(|uv| *uv == glam::Vec2::ZERO));
+    assert_quad_uvs(&soup, 2..4);
+    let wall = &soup.materials[soup.tri_material[0] as usize];
+    assert_eq!(
+        (wall.alpha, wall.albedo_map),
+        (formats::Alpha::Opaque, None)
+    );
+}
+
+#[test]
+fn transparent_tint_without_a_texture_keeps_the_soup_uv_free() {
+    let soup = convert(&textures_scene("Transparent"));
+    let glass = soup.materials.iter().find(|m| m.name == "HalfRed").unwrap();
+    assert_eq!((glass.alpha, glass.opacity), (formats::Alpha::Blend, 0.5));
+    assert!(soup.textures.is_empty() && soup.uvs.is_empty());
+}
+
+/// The bundled untextured scenes keep an empty UV array and no textures.
+#[test]
+fn untextured_scenes_carry_no_uvs() {
+    let baseline = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes/baseline/Assets/Scenes/Baseline.unity");
+    let soup = convert(&baseline);
+    assert!(soup.uvs.is_empty() && soup.textures.is_empty());
+    assert!(soup.materials.iter().all(|m| m.albedo_map.is_none()));
+}
+
+/// A texture that cannot be read is one warning naming the material and the file; the
+/// material keeps its tint; `--strict` refuses the scene.
+#[test]
+fn unreadable_texture_warns_and_strict_refuses() {
+    let src = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/textures");
+    for (what, bytes) in [
+        ("truncated", None),
+        (
+            "LFS pointer",
+            Some(b"version https://git-lfs.github.com/spec/v1\noid sha256:00\nsize 9\n".to_vec()),
+        ),
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        copy_dir(&src, dir.path());
+        let png = dir.path().join("Assets/Textures/Quadrants.png");
+        let full = std::fs::read(&png).unwrap();
+        std::fs::write(
+            &png,
+            bytes.unwrap_or_else(|| full[..full.len() / 2].to_vec()),
+        )
+        .unwrap();
+        let scene = dir.path().join("Assets/Scenes/Quadrants.unity");
+        let soup = convert(&scene);
+        assert_eq!(soup.warnings.len(), 1, "{what}: {:?}", soup.warnings);
+        let w = &soup.warnings[0];
+        assert!(
+            w.starts_with("Assets/Materials/Quadrants.mat: Assets/Textures/Quadrants.png: ")
+                && w.ends_with("drawn with its tint alone"),
+            "{what}: {w}"
+        );
+        assert!(soup.textures.is_empty() && soup.uvs.is_empty());
+        assert_eq!(soup.materials[0].albedo_map, None);
+        let strict = unity::Options {
+            strict: true,
+            ..Default::default()
+        };
+        assert!(unity::convert(&scene, &strict).is_err(), "{what}");
+    }
+}
+
+fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
+    for e in std::fs::read_dir(from).unwrap().flatten() {
+        let (src, dst) = (e.path(), to.join(e.file_name()));
+        if src.is_dir() {
+            std::fs::create_dir_all(&dst).unwrap();
+            copy_dir(&src, &dst);
+        } else {
+            std::fs::copy(&src, &dst).unwrap();
+        }
+    }
+}
+
+/// CreateWithVR's TravisRoom: five FBX logs use their own material, whose texture Unity
+/// finds in the `Textures/` folder beside the models' folder; it is the image two `.mat`
+/// files name too, stored once. GDSJam's target material is cut out at its own cutoff.
+#[test]
+fn corpus_model_textures_are_found_and_shared() {
+    let Some(root) = corpus() else { return };
+    let soup = unity::convert(
+        &root.join("thespeedyboy__CreateWithVR2021/Assets/Scenes/TravisRoom.unity"),
+        &unity::Options::default(),
+    )
+    .unwrap();
+    let swatch = "Assets/_Course Library/Source Files/Textures/InteriorColourSwatch.png";
+    let users: Vec<&formats::Material> = soup
+        .materials
+        .iter()
+        .filter(|m| {
+            m.albedo_map
+                .is_some_and(|r| soup.textures[r.texture as usize].source == swatch)
+        })
+        .collect();
+    let own = users.iter().filter(|m| m.source.contains(".FBX#")).count();
+    assert_eq!((users.len(), own), (7, 5));
+    assert!(users
+        .windows(2)
+        .all(|w| w[0].albedo_map.unwrap().texture == w[1].albedo_map.unwrap().texture));
+    assert_eq!(
+        soup.textures.iter().filter(|t| t.source == swatch).count(),
+        1
+    );
+    let glass = users
+        .iter()
+        .find(|m| m.name == "Material_Main_Transparent")
+        .unwrap();
+    assert_eq!(glass.alpha, formats::Alpha::Blend);
+    assert_eq!(soup.uvs.len(), soup.triangles.len());
+
+    let soup = unity::convert(
+        &root.join("Pjaerr__GDSJam-Reflection/Assets/Scenes/Tutorial.unity"),
+        &unity::Options::default(),
+    )
+    .unwrap();
+    let target = soup.materials.iter().find(|m| m.name == "target").unwrap();
+    assert_eq!(target.alpha, formats::Alpha::Cutout { cutoff: 0.579 });
+    assert!(target.albedo_map.is_some());
 }
