@@ -466,11 +466,25 @@ fn psd_end(bytes: &[u8], w: u32, h: u32) -> Option<usize> {
 /// without checking on some malformed files, so its panics are caught and reported as a
 /// decode error instead of taking the converter down.
 fn decode_psd(bytes: &[u8]) -> Result<Vec<u8>, String> {
-    match std::panic::catch_unwind(|| psd::Psd::from_bytes(bytes).map(|p| p.rgba())) {
+    IN_PSD.set(true);
+    let r = std::panic::catch_unwind(|| psd::Psd::from_bytes(bytes).map(|p| p.rgba()));
+    IN_PSD.set(false);
+    match r {
         Ok(Ok(rgba)) => Ok(rgba),
         Ok(Err(e)) => Err(e.to_string()),
         Err(_) => Err("malformed PSD".to_string()),
     }
+}
+
+thread_local! {
+    static IN_PSD: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Whether this thread is inside the PSD decoder, whose panics become a decode error: a
+/// program's panic hook can stay silent for those (the warning says what happened) and
+/// still report every other panic.
+pub fn panic_is_caught_decode() -> bool {
+    IN_PSD.get()
 }
 
 #[cfg(test)]

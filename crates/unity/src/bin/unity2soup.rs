@@ -30,6 +30,12 @@ struct Args {
 }
 
 fn main() {
+    let report = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        if !unity::texture::panic_is_caught_decode() {
+            report(info)
+        }
+    }));
     let args = Args::parse();
     if let Err(e) = run(&args) {
         eprintln!("unity2soup: {e:#}");
