@@ -38,6 +38,18 @@ const CHUNK: usize = 1 << 14;
 /// that differ by less may still round to the same SAH cost, and the tie rule must see them.
 const SLACK: f64 = 1.0 + 1e-9;
 
+/// Cells at least this large whose candidate slabs hold more events than the cell has
+/// references (a dense cluster in one slab) go to the event builder, which sorts their
+/// events once, rather than gathering and sorting most of them at every level.
+const CROWDED_MIN: usize = 1 << 14;
+
+/// What the binned search found: the cheapest split (or none), or that the slabs that may
+/// hold it are too crowded to gather.
+pub(super) enum Search {
+    Found(Option<Split>),
+    Crowded,
+}
+
 /// A triangle (global id) and its bounds inside the current cell.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Ref {
@@ -167,10 +179,10 @@ fn gather(refs: &[Ref], slabs: &Slabs, chosen: &[[bool; BINS]; 3]) -> [Vec<Event
 }
 
 /// The cheapest split of a cell's references, as the full event sweep would find it.
-pub(super) fn find_split(ctx: &Ctx, refs: &[Ref], cell: &Aabb) -> Option<Split> {
+pub(super) fn find_split(ctx: &Ctx, refs: &[Ref], cell: &Aabb) -> Search {
     let area = cell.area();
     if !(area > 0.0) || !area.is_finite() {
-        return None;
+        return Search::Found(None);
     }
     let n = refs.len() as f64;
     let parallel = refs.len() >= PARALLEL_MIN;
@@ -185,7 +197,8 @@ pub(super) fn find_split(ctx: &Ctx, refs: &[Ref], cell: &Aabb) -> Option<Split> 
                     }
                 }
                 a
-            })?
+            })
+            .unwrap_or_else(|| histogram(&[], &slabs))
     } else {
         histogram(refs, &slabs)
     };
@@ -234,6 +247,14 @@ pub(super) fn find_split(ctx: &Ctx, refs: &[Ref], cell: &Aabb) -> Option<Split> 
             // Infinite: a slab with one position (priced directly) or none inside the cell.
             chosen[axis][k] = lower[axis][k] < f64::INFINITY && lower[axis][k] <= limit;
         }
+    }
+    let gathered: usize = (0..3)
+        .flat_map(|a| h[a].iter().zip(&chosen[a]))
+        .filter(|(_, &c)| c)
+        .map(|(b, _)| b.events())
+        .sum();
+    if refs.len() >= CROWDED_MIN && gathered > refs.len() {
+        return Search::Crowded;
     }
     let mut ev = if parallel {
         refs.par_chunks(CHUNK)
@@ -286,10 +307,12 @@ pub(super) fn find_split(ctx: &Ctx, refs: &[Ref], cell: &Aabb) -> Option<Split> 
             planar_below,
         });
     }
-    found
-        .into_iter()
-        .flatten()
-        .min_by(|a, b| a.cost.total_cmp(&b.cost))
+    Search::Found(
+        found
+            .into_iter()
+            .flatten()
+            .min_by(|a, b| a.cost.total_cmp(&b.cost)),
+    )
 }
 
 // A reference's side of the split plane.
@@ -449,6 +472,29 @@ mod tests {
         ] {
             same_tree(&tris, &params).unwrap();
         }
+    }
+
+    #[test]
+    fn a_dense_cluster_beside_an_outlier_builds_the_same_tree() {
+        // Every event of the cluster falls in the first slab of each axis: the crowded
+        // cells go to the event builder.
+        let mut rng = Rng(11);
+        let mut tris: Vec<[Vec3; 3]> = (0..20_000)
+            .map(|_| {
+                let c = Vec3::new(rng.unit(), rng.unit(), rng.unit());
+                [c, c + 0.01 * rng.dir(), c + 0.01 * rng.dir()]
+            })
+            .collect();
+        tris.push([
+            Vec3::splat(1000.0),
+            Vec3::new(1001.0, 1000.0, 1000.0),
+            Vec3::splat(1001.0),
+        ]);
+        let params = BuildParams::default();
+        let events = build_with(&tris, &params, [0; 32], usize::MAX);
+        let binned = build_with(&tris, &params, [0; 32], 0);
+        assert_eq!(binned.nodes, events.nodes);
+        assert_eq!(binned.leaf_tris, events.leaf_tris);
     }
 
     /// Coordinates on a coarse lattice: shared planes, planar and degenerate triangles,

@@ -243,8 +243,11 @@ fn build_refs(ctx: &Ctx, refs: Vec<Ref>, cell: Aabb, depth: u32) -> Part {
         return leaf(refs);
     }
     let split = match binned::find_split(ctx, &refs, &cell) {
-        Some(s) if s.cost < ctx.ki * n as f64 => s,
-        _ => return leaf(refs),
+        binned::Search::Found(Some(s)) if s.cost < ctx.ki * n as f64 => s,
+        binned::Search::Found(_) => return leaf(refs),
+        binned::Search::Crowded => {
+            return build_events(ctx, binned::to_work(refs, cell), depth);
+        }
     };
     let [(rb, cb), (ra, ca)] = binned::split(ctx, refs, &cell, &split);
     let (b, a) = rayon::join(
