@@ -31,8 +31,9 @@ pub fn ordered(pos: f32) -> u32 {
     }
 }
 
+/// The position of an [`ordered`] key.
 #[inline]
-fn unordered(key: u32) -> f32 {
+pub fn unordered(key: u32) -> f32 {
     f32::from_bits(if key >> 31 == 1 {
         key & 0x7fff_ffff
     } else {

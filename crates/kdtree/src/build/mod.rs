@@ -1,33 +1,45 @@
 //! The SAH k-d tree compiler (Wald & Havran 2006, "On building fast kd-trees for ray
 //! tracing, and on doing that in O(N log N)").
 //!
-//! * Events are sorted once per axis and kept sorted through the splits: the triangles
-//!   that stay on one side keep their events (filtered in order), only the triangles that
-//!   straddle the split get new events, from clipping them to each child cell (perfect
-//!   splits, see [`clip`]), and those few are sorted and merged in.
+//! * Large cells (above `EVENT_MAX` triangles) keep a plain list of triangle references
+//!   with their clipped bounds and find the SAH's cheapest plane by binning first and
+//!   sweeping only the slabs that can hold it ([`binned`]): the same plane the full sweep
+//!   finds, for far less work.
+//! * Smaller cells sort their events once per axis and keep them sorted through the
+//!   splits: the triangles that stay on one side keep their events (filtered in order),
+//!   only the triangles that straddle the split get new events, from clipping them to each
+//!   child cell (perfect splits, see [`clip`]), and those few are sorted and merged in.
 //! * Triangles lying in a candidate plane are tried on both sides; a split that cuts off
 //!   empty space gets the empty-space bonus; a node becomes a leaf when no split is
 //!   cheaper than intersecting all its triangles, at the depth bound, or at `leaf_size`.
-//! * Subtrees above `JOIN_MIN` triangles are built in parallel (`rayon::join`), and
-//!   above `PARALLEL_MIN` the three axes' sweeps, classification and sorting run in
-//!   parallel too.
+//! * Subtrees above `JOIN_MIN` triangles are built in parallel (`rayon::join`); cells of
+//!   at least 65,536 references bin and partition on every thread, so both threads work
+//!   from the first split on. The parallel subtrees are stitched together once, at the end.
 
+pub mod binned;
 pub mod clip;
 pub mod events;
 pub mod median;
+pub mod sah;
 pub mod stats;
 
 use crate::aabb::Aabb;
+use binned::Ref;
 use events::{Event, END, START};
 use formats::{BuildParams, KdFile, KdNode};
 use glam::Vec3;
 use rayon::prelude::*;
+use sah::{AxisCost, Best};
 
 /// The traversal stack holds this many entries; the build never goes deeper.
 pub const MAX_DEPTH_LIMIT: u32 = 60;
 
 /// Nodes with at least this many triangles work on their three axes in parallel.
 const PARALLEL_MIN: usize = 8192;
+
+/// Cells with more triangles than this are split by the binned search; smaller ones by
+/// the sorted event lists, which pay off once a cell's events fit the caches.
+const EVENT_MAX: usize = 4096;
 
 /// Nodes with at least this many triangles build their two subtrees as parallel tasks:
 /// far below `PARALLEL_MIN`, so that uneven subtrees (a floor next to small props) still
@@ -52,6 +64,7 @@ struct Ctx<'a> {
     bonus: f64,
     leaf_size: usize,
     max_depth: u32,
+    event_max: usize,
 }
 
 /// The triangles of one cell: global ids, and per axis the sorted events over local ids.
@@ -92,6 +105,67 @@ impl Subtree {
     }
 }
 
+/// A subtree as the parallel tasks return it: serial parts already flat, the nodes above
+/// them (whose children were built as separate tasks) still linked.
+enum Part {
+    Flat(Subtree),
+    Node {
+        axis: u32,
+        pos: f32,
+        children: Box<[Part; 2]>,
+    },
+}
+
+impl Part {
+    fn leaf(tris: Vec<u32>) -> Part {
+        Part::Flat(Subtree {
+            nodes: vec![KdNode::leaf(tris.len() as u32, 0)],
+            leaf_tris: tris,
+        })
+    }
+
+    fn sizes(&self) -> (usize, usize) {
+        match self {
+            Part::Flat(s) => (s.nodes.len(), s.leaf_tris.len()),
+            Part::Node { children, .. } => {
+                let (b, a) = (children[0].sizes(), children[1].sizes());
+                (1 + b.0 + a.0, b.1 + a.1)
+            }
+        }
+    }
+
+    /// Depth-first, below before above: the order a serial build writes.
+    fn flatten_into(self, out: &mut Subtree) {
+        match self {
+            Part::Flat(s) => out.append(s),
+            Part::Node {
+                axis,
+                pos,
+                children,
+            } => {
+                let at = out.nodes.len();
+                out.nodes.push(KdNode::leaf(0, 0)); // placeholder until `above` has an index
+                let [below, above] = *children;
+                below.flatten_into(out);
+                let above_at = out.nodes.len() as u32;
+                above.flatten_into(out);
+                out.nodes[at] = KdNode::interior(axis, pos, above_at);
+            }
+        }
+    }
+
+    /// One copy of every node and leaf list, into arrays of their final size.
+    fn flatten(self) -> Subtree {
+        let (nodes, leaf_tris) = self.sizes();
+        let mut out = Subtree {
+            nodes: Vec::with_capacity(nodes),
+            leaf_tris: Vec::with_capacity(leaf_tris),
+        };
+        self.flatten_into(&mut out);
+        out
+    }
+}
+
 /// Build a tree over `triangles` (soup order), fewer than [`events::MAX_TRIANGLES`]
 /// (callers check; `soup2kd` refuses larger soups). Non-finite triangles are left out (the
 /// soup reader refuses them anyway); every other triangle, degenerate ones included, is
@@ -100,6 +174,15 @@ pub fn build(
     triangles: &[[Vec3; 3]],
     params: &BuildParams,
     geometry_hash: formats::Digest,
+) -> KdFile {
+    build_with(triangles, params, geometry_hash, EVENT_MAX)
+}
+
+fn build_with(
+    triangles: &[[Vec3; 3]],
+    params: &BuildParams,
+    geometry_hash: formats::Digest,
+    event_max: usize,
 ) -> KdFile {
     let start = std::time::Instant::now();
     let n = triangles.len();
@@ -110,45 +193,27 @@ pub fn build(
         bonus: (params.empty_bonus as f64).clamp(0.0, 1.0),
         leaf_size: params.leaf_size.max(1) as usize,
         max_depth: depth_bound(params, n),
+        event_max,
     };
-    let ids: Vec<u32> = (0..n as u32)
+    let refs: Vec<Ref> = (0..n as u32)
         .into_par_iter()
         .filter(|&i| triangles[i as usize].iter().all(|v| v.is_finite()))
-        .collect();
-    let boxes: Vec<Aabb> = ids
-        .par_iter()
-        .map(|&i| Aabb::of_triangle(&triangles[i as usize]))
-        .collect();
-    let cell = boxes
-        .par_iter()
-        .copied()
-        .reduce(|| Aabb::EMPTY, |a, b| a.union(&b));
-    let parallel = ids.len() >= PARALLEL_MIN;
-    let events: Vec<Vec<Event>> = (0..3)
-        .into_par_iter()
-        .map(|axis| {
-            let mut ev = Vec::with_capacity(2 * boxes.len());
-            for (local, b) in boxes.iter().enumerate() {
-                events::push_events(&mut ev, b, axis, local as u32);
-            }
-            events::sort(&mut ev, parallel);
-            ev
+        .map(|tri| Ref {
+            tri,
+            b: Aabb::of_triangle(&triangles[tri as usize]),
         })
         .collect();
-    let [ex, ey, ez]: [Vec<Event>; 3] = events.try_into().expect("three axes");
-    drop(boxes);
-    let work = Work {
-        tris: ids,
-        events: [ex, ey, ez],
-        cell,
-    };
-    let tree = if work.tris.is_empty() {
+    let cell = refs
+        .par_iter()
+        .map(|r| r.b)
+        .reduce(|| Aabb::EMPTY, |a, b| a.union(&b));
+    let tree = if refs.is_empty() {
         Subtree {
             nodes: vec![KdNode::leaf(0, 0)],
             leaf_tris: vec![],
         }
     } else {
-        build_sub(&ctx, work, 0)
+        build_refs(&ctx, refs, cell, 0).flatten()
     };
     let bounds = if cell.is_empty() {
         [Vec3::ZERO; 2]
@@ -168,10 +233,59 @@ pub fn build(
     kd
 }
 
-fn build_sub(ctx: &Ctx, w: Work, depth: u32) -> Subtree {
-    let mut out = Subtree::default();
-    build_rec(ctx, w, depth, &mut out);
-    out
+fn build_refs(ctx: &Ctx, refs: Vec<Ref>, cell: Aabb, depth: u32) -> Part {
+    let n = refs.len();
+    if n <= ctx.event_max {
+        return build_events(ctx, binned::to_work(refs, cell), depth);
+    }
+    let leaf = |refs: Vec<Ref>| Part::leaf(refs.iter().map(|r| r.tri).collect());
+    if n <= ctx.leaf_size || depth >= ctx.max_depth {
+        return leaf(refs);
+    }
+    let split = match binned::find_split(ctx, &refs, &cell) {
+        binned::Search::Found(Some(s)) if s.cost < ctx.ki * n as f64 => s,
+        binned::Search::Found(_) => return leaf(refs),
+        binned::Search::Crowded => {
+            return build_events(ctx, binned::to_work(refs, cell), depth);
+        }
+    };
+    let [(rb, cb), (ra, ca)] = binned::split(ctx, refs, &cell, &split);
+    let (b, a) = rayon::join(
+        || build_refs(ctx, rb, cb, depth + 1),
+        || build_refs(ctx, ra, ca, depth + 1),
+    );
+    Part::Node {
+        axis: split.axis as u32,
+        pos: split.pos,
+        children: Box::new([b, a]),
+    }
+}
+
+fn build_events(ctx: &Ctx, w: Work, depth: u32) -> Part {
+    let n = w.tris.len();
+    if n < JOIN_MIN {
+        let mut out = Subtree::default();
+        build_rec(ctx, w, depth, &mut out);
+        return Part::Flat(out);
+    }
+    if n <= ctx.leaf_size || depth >= ctx.max_depth {
+        return Part::leaf(w.tris);
+    }
+    let parallel = n >= PARALLEL_MIN;
+    let split = match find_split(ctx, &w, parallel) {
+        Some(s) if s.cost < ctx.ki * n as f64 => s,
+        _ => return Part::leaf(w.tris),
+    };
+    let (below, above) = split_work(ctx, w, &split, parallel);
+    let (b, a) = rayon::join(
+        || build_events(ctx, below, depth + 1),
+        || build_events(ctx, above, depth + 1),
+    );
+    Part::Node {
+        axis: split.axis as u32,
+        pos: split.pos,
+        children: Box::new([b, a]),
+    }
 }
 
 fn make_leaf(w: Work, out: &mut Subtree) {
@@ -182,34 +296,23 @@ fn make_leaf(w: Work, out: &mut Subtree) {
     out.leaf_tris.extend_from_slice(&w.tris);
 }
 
+/// The serial build below `JOIN_MIN` triangles, straight into one flat subtree.
 fn build_rec(ctx: &Ctx, w: Work, depth: u32, out: &mut Subtree) {
     let n = w.tris.len();
     if n <= ctx.leaf_size || depth >= ctx.max_depth {
         return make_leaf(w, out);
     }
-    let parallel = n >= PARALLEL_MIN;
-    let split = match find_split(ctx, &w, parallel) {
+    let split = match find_split(ctx, &w, false) {
         Some(s) if s.cost < ctx.ki * n as f64 => s,
         _ => return make_leaf(w, out),
     };
-    let (below, above) = split_work(ctx, w, &split, parallel);
+    let (below, above) = split_work(ctx, w, &split, false);
     let at = out.nodes.len();
     out.nodes.push(KdNode::leaf(0, 0)); // placeholder, set once `above` has an index
-    if n >= JOIN_MIN {
-        let (b, a) = rayon::join(
-            || build_sub(ctx, below, depth + 1),
-            || build_sub(ctx, above, depth + 1),
-        );
-        out.append(b);
-        let above_at = out.nodes.len() as u32;
-        out.append(a);
-        out.nodes[at] = KdNode::interior(split.axis as u32, split.pos, above_at);
-    } else {
-        build_rec(ctx, below, depth + 1, out);
-        let above_at = out.nodes.len() as u32;
-        build_rec(ctx, above, depth + 1, out);
-        out.nodes[at] = KdNode::interior(split.axis as u32, split.pos, above_at);
-    }
+    build_rec(ctx, below, depth + 1, out);
+    let above_at = out.nodes.len() as u32;
+    build_rec(ctx, above, depth + 1, out);
+    out.nodes[at] = KdNode::interior(split.axis as u32, split.pos, above_at);
 }
 
 fn find_split(ctx: &Ctx, w: &Work, parallel: bool) -> Option<Split> {
@@ -217,7 +320,17 @@ fn find_split(ctx: &Ctx, w: &Work, parallel: bool) -> Option<Split> {
     if !(area > 0.0) || !area.is_finite() {
         return None;
     }
-    let sweep = |axis: usize| sweep_axis(ctx, &w.events[axis], axis, w.tris.len(), &w.cell, area);
+    let sweep = |axis: usize| {
+        let ax = AxisCost::new(&w.cell, axis, ctx.bonus)?;
+        let mut best = Best::NONE;
+        sah::sweep(&ax, &w.events[axis], 0.0, w.tris.len() as f64, &mut best);
+        best.at.map(|(pos, planar_below)| Split {
+            cost: AxisCost::cost(best.rank, ctx.kt, ctx.ki, area),
+            axis,
+            pos,
+            planar_below,
+        })
+    };
     let best = if parallel {
         let (a, (b, c)) = rayon::join(|| sweep(0), || rayon::join(|| sweep(1), || sweep(2)));
         [a, b, c]
@@ -227,79 +340,6 @@ fn find_split(ctx: &Ctx, w: &Work, parallel: bool) -> Option<Split> {
     best.into_iter()
         .flatten()
         .min_by(|a, b| a.cost.total_cmp(&b.cost))
-}
-
-/// One linear sweep over an axis's sorted events, evaluating the SAH at every distinct
-/// position strictly inside the cell (a plane on the cell's face separates nothing).
-fn sweep_axis(
-    ctx: &Ctx,
-    ev: &[Event],
-    axis: usize,
-    n: usize,
-    cell: &Aabb,
-    area: f64,
-) -> Option<Split> {
-    let lo = cell.lo[axis];
-    let hi = cell.hi[axis];
-    if !(lo < hi) {
-        return None;
-    }
-    let e: [f64; 3] = std::array::from_fn(|a| cell.hi[a] as f64 - cell.lo[a] as f64);
-    let (o1, o2) = ((axis + 1) % 3, (axis + 2) % 3);
-    // A child's area is 2·(cap + d·ring) for its extent d along the axis. The sweep ranks
-    // splits by (cap + dl·ring)·nl + (cap + dr·ring)·nr (times the empty-space factor) and
-    // only the winner is scaled into the SAH cost; nl and nr are f64 (exact below 2^53),
-    // so each position converts its three counts once.
-    let cap = e[o1] * e[o2];
-    let ring = e[o1] + e[o2];
-    let keep = 1.0 - ctx.bonus;
-    let (lo_key, hi_key) = (events::ordered(lo), events::ordered(hi));
-    let (mut nl, mut nr) = (0.0f64, n as f64);
-    let mut best = f64::INFINITY;
-    let mut best_at: Option<(f32, bool)> = None;
-    let mut i = 0;
-    while i < ev.len() {
-        // One position at a time: count its end, planar and start events.
-        let key = ev[i].pos_key();
-        let mut count = [0u32; 3];
-        while i < ev.len() && ev[i].pos_key() == key {
-            count[ev[i].kind() as usize] += 1;
-            i += 1;
-        }
-        let [pe, pp, ps] = count.map(f64::from);
-        nr -= pp + pe;
-        if key > lo_key && key < hi_key {
-            let p = ev[i - 1].pos();
-            let wl = cap + (p as f64 - lo as f64) * ring;
-            let wr = cap + (hi as f64 - p as f64) * ring;
-            let weigh = |l: f64, r: f64| {
-                let c = wl * l + wr * r;
-                if l == 0.0 || r == 0.0 {
-                    keep * c
-                } else {
-                    c
-                }
-            };
-            let c_below = weigh(nl + pp, nr);
-            let c_above = weigh(nl, nr + pp);
-            let (c, planar_below) = if c_below <= c_above {
-                (c_below, true)
-            } else {
-                (c_above, false)
-            };
-            if c < best {
-                best = c;
-                best_at = Some((p, planar_below));
-            }
-        }
-        nl += ps + pp;
-    }
-    best_at.map(|(pos, planar_below)| Split {
-        cost: ctx.kt + ctx.ki * 2.0 * best / area,
-        axis,
-        pos,
-        planar_below,
-    })
 }
 
 // A triangle's place in a split: its side in the low 2 bits and, for triangles that stay

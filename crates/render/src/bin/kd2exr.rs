@@ -177,6 +177,7 @@ fn writable_folder(path: &std::path::Path) -> Result<()> {
 }
 
 fn run(a: RenderArgs) -> Result<()> {
+    let start = Instant::now();
     let (Some(soup_path), Some(kd_path), Some(out_path)) = (a.soup, a.kd, a.output) else {
         anyhow::bail!("a render needs SOUP KD -o OUTPUT");
     };
@@ -247,16 +248,28 @@ fn run(a: RenderArgs) -> Result<()> {
 
     let mut attrs = render::header_attributes(&plan, &opts, out.seconds, &soup.geometry_hash);
     attrs.extend(render::source_attributes(&soup_digest, &kd.params));
-    ExrImage::from_frame(&out.frame, a.half, attrs).write(&out_path)?;
-    if let Some(png) = &a.preview {
-        preview::write_png(png, &out.frame, a.exposure)?;
-    }
+    // The EXR's compression and the PNG's are independent: one thread each (the EXR also
+    // spreads its blocks over whatever threads are free).
+    let t_write = Instant::now();
+    let exr = ExrImage::from_frame(&out.frame, a.half, attrs);
+    let (exr_written, png_written) = rayon::join(
+        || exr.write(&out_path),
+        || {
+            a.preview
+                .as_ref()
+                .map(|png| preview::write_png(png, &out.frame, a.exposure))
+                .transpose()
+        },
+    );
+    exr_written?;
+    png_written?;
+    let write_seconds = t_write.elapsed().as_secs_f64();
 
     let c = out.counts;
     let mrays = c.total() as f64 / out.seconds.max(1e-9) / 1e6;
     eprintln!(
-        "kd2exr: rendered {}×{} (window {}) at {} spp, depth {} in {:.3} s ({:.2} Mrays/s; loading took {:.3} s)",
-        opts.width, opts.height, window, opts.spp, opts.depth, out.seconds, mrays, load_seconds
+        "kd2exr: rendered {}×{} (window {}) at {} spp, depth {} in {:.3} s ({:.2} Mrays/s; loading took {:.3} s, writing {:.3} s)",
+        opts.width, opts.height, window, opts.spp, opts.depth, out.seconds, mrays, load_seconds, write_seconds
     );
     eprintln!(
         "kd2exr: rays: camera {}, shadow {}, soft_shadow {}, reflection {}, pass_through {}, shadow_pass_through {} (total {})",
@@ -283,6 +296,9 @@ fn run(a: RenderArgs) -> Result<()> {
             "spp": opts.spp,
             "depth": opts.depth,
             "seconds": out.seconds,
+            "load_seconds": load_seconds,
+            "write_seconds": write_seconds,
+            "total_seconds": start.elapsed().as_secs_f64(),
             "rays": c,
             "sanitized": c.sanitized,
             "plan": plan.to_json(),

@@ -1,0 +1,149 @@
+//! The SAH cost of candidate planes on one axis of a cell, and the sweep over sorted
+//! events that ranks them. The event builder and the binned search both rank planes here,
+//! with the same arithmetic, so that both pick bit-for-bit the same split.
+
+use super::events::{self, Event};
+use crate::aabb::Aabb;
+
+/// One axis of one cell, ready to price planes.
+pub struct AxisCost {
+    lo: f32,
+    hi: f32,
+    cap: f64,
+    ring: f64,
+    keep: f64,
+    lo_key: u32,
+    hi_key: u32,
+}
+
+impl AxisCost {
+    /// None when the cell is flat along `axis` (no plane strictly inside it).
+    pub fn new(cell: &Aabb, axis: usize, bonus: f64) -> Option<AxisCost> {
+        let lo = cell.lo[axis];
+        let hi = cell.hi[axis];
+        if !(lo < hi) {
+            return None;
+        }
+        let e: [f64; 3] = std::array::from_fn(|a| cell.hi[a] as f64 - cell.lo[a] as f64);
+        let (o1, o2) = ((axis + 1) % 3, (axis + 2) % 3);
+        // A child's area is 2·(cap + d·ring) for its extent d along the axis. Planes are
+        // ranked by (cap + dl·ring)·nl + (cap + dr·ring)·nr (times the empty-space factor)
+        // and only the winner is scaled into the SAH cost; nl and nr are f64 (exact below
+        // 2^53), so each position converts its three counts once.
+        Some(AxisCost {
+            lo,
+            hi,
+            cap: e[o1] * e[o2],
+            ring: e[o1] + e[o2],
+            keep: 1.0 - bonus,
+            lo_key: events::ordered(lo),
+            hi_key: events::ordered(hi),
+        })
+    }
+
+    /// A plane on the cell's face separates nothing.
+    #[inline]
+    pub fn inside(&self, key: u32) -> bool {
+        key > self.lo_key && key < self.hi_key
+    }
+
+    /// Whether events between these two keys may lie strictly inside the cell.
+    #[inline]
+    pub fn may_hold_inside(&self, min_key: u32, max_key: u32) -> bool {
+        max_key > self.lo_key && min_key < self.hi_key
+    }
+
+    #[inline]
+    fn weights(&self, p_low: f32, p_high: f32) -> (f64, f64) {
+        (
+            self.cap + (p_low as f64 - self.lo as f64) * self.ring,
+            self.cap + (self.hi as f64 - p_high as f64) * self.ring,
+        )
+    }
+
+    #[inline]
+    fn weigh(&self, (wl, wr): (f64, f64), l: f64, r: f64) -> f64 {
+        let c = wl * l + wr * r;
+        if l == 0.0 || r == 0.0 {
+            self.keep * c
+        } else {
+            c
+        }
+    }
+
+    /// The rank of the plane at `p` with `nl` triangles starting below it, `nr` ending
+    /// above it and `pp` lying in it, and whether those go below: the cheaper side.
+    #[inline]
+    pub fn at(&self, p: f32, nl: f64, nr: f64, pp: f64) -> (f64, bool) {
+        let w = self.weights(p, p);
+        let c_below = self.weigh(w, nl + pp, nr);
+        if pp == 0.0 {
+            // Nothing lies in the plane: both sides price the same, and below wins ties.
+            return (c_below, true);
+        }
+        let c_above = self.weigh(w, nl, nr + pp);
+        if c_below <= c_above {
+            (c_below, true)
+        } else {
+            (c_above, false)
+        }
+    }
+
+    /// A lower bound on [`AxisCost::at`] for every plane in `[p_low, p_high]` that has at
+    /// least `l` triangles below and `r` above: every operation is monotone in its inputs,
+    /// so the bound holds in floating point too.
+    #[inline]
+    pub fn bound(&self, p_low: f32, p_high: f32, l: f64, r: f64) -> f64 {
+        self.weigh(self.weights(p_low, p_high), l, r)
+    }
+
+    /// The SAH cost of a ranked plane.
+    #[inline]
+    pub fn cost(rank: f64, kt: f64, ki: f64, area: f64) -> f64 {
+        kt + ki * 2.0 * rank / area
+    }
+}
+
+/// The best plane of one axis so far: the first of the cheapest in position order.
+#[derive(Clone, Copy, Debug)]
+pub struct Best {
+    pub rank: f64,
+    pub at: Option<(f32, bool)>,
+}
+
+impl Best {
+    pub const NONE: Best = Best {
+        rank: f64::INFINITY,
+        at: None,
+    };
+
+    #[inline]
+    pub fn offer(&mut self, (rank, planar_below): (f64, bool), p: f32) {
+        if rank < self.rank {
+            self.rank = rank;
+            self.at = Some((p, planar_below));
+        }
+    }
+}
+
+/// Sweep sorted events in position order, starting from the counts the positions before
+/// them leave: `nl` triangles started (or planar) below, `nr` not yet ended.
+pub fn sweep(ax: &AxisCost, ev: &[Event], mut nl: f64, mut nr: f64, best: &mut Best) {
+    let mut i = 0;
+    while i < ev.len() {
+        // One position at a time: count its end, planar and start events.
+        let key = ev[i].pos_key();
+        let mut count = [0u32; 3];
+        while i < ev.len() && ev[i].pos_key() == key {
+            count[ev[i].kind() as usize] += 1;
+            i += 1;
+        }
+        let [pe, pp, ps] = count.map(f64::from);
+        nr -= pp + pe;
+        if ax.inside(key) {
+            let p = ev[i - 1].pos();
+            best.offer(ax.at(p, nl, nr, pp), p);
+        }
+        nl += ps + pp;
+    }
+}
