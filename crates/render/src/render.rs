@@ -66,7 +66,7 @@ pub fn render(
 ) -> Result<Rendered, RenderError> {
     opts.validate()?;
     let camera = CameraModel::new(&soup.camera, opts.width, opts.height)?;
-    let integrator = Integrator::new(soup, accel, plan, opts.soft_samples);
+    let integrator = Integrator::new(soup, accel, plan, opts.soft_samples, opts.texture_filter);
     let window = opts.window();
     let run = || render_tiles(&camera, &integrator, opts, window, progress);
     let start = Instant::now();
@@ -147,9 +147,10 @@ pub fn render_pixel(
     let samples = pixel_samples(opts.spp, &mut rng);
     let mut sum = Vec3::ZERO;
     let mut best = (f32::INFINITY, Primary::MISS);
+    let cone = camera.cone();
     for (sx, sy) in &samples {
         let ray = camera.ray(x as f32 + sx, y as f32 + sy);
-        let (l, primary) = integrator.camera_sample(&ray, &mut rng, counts);
+        let (l, primary) = integrator.camera_sample(&ray, cone, &mut rng, counts);
         sum += l;
         let d = (sx - 0.5).powi(2) + (sy - 0.5).powi(2);
         if d < best.0 {
