@@ -25,6 +25,10 @@ struct Args {
     runs: usize,
     #[arg(long, default_value_t = 256)]
     reference_spp: u32,
+    /// Sweep only these scenes (comma-separated names: baseline, shadows-soft,
+    /// spot-on-mirror, checkerboard).
+    #[arg(long, value_delimiter = ',')]
+    only: Vec<String>,
 }
 
 fn main() {
@@ -65,6 +69,13 @@ fn run() -> Result<()> {
         );
         eprintln!("{line}");
         notes.push(line);
+    }
+    list.push(scenes::checkerboard());
+    if !a.only.is_empty() {
+        list.retain(|s| a.only.contains(&s.name));
+        if list.is_empty() {
+            anyhow::bail!("--only {}: no such scene", a.only.join(","));
+        }
     }
     let start = std::time::Instant::now();
     let log = |l: &str| eprintln!("[{:6.1} s] {l}", start.elapsed().as_secs_f64());
