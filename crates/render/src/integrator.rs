@@ -315,6 +315,15 @@ impl<'a> Integrator<'a> {
         primary: Option<&mut Primary>,
     ) -> Vec3 {
         let mut primary = primary;
+        if !self.alpha {
+            let Some(hit) = self.first_visible(ray, cone, counts) else {
+                return environment::background(&self.soup.environment, ray.dir);
+            };
+            let p = &mut primary;
+            return self
+                .shade(ray, &hit, cone, bounce, weight, 1.0, rng, counts, p)
+                .0;
+        }
         let mut r = *ray;
         // Light gathered from the blended layers so far, and the share of what lies behind
         // them that still reaches the eye.
@@ -507,32 +516,33 @@ impl<'a> Integrator<'a> {
     /// surface, so a cut-out's edge and its colour come from the same mip level, as in
     /// Unity's `clip()` on the sampled alpha.
     fn first_visible(&self, ray: &Ray, cone: RayCone, counts: &mut RayCounts) -> Option<Hit> {
-        if !self.culling && !self.alpha {
-            return self.accel.intersect(ray);
-        }
-        self.accel.intersect_filtered(ray, |hit| {
-            let prim = hit.prim as usize;
-            if self.culling {
-                let obj = &self.soup.objects[self.soup.tri_object[prim] as usize];
-                let cull = self.soup.materials[self.soup.tri_material[prim] as usize].cull;
-                if !obj.visible()
-                    || (cull != Cull::None && cull.skips(winding(self.soup, prim), ray.dir))
-                {
-                    counts.pass_through += 1;
-                    return false;
-                }
-            }
-            if self.alpha {
+        // Each combination gets its own closure, so a scene without cut-outs runs the
+        // culling test alone, as it did before alpha existed.
+        match (self.culling, self.alpha) {
+            (false, false) => self.accel.intersect(ray),
+            (true, false) => self.accel.intersect_filtered(ray, |hit| {
+                let through = self.culled(hit.prim as usize, ray.dir);
+                counts.pass_through += through as u64;
+                !through
+            }),
+            (culling, true) => self.accel.intersect_filtered(ray, |hit| {
+                let prim = hit.prim as usize;
                 let s = &self.surfacing[self.soup.tri_material[prim] as usize];
-                if let AlphaUse::Cutout { cutoff } = s.alpha {
-                    if self.alpha_at(s, prim, hit, ray.dir, cone.at(hit.t), counts) < cutoff {
-                        counts.pass_through += 1;
-                        return false;
-                    }
-                }
-            }
-            true
-        })
+                let through = (culling && self.culled(prim, ray.dir))
+                    || matches!(s.alpha, AlphaUse::Cutout { cutoff }
+                        if self.alpha_at(s, prim, hit, ray.dir, cone.at(hit.t), counts) < cutoff);
+                counts.pass_through += through as u64;
+                !through
+            }),
+        }
+    }
+
+    /// Whether camera and reflection rays along `dir` pass through triangle `prim`: a
+    /// shadows-only object, or a face its material culls.
+    fn culled(&self, prim: usize, dir: Vec3) -> bool {
+        let obj = &self.soup.objects[self.soup.tri_object[prim] as usize];
+        let cull = self.soup.materials[self.soup.tri_material[prim] as usize].cull;
+        !obj.visible() || (cull != Cull::None && cull.skips(winding(self.soup, prim), dir))
     }
 
     /// Whether the hit triangle `prim` blocks a shadow ray travelling along `dir` (towards
@@ -579,6 +589,14 @@ impl<'a> Integrator<'a> {
         if !self.shadow_filter {
             return if self.accel.occluded(&ray) { 0.0 } else { 1.0 };
         }
+        if !self.alpha {
+            let blocked = self.accel.occluded_filtered(&ray, |hit| {
+                let casts = self.casts(hit.prim as usize, ray.dir);
+                counts.shadow_pass_through += !casts as u64;
+                casts
+            });
+            return if blocked { 0.0 } else { 1.0 };
+        }
         let mut share = 1.0f32;
         let mut seen = Seen::new();
         let blocked = self.accel.occluded_filtered(&ray, |hit| {
@@ -586,9 +604,6 @@ impl<'a> Integrator<'a> {
             if !self.casts(prim, ray.dir) {
                 counts.shadow_pass_through += 1;
                 return false;
-            }
-            if !self.alpha {
-                return true;
             }
             let s = &self.surfacing[self.soup.tri_material[prim] as usize];
             match s.alpha {

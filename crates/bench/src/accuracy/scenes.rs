@@ -209,7 +209,7 @@ pub fn checker_texture(size: u32, check: u32) -> Texture {
     let mut texels = Vec::with_capacity((size * size * 4) as usize);
     for y in 0..size {
         for x in 0..size {
-            let c = if (x / check + y / check) % 2 == 0 {
+            let c = if (x / check + y / check).is_multiple_of(2) {
                 255
             } else {
                 0

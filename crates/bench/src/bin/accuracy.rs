@@ -25,6 +25,11 @@ struct Args {
     runs: usize,
     #[arg(long, default_value_t = 256)]
     reference_spp: u32,
+    /// Also write each scene's soup to DIR/NAME.soup, and for a textured scene the same
+    /// soup with its maps removed (DIR/NAME-no-maps.soup), to time with kd2exr what the
+    /// textures cost.
+    #[arg(long, value_name = "DIR")]
+    export: Option<PathBuf>,
     /// Sweep only these scenes (comma-separated names: baseline, shadows-soft,
     /// spot-on-mirror, checkerboard).
     #[arg(long, value_delimiter = ',')]
@@ -77,6 +82,11 @@ fn run() -> Result<()> {
             anyhow::bail!("--only {}: no such scene", a.only.join(","));
         }
     }
+    if let Some(dir) = &a.export {
+        for s in &list {
+            export(dir, s)?;
+        }
+    }
     let start = std::time::Instant::now();
     let log = |l: &str| eprintln!("[{:6.1} s] {l}", start.elapsed().as_secs_f64());
     let mut results = vec![];
@@ -95,5 +105,26 @@ fn run() -> Result<()> {
     formats::write_atomic(&a.svg, svg.as_bytes())
         .with_context(|| format!("{}: cannot write the plot", a.svg.display()))?;
     eprintln!("wrote {} and {}", a.out.display(), a.svg.display());
+    Ok(())
+}
+
+fn export(dir: &std::path::Path, scene: &scenes::Scene) -> Result<()> {
+    let write = |name: &str, soup: &formats::Soup| {
+        let path = dir.join(format!("{name}.soup"));
+        soup.write(&path)
+            .with_context(|| format!("{}: cannot write", path.display()))?;
+        eprintln!("wrote {}", path.display());
+        Ok::<_, anyhow::Error>(())
+    };
+    write(&scene.name, &scene.soup)?;
+    if scene.soup.materials.iter().any(|m| m.albedo_map.is_some()) {
+        let mut plain = scene.soup.clone();
+        for m in &mut plain.materials {
+            m.albedo_map = None;
+        }
+        plain.textures.clear();
+        plain.uvs.clear();
+        write(&format!("{}-no-maps", scene.name), &plain)?;
+    }
     Ok(())
 }
