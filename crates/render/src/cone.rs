@@ -24,6 +24,17 @@ impl RayCone {
         self.width + self.spread * t
     }
 
+    /// The cone of one of `samples` stratified samples of a pixel: each stands for a
+    /// 1/√samples share of the pixel's width, so the box filter over the samples and the
+    /// texture filter over each sample's footprint do not blur the same pixel twice.
+    pub fn per_sample(&self, samples: u32) -> RayCone {
+        let k = 1.0 / (samples.max(1) as f32).sqrt();
+        RayCone {
+            width: self.width * k,
+            spread: self.spread * k,
+        }
+    }
+
     /// The cone of a mirror ray leaving a hit at distance `t`.
     pub fn reflected(&self, t: f32) -> RayCone {
         RayCone {
@@ -47,5 +58,7 @@ mod tests {
         let r = c.reflected(10.0);
         assert_eq!(r.at(0.0), 1.25);
         assert_eq!(r.at(2.0), 1.5);
+        assert_eq!(c.per_sample(1), c);
+        assert_eq!(c.per_sample(16).at(10.0), 1.25 / 4.0);
     }
 }

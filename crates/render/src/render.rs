@@ -147,7 +147,7 @@ pub fn render_pixel(
     let samples = pixel_samples(opts.spp, &mut rng);
     let mut sum = Vec3::ZERO;
     let mut best = (f32::INFINITY, Primary::MISS);
-    let cone = camera.cone();
+    let cone = camera.cone().per_sample(samples.len() as u32);
     for (sx, sy) in &samples {
         let ray = camera.ray(x as f32 + sx, y as f32 + sy);
         let (l, primary) = integrator.camera_sample(&ray, cone, &mut rng, counts);

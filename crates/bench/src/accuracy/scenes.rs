@@ -282,6 +282,29 @@ pub fn checkerboard() -> Scene {
     }
 }
 
+/// `scene` with every material textured by a 512×512 checker (8-texel squares) projected
+/// from above (uv = (x, z) / 2 m): what textures cost on real geometry, where shadow and
+/// mirror rays dilute the lookups.
+pub fn with_checker(scene: &Scene) -> Scene {
+    let mut soup = scene.soup.clone();
+    soup.textures = vec![checker_texture(512, 8)];
+    for m in &mut soup.materials {
+        m.albedo_map = Some(TextureRef {
+            texture: 0,
+            tiling: Tiling::default(),
+        });
+    }
+    soup.uvs = soup
+        .triangles
+        .iter()
+        .map(|t| t.map(|p| Vec2::new(p.x, p.z) / 2.0))
+        .collect();
+    Scene {
+        name: format!("{}-textured", scene.name),
+        soup,
+    }
+}
+
 /// A tiny scene for tests: a mirror floor, a diffuse box-less wall and a floating
 /// triangle casting a soft shadow from a point light.
 pub fn tiny() -> Scene {

@@ -27,7 +27,8 @@ struct Args {
     reference_spp: u32,
     /// Also write each scene's soup to DIR/NAME.soup, and for a textured scene the same
     /// soup with its maps removed (DIR/NAME-no-maps.soup), to time with kd2exr what the
-    /// textures cost.
+    /// textures cost; the baseline is also written with a checker on every material
+    /// (baseline-textured).
     #[arg(long, value_name = "DIR")]
     export: Option<PathBuf>,
     /// Sweep only these scenes (comma-separated names: baseline, shadows-soft,
@@ -76,15 +77,18 @@ fn run() -> Result<()> {
         notes.push(line);
     }
     list.push(scenes::checkerboard());
+    if let Some(dir) = &a.export {
+        for s in &list {
+            export(dir, s)?;
+        }
+        if let Some(b) = list.iter().find(|s| s.name == "baseline") {
+            export(dir, &scenes::with_checker(b))?;
+        }
+    }
     if !a.only.is_empty() {
         list.retain(|s| a.only.contains(&s.name));
         if list.is_empty() {
             anyhow::bail!("--only {}: no such scene", a.only.join(","));
-        }
-    }
-    if let Some(dir) = &a.export {
-        for s in &list {
-            export(dir, s)?;
         }
     }
     let start = std::time::Instant::now();
