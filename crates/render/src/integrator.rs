@@ -369,6 +369,7 @@ impl<'a> Integrator<'a> {
     /// is blended). `through` is the share of this surface's light that reaches the eye
     /// past the blended layers in front of it (it scales the mirror ray's weight).
     #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
     fn shade(
         &self,
         ray: &Ray,
@@ -525,20 +526,29 @@ impl<'a> Integrator<'a> {
                 counts.pass_through += through as u64;
                 !through
             }),
-            (culling, true) => self.accel.intersect_filtered(ray, |hit| {
-                let prim = hit.prim as usize;
-                let s = &self.surfacing[self.soup.tri_material[prim] as usize];
-                let through = (culling && self.culled(prim, ray.dir))
-                    || matches!(s.alpha, AlphaUse::Cutout { cutoff }
-                        if self.alpha_at(s, prim, hit, ray.dir, cone.at(hit.t), counts) < cutoff);
-                counts.pass_through += through as u64;
-                !through
-            }),
+            (_, true) => self.first_visible_alpha(ray, cone, counts),
         }
+    }
+
+    /// [`Integrator::first_visible`] with cut-out holes, out of line so that scenes
+    /// without them keep the old query's code.
+    #[inline(never)]
+    fn first_visible_alpha(&self, ray: &Ray, cone: RayCone, counts: &mut RayCounts) -> Option<Hit> {
+        let culling = self.culling;
+        self.accel.intersect_filtered(ray, |hit| {
+            let prim = hit.prim as usize;
+            let s = &self.surfacing[self.soup.tri_material[prim] as usize];
+            let through = (culling && self.culled(prim, ray.dir))
+                || matches!(s.alpha, AlphaUse::Cutout { cutoff }
+                    if self.alpha_at(s, prim, hit, ray.dir, cone.at(hit.t), counts) < cutoff);
+            counts.pass_through += through as u64;
+            !through
+        })
     }
 
     /// Whether camera and reflection rays along `dir` pass through triangle `prim`: a
     /// shadows-only object, or a face its material culls.
+    #[inline(always)]
     fn culled(&self, prim: usize, dir: Vec3) -> bool {
         let obj = &self.soup.objects[self.soup.tri_object[prim] as usize];
         let cull = self.soup.materials[self.soup.tri_material[prim] as usize].cull;
@@ -597,9 +607,16 @@ impl<'a> Integrator<'a> {
             });
             return if blocked { 0.0 } else { 1.0 };
         }
+        self.transmittance_alpha(&ray, counts)
+    }
+
+    /// [`Integrator::transmittance`] through cut-out holes and blended casters, out of
+    /// line so that scenes without them keep the old query's code.
+    #[inline(never)]
+    fn transmittance_alpha(&self, ray: &Ray, counts: &mut RayCounts) -> f32 {
         let mut share = 1.0f32;
         let mut seen = Seen::new();
-        let blocked = self.accel.occluded_filtered(&ray, |hit| {
+        let blocked = self.accel.occluded_filtered(ray, |hit| {
             let prim = hit.prim as usize;
             if !self.casts(prim, ray.dir) {
                 counts.shadow_pass_through += 1;

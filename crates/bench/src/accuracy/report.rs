@@ -51,7 +51,8 @@ pub fn markdown(results: &[SceneResult], cfg: &Config, command: &str, notes: &[S
          renders on all cores (tracing only; the tree is prebuilt), rays traced, and the error \
          against a converged reference ({} spp, depth {}, cut-off 0, {} soft-shadow samples, \
          textures bilinear at full size, another seed). Each knob is swept alone from the renderer's defaults (spp {}, depth \
-         {}, cut-off {}, soft samples {}). RMSE and relMSE (mean (a−r)²/(r²+0.01)) are on the \
+         {}, cut-off {}, soft samples {}, texture filter {}; the texture filter is swept on \
+         textured scenes only). RMSE and relMSE (mean (a−r)²/(r²+0.01)) are on the \
          linear HDR colour; 1−SSIM is on the luma of the 8-bit sRGB preview, 8×8 windows \
          stepped by 4. The bias column (mirror depth, cut-off, soft samples) is the RMSE \
          against the sweep's own most accurate setting rendered with the same seed, so the \
@@ -67,6 +68,7 @@ pub fn markdown(results: &[SceneResult], cfg: &Config, command: &str, notes: &[S
         d.depth,
         d.cutoff,
         d.soft_samples,
+        d.texture_filter,
         cfg.reference_depth
     );
     let _ = writeln!(s, "![error against time](accuracy.svg)\n");
