@@ -26,6 +26,11 @@ fn mix(a: Vec4, b: Vec4, f: f32) -> Vec4 {
 /// Integer texel coordinate `i` wrapped into [0, n).
 fn wrap(i: i64, n: u32, mode: Wrap) -> u32 {
     let n = n as i64;
+    // Inside the image every mode is the identity; the division below is the slow part of
+    // a lookup, and the neighbours of a wrapped texel are almost always inside.
+    if (0..n).contains(&i) {
+        return i as u32;
+    }
     (match mode {
         Wrap::Repeat => i.rem_euclid(n),
         Wrap::Clamp => i.clamp(0, n - 1),
@@ -125,6 +130,11 @@ impl Sampler {
         Vec4::from_array(level.texel(x, y))
     }
 
+    /// The texel at wrapped coordinates (x, y).
+    fn at(level: &Level, x: u32, y: u32) -> Vec4 {
+        Vec4::from_array(level.texel(x, y))
+    }
+
     fn point(&self, level: usize, uv: Vec2) -> Vec4 {
         let l = &self.levels[level];
         let x = (uv.x as f64 * l.width as f64).floor() as i64;
@@ -139,8 +149,17 @@ impl Sampler {
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
         let (x0, y0) = (x0 as i64, y0 as i64);
-        let bottom = mix(self.fetch(l, x0, y0), self.fetch(l, x0 + 1, y0), fx);
-        let top = mix(self.fetch(l, x0, y0 + 1), self.fetch(l, x0 + 1, y0 + 1), fx);
+        // Each of the four coordinates wrapped once, not once per texel read.
+        let (xa, xb) = (
+            wrap(x0, l.width, self.wrap_u),
+            wrap(x0 + 1, l.width, self.wrap_u),
+        );
+        let (ya, yb) = (
+            wrap(y0, l.height, self.wrap_v),
+            wrap(y0 + 1, l.height, self.wrap_v),
+        );
+        let bottom = mix(Self::at(l, xa, ya), Self::at(l, xb, ya), fx);
+        let top = mix(Self::at(l, xa, yb), Self::at(l, xb, yb), fx);
         mix(bottom, top, fy)
     }
 }
