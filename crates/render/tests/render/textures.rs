@@ -364,3 +364,41 @@ fn an_untextured_scene_plans_no_texture_or_alpha_work() {
         0
     );
 }
+
+#[test]
+fn a_mirror_shows_a_texture_where_its_reflection_lands() {
+    let mut s = SceneBuilder::new();
+    ambient_white(&mut s);
+    let m = s.material(mirror(1.0));
+    s.floor(0.0, 0.0, 0.0, 20.0, m);
+    let t = s.texture(four_colours(Wrap::Clamp));
+    let c = s.material(mapped(t, Tiling::default()));
+    // A 4 m ceiling above the camera, uv = ((x + 2) / 4, (z + 2) / 4).
+    s.quad(
+        "ceiling",
+        Vec3::new(-2.0, 20.0, -2.0),
+        Vec3::new(4.0, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, 4.0),
+        c,
+    );
+    s.camera(top_down_camera(Vec3::new(0.0, 10.0, 0.0), 2.0));
+    let (soup, kd) = s.build();
+    let (out, _) = render(&soup, &kd, &opts(4, 4));
+    let colours = [RED, GREEN, BLUE, WHITE];
+    for py in 0..4 {
+        for px in 0..4 {
+            // The camera looks straight down at a flat mirror: the reflection is the
+            // ceiling point straight above the mirror point.
+            let p = ortho_point(&soup.camera, 4, 4, px, py, 0.0);
+            let (u, v) = ((p.x + 2.0) / 4.0, (p.z + 2.0) / 4.0);
+            let i = (v * 2.0).floor() as usize * 2 + (u * 2.0).floor() as usize;
+            assert_eq!(
+                out.frame.pixel(px, py),
+                rgb(colours[i]),
+                "pixel ({px}, {py})"
+            );
+        }
+    }
+    assert_eq!(out.counts.texture_lookups, 16);
+    assert_eq!(out.counts.reflection, 16);
+}
