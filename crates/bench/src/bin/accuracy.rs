@@ -102,7 +102,17 @@ fn run() -> Result<()> {
         start.elapsed().as_secs_f64(),
         rayon::current_num_threads()
     ));
-    let md = report::markdown(&results, &cfg, "just accuracy", &notes);
+    // The report names the command that made it: `just accuracy` runs it bare.
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let command = if args.is_empty() {
+        "just accuracy".to_string()
+    } else {
+        format!(
+            "cargo run --release -p bench --bin accuracy -- {}",
+            args.join(" ")
+        )
+    };
+    let md = report::markdown(&results, &cfg, &command, &notes);
     formats::write_atomic(&a.out, md.as_bytes())
         .with_context(|| format!("{}: cannot write the report", a.out.display()))?;
     let svg = plot::svg(&results).map_err(|e| anyhow::anyhow!("plotting: {e}"))?;
