@@ -1,5 +1,6 @@
 //! Camera rays: perspective (vertical field of view) or orthographic (half height).
 
+use crate::cone::RayCone;
 use crate::RenderError;
 use formats::{Camera, Projection};
 use glam::Vec3;
@@ -75,6 +76,23 @@ impl CameraModel {
         })
     }
 
+    /// The ray cone of one pixel (the same for every pixel: the spread of the image centre's
+    /// pixel, which the off-axis pixels of a wide lens exceed a little).
+    pub fn cone(&self) -> RayCone {
+        let pixel = 2.0 * self.half_h / self.height;
+        if self.ortho {
+            RayCone {
+                width: pixel,
+                spread: 0.0,
+            }
+        } else {
+            RayCone {
+                width: 0.0,
+                spread: pixel,
+            }
+        }
+    }
+
     /// The ray through image position (`px`, `py`) in pixels of the full image, with
     /// (0, 0) the top-left corner of the top-left pixel and y growing downwards. Geometry
     /// nearer than the camera's near clip plane is not seen, as in Unity.
@@ -130,6 +148,21 @@ mod tests {
         let top = m.ray(50.0, 0.0);
         assert_eq!(top.dir, cam.forward);
         assert!((top.origin - (cam.position + Vec3::Y * 2.0)).length() < 1e-5);
+    }
+
+    #[test]
+    fn a_pixel_cone_spans_one_pixel() {
+        let m = CameraModel::new(&Camera::default(), 200, 100).unwrap();
+        let c = m.cone();
+        // Two neighbouring centre rays are one cone width apart at unit distance.
+        let (a, b) = (m.ray(100.0, 50.0).dir, m.ray(101.0, 50.0).dir);
+        assert!((c.at(1.0) - (a - b).length()).abs() < 1e-5, "{c:?}");
+        let ortho = Camera {
+            projection: Projection::Orthographic { half_height: 2.0 },
+            ..Camera::default()
+        };
+        let c = CameraModel::new(&ortho, 100, 100).unwrap().cone();
+        assert_eq!((c.width, c.spread), (0.04, 0.0));
     }
 
     #[test]

@@ -11,10 +11,22 @@ pub struct RayCounts {
     pub soft_shadow: u64,
     pub reflection: u64,
     /// Hits that camera and reflection rays passed through inside their traversal: faces
-    /// their material culls, shadows-only objects (not rays: no query is restarted).
+    /// their material culls, shadows-only objects, cut-out holes (not rays: no query is
+    /// restarted).
     pub pass_through: u64,
-    /// Hits that shadow rays passed through: surfaces that cast no shadow that way.
+    /// Hits that shadow rays passed through: surfaces that cast no shadow that way and
+    /// cut-out holes.
     pub shadow_pass_through: u64,
+    /// Camera and reflection rays continued past a blended (Transparent/Fade) surface for
+    /// the light behind it: each a query from the hit onwards.
+    pub blend_continuation: u64,
+    /// Blended surfaces that attenuated a shadow ray (each triangle once per ray).
+    pub shadow_blend: u64,
+    /// Albedo lookups at shaded points.
+    pub texture_lookups: u64,
+    /// Alpha lookups: cut-out tests inside the traversals and blended surfaces' alpha where
+    /// no albedo lookup gave it.
+    pub alpha_lookups: u64,
     /// Samples whose radiance was NaN or infinite and were replaced by 0 (not a ray kind).
     #[serde(skip)]
     pub sanitized: u64,
@@ -28,10 +40,15 @@ impl RayCounts {
         self.reflection += o.reflection;
         self.pass_through += o.pass_through;
         self.shadow_pass_through += o.shadow_pass_through;
+        self.blend_continuation += o.blend_continuation;
+        self.shadow_blend += o.shadow_blend;
+        self.texture_lookups += o.texture_lookups;
+        self.alpha_lookups += o.alpha_lookups;
         self.sanitized += o.sanitized;
     }
+    /// Queries traced: every ray kind, blend continuations included.
     pub fn total(&self) -> u64 {
-        self.camera + self.shadow + self.soft_shadow + self.reflection
+        self.camera + self.shadow + self.soft_shadow + self.reflection + self.blend_continuation
     }
 }
 
@@ -43,6 +60,10 @@ pub struct SharedCounts {
     reflection: AtomicU64,
     pass_through: AtomicU64,
     shadow_pass_through: AtomicU64,
+    blend_continuation: AtomicU64,
+    shadow_blend: AtomicU64,
+    texture_lookups: AtomicU64,
+    alpha_lookups: AtomicU64,
     sanitized: AtomicU64,
 }
 
@@ -55,6 +76,11 @@ impl SharedCounts {
         self.pass_through.fetch_add(c.pass_through, Relaxed);
         self.shadow_pass_through
             .fetch_add(c.shadow_pass_through, Relaxed);
+        self.blend_continuation
+            .fetch_add(c.blend_continuation, Relaxed);
+        self.shadow_blend.fetch_add(c.shadow_blend, Relaxed);
+        self.texture_lookups.fetch_add(c.texture_lookups, Relaxed);
+        self.alpha_lookups.fetch_add(c.alpha_lookups, Relaxed);
         self.sanitized.fetch_add(c.sanitized, Relaxed);
     }
     pub fn load(&self) -> RayCounts {
@@ -65,6 +91,10 @@ impl SharedCounts {
             reflection: self.reflection.load(Relaxed),
             pass_through: self.pass_through.load(Relaxed),
             shadow_pass_through: self.shadow_pass_through.load(Relaxed),
+            blend_continuation: self.blend_continuation.load(Relaxed),
+            shadow_blend: self.shadow_blend.load(Relaxed),
+            texture_lookups: self.texture_lookups.load(Relaxed),
+            alpha_lookups: self.alpha_lookups.load(Relaxed),
             sanitized: self.sanitized.load(Relaxed),
         }
     }

@@ -9,6 +9,12 @@
 //! n is the interpolated shading normal turned to face the incoming ray; the geometric
 //! normal decides which side a secondary ray leaves from (see [`crate::offset`]).
 //!
+//! Albedo is colour·texel·(1 − metallic) where the material has a map and the plan turns
+//! textures on: the texel is looked up at the hit's interpolated UV through the material's
+//! tiling, filtered over the footprint of the pixel's ray cone (see [`crate::cone`]). Alpha
+//! (see [`crate::alpha`]): cut-out holes are refused inside the traversals; a blended
+//! surface mixes α of its own light with 1 − α of what lies behind it.
+//!
 //! Unity's draw rules: camera and reflection rays pass through faces their material culls
 //! and shadows-only objects; shadow rays pass through objects that cast no shadow and
 //! faces the material culls seen from the light (unless the object casts two-sided); a
@@ -16,16 +22,20 @@
 //! its mask. Passing through is the same ray again with `tmin` just above the hit's t:
 //! the same ray parameters give the same t for that triangle, so it is never found again.
 
+use crate::alpha::{alpha_use, min_alphas, AlphaUse};
+use crate::cone::RayCone;
 use crate::counters::RayCounts;
 use crate::environment;
 use crate::lights::{basis, incident, Incident};
 use crate::offset::{
     hit_point, intersector_margin, offset_origin, SHADOW_TMAX_FRACTION, SPAWN_TMIN,
 };
-use crate::plan::{Plan, ShadowMode};
+use crate::plan::{colour_mapped, Plan, ShadowMode};
 use crate::sampling::{disc_sample, Rng};
-use formats::{CastShadows, Cull, Hit, Light, LightKind, Soup};
-use glam::Vec3;
+use crate::texture::{cone_footprint, Sampler};
+use crate::TextureFilter;
+use formats::{CastShadows, Cull, Hit, Light, LightKind, Soup, Tiling};
+use glam::{Vec2, Vec3, Vec4};
 use kdtree::{Accel, Ray};
 
 /// What the first hit of a camera ray tells the AOVs.
@@ -66,6 +76,59 @@ impl Surface {
     }
 }
 
+/// What a material needs from its texture, resolved once per render.
+struct Surfacing {
+    /// The sampler (index into `Integrator::samplers`) and tiling of its map.
+    map: Option<(usize, Tiling)>,
+    /// The albedo is multiplied by the map's colour.
+    colour: bool,
+    alpha: AlphaUse,
+    opacity: f32,
+}
+
+/// Two hits of one object closer than this fraction of their distance are one surface
+/// point: the any-hit query reports a triangle once per leaf it spans, and a ray through an
+/// edge meets both triangles that share it (at t a few ulps apart). Distinct layers this
+/// close would z-fight in Unity's depth buffer, which is far coarser.
+const SAME_SURFACE: f32 = 1e-5;
+
+fn same_surface(t0: f32, t1: f32) -> bool {
+    (t0 - t1).abs() <= SAME_SURFACE * t0.max(t1)
+}
+
+/// Blended surface points a shadow ray has already been attenuated by, as (object, t).
+/// Eight fit inline; deeper stacks spill.
+struct Seen {
+    inline: [(u32, f32); 8],
+    len: usize,
+    spill: Vec<(u32, f32)>,
+}
+
+impl Seen {
+    fn new() -> Self {
+        Seen {
+            inline: [(0, 0.0); 8],
+            len: 0,
+            spill: Vec::new(),
+        }
+    }
+
+    /// True the first time a point of `object` at `t` is offered.
+    fn first(&mut self, object: u32, t: f32) -> bool {
+        let seen = |&(o, s): &(u32, f32)| o == object && same_surface(s, t);
+        if self.inline[..self.len].iter().any(seen) || self.spill.iter().any(seen) {
+            return false;
+        }
+        if self.len < self.inline.len() {
+            self.inline[self.len] = (object, t);
+            self.len += 1;
+        } else {
+            self.spill.push((object, t));
+        }
+        true
+    }
+}
+
 pub struct Integrator<'a> {
     soup: &'a Soup,
     accel: &'a Accel,
@@ -77,8 +140,15 @@ pub struct Integrator<'a> {
     soft_samples: u32,
     /// Camera and reflection rays check their hits against the culling rules.
     culling: bool,
-    /// Shadow rays loop closest hits past non-casting surfaces instead of any-hit.
+    /// Shadow rays ask each hit whether it casts (non-casting surfaces, culled faces).
     shadow_filter: bool,
+    /// Cut-out and blended materials are honoured (the plan's alpha effect).
+    alpha: bool,
+    filter: TextureFilter,
+    /// One per soup texture, built when textures or alpha are on (else empty).
+    samplers: Vec<Sampler>,
+    /// One per material (empty when textures and alpha are off).
+    surfacing: Vec<Surfacing>,
 }
 
 /// Replace NaN and ±Inf channels by 0; true when something was replaced.
@@ -91,7 +161,15 @@ pub fn sanitize(v: &mut Vec3) -> bool {
 }
 
 impl<'a> Integrator<'a> {
-    pub fn new(soup: &'a Soup, accel: &'a Accel, plan: &Plan, soft_samples: u32) -> Self {
+    /// Builds every texture's sampler (mip chain) when the plan reads textures, so this
+    /// is the render's texture loading step.
+    pub fn new(
+        soup: &'a Soup,
+        accel: &'a Accel,
+        plan: &Plan,
+        soft_samples: u32,
+        filter: TextureFilter,
+    ) -> Self {
         let lights = soup
             .lights
             .iter()
@@ -102,6 +180,31 @@ impl<'a> Integrator<'a> {
                 shadows: p.shadows,
             })
             .collect();
+        let textures = plan.textures.enabled;
+        let alpha = plan.alpha.enabled;
+        let (samplers, surfacing) = if textures || alpha {
+            let min_alpha = min_alphas(&soup.textures);
+            let surfacing = soup
+                .materials
+                .iter()
+                .map(|m| Surfacing {
+                    map: m
+                        .albedo_map
+                        .map(|r| (r.texture as usize, r.tiling))
+                        .filter(|_| textures || alpha),
+                    colour: textures && colour_mapped(m),
+                    alpha: if alpha {
+                        alpha_use(m, &min_alpha)
+                    } else {
+                        AlphaUse::Opaque
+                    },
+                    opacity: m.opacity,
+                })
+                .collect();
+            (soup.textures.iter().map(Sampler::new).collect(), surfacing)
+        } else {
+            (Vec::new(), Vec::new())
+        };
         Integrator {
             soup,
             accel,
@@ -116,21 +219,70 @@ impl<'a> Integrator<'a> {
             cutoff: plan.reflections.cutoff,
             soft_samples,
             culling: plan.culling.enabled,
-            shadow_filter: plan.shadow_casting.enabled,
+            shadow_filter: plan.shadow_casting.enabled || alpha,
+            alpha,
+            filter,
+            samplers,
+            surfacing,
+        }
+    }
+
+    /// Bytes of the texture samplers this render built (mip chains included).
+    pub fn texture_bytes(&self) -> u64 {
+        self.samplers.iter().map(Sampler::bytes).sum()
+    }
+
+    /// The interpolated UV of triangle `prim` at barycentrics (u, v): corner 0 weighs
+    /// 1 − u − v, corner 1 u, corner 2 v, as for the normals.
+    fn uv_at(&self, prim: usize, u: f32, v: f32) -> Vec2 {
+        let t = &self.soup.uvs[prim];
+        t[0] * (1.0 - u - v) + t[1] * u + t[2] * v
+    }
+
+    /// The map's RGBA at a hit of `prim` along `dir`, where the ray's cone is `width` wide
+    /// (0: the full-size image, for shadow rays, which have no pixel footprint).
+    fn texel(&self, map: &(usize, Tiling), prim: usize, hit: &Hit, dir: Vec3, width: f32) -> Vec4 {
+        let uv = self.uv_at(prim, hit.u, hit.v);
+        let w = if self.filter == TextureFilter::Cone && width > 0.0 {
+            cone_footprint(width, dir, self.soup.triangles[prim], self.soup.uvs[prim])
+        } else {
+            0.0
+        };
+        self.samplers[map.0].lookup(self.filter, &map.1, uv, w)
+    }
+
+    /// α of a cut-out or blended surface at a hit (its opacity without a map).
+    fn alpha_at(
+        &self,
+        s: &Surfacing,
+        prim: usize,
+        hit: &Hit,
+        dir: Vec3,
+        width: f32,
+        counts: &mut RayCounts,
+    ) -> f32 {
+        match &s.map {
+            Some(map) => {
+                counts.alpha_lookups += 1;
+                s.opacity * self.texel(map, prim, hit, dir, width).w
+            }
+            None => s.opacity,
         }
     }
 
     /// Radiance along a camera ray (counted), with what its first hit tells the AOVs.
     /// The result is always finite (non-finite channels are zeroed and counted).
+    /// `cone` is the pixel's ray cone ([`crate::CameraModel::cone`]).
     pub fn camera_sample(
         &self,
         ray: &Ray,
+        cone: RayCone,
         rng: &mut Rng,
         counts: &mut RayCounts,
     ) -> (Vec3, Primary) {
         counts.camera += 1;
         let mut primary = Primary::MISS;
-        let mut l = self.radiance(ray, 0, Vec3::ONE, rng, counts, Some(&mut primary));
+        let mut l = self.radiance(ray, cone, 0, Vec3::ONE, rng, counts, Some(&mut primary));
         if sanitize(&mut l) {
             counts.sanitized += 1;
         }
@@ -149,19 +301,115 @@ impl<'a> Integrator<'a> {
         (l, primary)
     }
 
+    /// Radiance along `ray`: the first visible surface's, and where that surface is
+    /// blended, mixed with what the same ray meets behind it (each layer a continuation).
+    #[allow(clippy::too_many_arguments)]
     fn radiance(
         &self,
         ray: &Ray,
+        cone: RayCone,
         bounce: u32,
         weight: Vec3,
         rng: &mut Rng,
         counts: &mut RayCounts,
         primary: Option<&mut Primary>,
     ) -> Vec3 {
-        let Some(hit) = self.first_visible(ray, counts) else {
-            return environment::background(&self.soup.environment, ray.dir);
-        };
+        let mut primary = primary;
+        if !self.alpha {
+            let Some(hit) = self.first_visible(ray, cone, counts) else {
+                return environment::background(&self.soup.environment, ray.dir);
+            };
+            let p = &mut primary;
+            return self
+                .shade(ray, &hit, cone, bounce, weight, 1.0, rng, counts, p)
+                .0;
+        }
+        let mut r = *ray;
+        // Light gathered from the blended layers so far, and the share of what lies behind
+        // them that still reaches the eye.
+        let mut acc = Vec3::ZERO;
+        let mut through = 1.0f32;
+        loop {
+            let Some(hit) = self.first_visible(&r, cone, counts) else {
+                let bg = environment::background(&self.soup.environment, r.dir);
+                return if through == 1.0 {
+                    bg
+                } else {
+                    acc + bg * through
+                };
+            };
+            let (l, a) = self.shade(
+                &r,
+                &hit,
+                cone,
+                bounce,
+                weight,
+                through,
+                rng,
+                counts,
+                &mut primary,
+            );
+            if a >= 1.0 && through == 1.0 {
+                return l;
+            }
+            acc += l * (a * through);
+            through *= 1.0 - a;
+            // A layer that stops all light, or a remainder too faint to matter (the
+            // reflection cut-off's rule), ends the ray.
+            if a >= 1.0 || (weight * through).max_element() < self.cutoff.max(f32::MIN_POSITIVE) {
+                return acc;
+            }
+            counts.blend_continuation += 1;
+            // Past this surface point, and past the triangle sharing the edge it may lie on.
+            r.tmin = (hit.t + hit.t * SAME_SURFACE).max(hit.t.next_up());
+        }
+    }
+
+    /// The light a surface hit sends back along the ray, and its α (1 unless the surface
+    /// is blended). `through` is the share of this surface's light that reaches the eye
+    /// past the blended layers in front of it (it scales the mirror ray's weight).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn shade(
+        &self,
+        ray: &Ray,
+        hit: &Hit,
+        cone: RayCone,
+        bounce: u32,
+        weight: Vec3,
+        through: f32,
+        rng: &mut Rng,
+        counts: &mut RayCounts,
+        primary: &mut Option<&mut Primary>,
+    ) -> (Vec3, f32) {
         let prim = hit.prim as usize;
+        let mat_index = self.soup.tri_material[prim] as usize;
+        let mat = &self.soup.materials[mat_index];
+        let mut albedo = mat.albedo();
+        let mut a = 1.0f32;
+        if let Some(s) = self.surfacing.get(mat_index) {
+            let blend = s.alpha == AlphaUse::Blend;
+            match &s.map {
+                Some(map) if s.colour || blend => {
+                    let texel = self.texel(map, prim, hit, ray.dir, cone.at(hit.t));
+                    if s.colour {
+                        counts.texture_lookups += 1;
+                        albedo *= texel.truncate();
+                    } else {
+                        counts.alpha_lookups += 1;
+                    }
+                    if blend {
+                        a = s.opacity * texel.w;
+                    }
+                }
+                _ if blend => a = s.opacity,
+                _ => {}
+            }
+            if a <= 0.0 {
+                return (Vec3::ZERO, 0.0);
+            }
+        }
+
         let tri = &self.soup.triangles[prim];
         let (p, err) = hit_point(tri, hit.u, hit.v);
 
@@ -186,10 +434,8 @@ impl<'a> Integrator<'a> {
             ns = -ns;
         }
 
-        let mat = &self.soup.materials[self.soup.tri_material[prim] as usize];
         let obj = &self.soup.objects[self.soup.tri_object[prim] as usize];
-        let albedo = mat.albedo();
-        if let Some(pr) = primary {
+        if let Some(pr) = primary.take() {
             *pr = Primary {
                 depth: hit.t,
                 normal: ns,
@@ -227,11 +473,7 @@ impl<'a> Integrator<'a> {
                     ShadowMode::None => 1.0,
                     ShadowMode::Hard => {
                         counts.shadow += 1;
-                        if self.blocked(&surf, inc.dir, inc.dist, counts) {
-                            0.0
-                        } else {
-                            1.0
-                        }
+                        self.transmittance(&surf, inc.dir, inc.dist, counts)
                     }
                     ShadowMode::Soft => self.soft_visibility(&surf, al.light, &inc, rng, counts),
                 };
@@ -243,7 +485,7 @@ impl<'a> Integrator<'a> {
 
         if bounce < self.max_depth {
             let refl = mat.reflectance();
-            let w = weight * refl;
+            let w = weight * (through * a) * refl;
             if w.max_element() >= self.cutoff && refl.max_element() > 0.0 {
                 let d = ray.dir;
                 let mut r = d - ns * (2.0 * d.dot(ns));
@@ -261,28 +503,56 @@ impl<'a> Integrator<'a> {
                         tmin: SPAWN_TMIN,
                         tmax: f32::INFINITY,
                     };
-                    l += refl * self.radiance(&next, bounce + 1, w, rng, counts, None);
+                    let c = cone.reflected(hit.t);
+                    l += refl * self.radiance(&next, c, bounce + 1, w, rng, counts, None);
                 }
             }
         }
-        l
+        (l, a)
     }
 
-    /// The closest hit camera and reflection rays see, passing through culled faces and
-    /// shadows-only objects inside one traversal (each pass-through counted).
-    fn first_visible(&self, ray: &Ray, counts: &mut RayCounts) -> Option<Hit> {
-        if !self.culling {
-            return self.accel.intersect(ray);
+    /// The closest hit camera and reflection rays see, passing through culled faces,
+    /// shadows-only objects and cut-out holes inside one traversal (each pass-through
+    /// counted). Holes are tested at the cone's footprint, the lookup that shades the
+    /// surface, so a cut-out's edge and its colour come from the same mip level, as in
+    /// Unity's `clip()` on the sampled alpha.
+    fn first_visible(&self, ray: &Ray, cone: RayCone, counts: &mut RayCounts) -> Option<Hit> {
+        // Each combination gets its own closure, so a scene without cut-outs runs the
+        // culling test alone, as it did before alpha existed.
+        match (self.culling, self.alpha) {
+            (false, false) => self.accel.intersect(ray),
+            (true, false) => self.accel.intersect_filtered(ray, |hit| {
+                let through = self.culled(hit.prim as usize, ray.dir);
+                counts.pass_through += through as u64;
+                !through
+            }),
+            (_, true) => self.first_visible_alpha(ray, cone, counts),
         }
+    }
+
+    /// [`Integrator::first_visible`] with cut-out holes, out of line so that scenes
+    /// without them keep the old query's code.
+    #[inline(never)]
+    fn first_visible_alpha(&self, ray: &Ray, cone: RayCone, counts: &mut RayCounts) -> Option<Hit> {
+        let culling = self.culling;
         self.accel.intersect_filtered(ray, |hit| {
             let prim = hit.prim as usize;
-            let obj = &self.soup.objects[self.soup.tri_object[prim] as usize];
-            let cull = self.soup.materials[self.soup.tri_material[prim] as usize].cull;
-            let through = !obj.visible()
-                || (cull != Cull::None && cull.skips(winding(self.soup, prim), ray.dir));
+            let s = &self.surfacing[self.soup.tri_material[prim] as usize];
+            let through = (culling && self.culled(prim, ray.dir))
+                || matches!(s.alpha, AlphaUse::Cutout { cutoff }
+                    if self.alpha_at(s, prim, hit, ray.dir, cone.at(hit.t), counts) < cutoff);
             counts.pass_through += through as u64;
             !through
         })
+    }
+
+    /// Whether camera and reflection rays along `dir` pass through triangle `prim`: a
+    /// shadows-only object, or a face its material culls.
+    #[inline(always)]
+    fn culled(&self, prim: usize, dir: Vec3) -> bool {
+        let obj = &self.soup.objects[self.soup.tri_object[prim] as usize];
+        let cull = self.soup.materials[self.soup.tri_material[prim] as usize].cull;
+        !obj.visible() || (cull != Cull::None && cull.skips(winding(self.soup, prim), dir))
     }
 
     /// Whether the hit triangle `prim` blocks a shadow ray travelling along `dir` (towards
@@ -299,9 +569,12 @@ impl<'a> Integrator<'a> {
         }
     }
 
-    /// Whether the way from the surface at `p` along unit `dir` to a light `dist` away is
-    /// blocked (`dist` infinite: a directional light, the ray is unbounded).
-    fn blocked(&self, surf: &Surface, dir: Vec3, dist: f32, counts: &mut RayCounts) -> bool {
+    /// The share of a light's light that reaches the surface at `p` along unit `dir` from
+    /// `dist` away (`dist` infinite: a directional light, the ray is unbounded): 0 when an
+    /// opaque caster is in the way, the product of (1 − α) over the blended casters met
+    /// otherwise. Cut-out holes are tested at full resolution: a shadow ray has no pixel
+    /// footprint, and the full-size image gives the hole's true shape.
+    fn transmittance(&self, surf: &Surface, dir: Vec3, dist: f32, counts: &mut RayCounts) -> f32 {
         let origin = surf.spawn(dir);
         let p = surf.p;
         let ray = if dist.is_infinite() {
@@ -324,13 +597,54 @@ impl<'a> Integrator<'a> {
             }
         };
         if !self.shadow_filter {
-            return self.accel.occluded(&ray);
+            return if self.accel.occluded(&ray) { 0.0 } else { 1.0 };
         }
-        self.accel.occluded_filtered(&ray, |hit| {
-            let casts = self.casts(hit.prim as usize, ray.dir);
-            counts.shadow_pass_through += !casts as u64;
-            casts
-        })
+        if !self.alpha {
+            let blocked = self.accel.occluded_filtered(&ray, |hit| {
+                let casts = self.casts(hit.prim as usize, ray.dir);
+                counts.shadow_pass_through += !casts as u64;
+                casts
+            });
+            return if blocked { 0.0 } else { 1.0 };
+        }
+        self.transmittance_alpha(&ray, counts)
+    }
+
+    /// [`Integrator::transmittance`] through cut-out holes and blended casters, out of
+    /// line so that scenes without them keep the old query's code.
+    #[inline(never)]
+    fn transmittance_alpha(&self, ray: &Ray, counts: &mut RayCounts) -> f32 {
+        let mut share = 1.0f32;
+        let mut seen = Seen::new();
+        let blocked = self.accel.occluded_filtered(ray, |hit| {
+            let prim = hit.prim as usize;
+            if !self.casts(prim, ray.dir) {
+                counts.shadow_pass_through += 1;
+                return false;
+            }
+            let s = &self.surfacing[self.soup.tri_material[prim] as usize];
+            match s.alpha {
+                AlphaUse::Opaque => true,
+                AlphaUse::Cutout { cutoff } => {
+                    let hole = self.alpha_at(s, prim, hit, ray.dir, 0.0, counts) < cutoff;
+                    counts.shadow_pass_through += hole as u64;
+                    !hole
+                }
+                AlphaUse::Blend => {
+                    if !seen.first(self.soup.tri_object[prim], hit.t) {
+                        return false;
+                    }
+                    counts.shadow_blend += 1;
+                    share *= 1.0 - self.alpha_at(s, prim, hit, ray.dir, 0.0, counts);
+                    share <= 0.0
+                }
+            }
+        });
+        if blocked {
+            0.0
+        } else {
+            share
+        }
     }
 
     /// Fraction of `soft_samples` stratified shadow rays that reach the light's extent: a
@@ -348,11 +662,11 @@ impl<'a> Integrator<'a> {
         let n = self.soft_samples;
         let rotation = rng.next_f32() * std::f32::consts::TAU;
         let (t, b) = basis(inc.dir);
-        let mut visible = 0u32;
+        let mut visible = 0.0f32;
         for i in 0..n {
             let (dx, dy) = disc_sample(i, n, rng.next_f32(), rotation);
             counts.soft_shadow += 1;
-            let blocked = match light.kind {
+            visible += match light.kind {
                 LightKind::Directional => {
                     // Uniform over the spherical cap, stratified by the disc's area strata.
                     let half = (light.shadow_radius * 0.5)
@@ -368,7 +682,7 @@ impl<'a> Integrator<'a> {
                         (1.0, 0.0)
                     };
                     let dir = (t * (c * sin_t) + b * (s * sin_t) + inc.dir * cos_t).normalize();
-                    self.blocked(surf, dir, f32::INFINITY, counts)
+                    self.transmittance(surf, dir, f32::INFINITY, counts)
                 }
                 LightKind::Point | LightKind::Spot { .. } => {
                     let q = light.position + (t * dx + b * dy) * light.shadow_radius;
@@ -377,14 +691,11 @@ impl<'a> Integrator<'a> {
                     if dist <= 0.0 {
                         continue;
                     }
-                    self.blocked(surf, to / dist, dist, counts)
+                    self.transmittance(surf, to / dist, dist, counts)
                 }
             };
-            if !blocked {
-                visible += 1;
-            }
         }
-        visible as f32 / n as f32
+        visible / n as f32
     }
 }
 

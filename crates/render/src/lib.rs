@@ -4,6 +4,8 @@
 //! The steps, each in its own module:
 //! * [`plan`]: decide from the soup which effects can change the image (and why);
 //! * [`camera`]: pixel → ray (perspective or orthographic, y = 0 at the top row);
+//! * [`cone`]: how wide a pixel's rays are at a hit, for texture filtering;
+//! * [`texture`], [`alpha`]: albedo lookups, cut-out holes and blended surfaces;
 //! * [`lights`]: Unity's range falloff and spot cones;
 //! * [`integrator`]: emission, ambient, direct light with hard/soft shadows, mirrors;
 //! * [`offset`]: secondary rays spawned past the hit point's rounding error;
@@ -12,8 +14,10 @@
 //! * [`exrio`], [`preview`]: EXR with AOVs, crop windows and merging; PNG preview;
 //! * [`memory`]: refuse a render that cannot fit before it starts.
 
+pub mod alpha;
 pub mod aov;
 pub mod camera;
+pub mod cone;
 pub mod counters;
 pub mod environment;
 pub mod error;
@@ -36,7 +40,7 @@ pub use counters::RayCounts;
 pub use error::RenderError;
 pub use exrio::ExrImage;
 pub use frame::Frame;
-pub use options::{RenderOptions, Window};
+pub use options::{RenderOptions, TextureFilter, Window};
 pub use plan::Plan;
 pub use render::{render, render_scene, Rendered};
 
@@ -56,6 +60,7 @@ pub fn header_attributes(
     a.insert(format!("{p}seed"), opts.seed.to_string());
     a.insert(format!("{p}softSamples"), opts.soft_samples.to_string());
     a.insert(format!("{p}cutoff"), opts.cutoff.to_string());
+    a.insert(format!("{p}textureFilter"), opts.texture_filter.to_string());
     a.insert(format!("{p}renderSeconds"), format!("{seconds:.6}"));
     a.insert(format!("{p}geometryHash"), formats::hex(geometry_hash));
     a.insert(format!("{p}version"), env!("CARGO_PKG_VERSION").to_string());

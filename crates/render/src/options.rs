@@ -1,6 +1,52 @@
 //! What a render is asked to do: image size, window, sampling and effect limits.
 
 use crate::{AovSet, RenderError};
+use serde::Serialize;
+
+/// How albedo and alpha lookups filter a texture (`--texture-filter`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TextureFilter {
+    /// The texel under the hit on the full-size image, whatever the import settings: the
+    /// cheapest lookup, and it aliases wherever a pixel covers many texels.
+    Point,
+    /// Bilinear on the full-size image, whatever the import settings: smooth up close,
+    /// aliases like point when minified.
+    Bilinear,
+    /// What Unity does: the texture's own filter mode (point, bilinear, trilinear) and mip
+    /// maps, the level chosen by the ray cone's footprint at the hit.
+    #[default]
+    Cone,
+}
+
+impl TextureFilter {
+    pub const ALL: [TextureFilter; 3] = [
+        TextureFilter::Point,
+        TextureFilter::Bilinear,
+        TextureFilter::Cone,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            TextureFilter::Point => "point",
+            TextureFilter::Bilinear => "bilinear",
+            TextureFilter::Cone => "cone",
+        }
+    }
+
+    pub fn parse(s: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|f| f.name() == s)
+            .ok_or_else(|| format!("--texture-filter {s:?}: choose from point, bilinear, cone"))
+    }
+}
+
+impl std::fmt::Display for TextureFilter {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
 
 /// A half-open pixel rectangle [x0, x1) × [y0, y1) of the full image, y = 0 at the top.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -74,6 +120,7 @@ pub struct RenderOptions {
     pub threads: Option<usize>,
     /// Tile edge in pixels.
     pub tile: u32,
+    pub texture_filter: TextureFilter,
 }
 
 impl Default for RenderOptions {
@@ -92,6 +139,7 @@ impl Default for RenderOptions {
             aovs: AovSet::default(),
             threads: None,
             tile: 32,
+            texture_filter: TextureFilter::default(),
         }
     }
 }

@@ -2,8 +2,9 @@
 //! image, and why. The integrator consults it, so a ray that cannot change the image is
 //! never traced; it is printed, stored in the EXR header and returned in `--json`.
 
-use crate::RenderOptions;
-use formats::{AmbientMode, CastShadows, ClearFlags, Cull, LightKind, Shadows, Soup};
+use crate::alpha::{alpha_use, min_alphas, AlphaUse};
+use crate::{RenderOptions, TextureFilter};
+use formats::{AmbientMode, CastShadows, ClearFlags, Cull, LightKind, Material, Shadows, Soup};
 use glam::Vec3;
 use serde::Serialize;
 
@@ -78,6 +79,31 @@ pub struct ShadowCastPlan {
     pub reason: String,
 }
 
+/// Albedo textures: on when a used material with a diffuse colour has a map. Off, no UV
+/// is interpolated and no texel read.
+#[derive(Clone, Debug, Serialize)]
+pub struct TexturePlan {
+    pub enabled: bool,
+    /// Used materials whose albedo is looked up in a map.
+    pub textured_materials: usize,
+    /// Distinct textures those materials (and the alpha lookups) read.
+    pub textures: usize,
+    /// Bytes of those textures' samplers, mip levels included (linear RGBA f32).
+    pub bytes: u64,
+    pub filter: TextureFilter,
+    pub reason: String,
+}
+
+/// Alpha: on when a used material is cut out where its α can fall below the cut-off, or
+/// blended where α can be below 1.
+#[derive(Clone, Debug, Serialize)]
+pub struct AlphaPlan {
+    pub enabled: bool,
+    pub cutout_materials: usize,
+    pub blend_materials: usize,
+    pub reason: String,
+}
+
 #[derive(Clone, Debug, Serialize)]
 pub struct Plan {
     /// Direct lighting: on when some light is on and some material has a diffuse albedo.
@@ -85,6 +111,8 @@ pub struct Plan {
     pub lights: Vec<LightPlan>,
     pub culling: CullPlan,
     pub shadow_casting: ShadowCastPlan,
+    pub textures: TexturePlan,
+    pub alpha: AlphaPlan,
     pub reflections: ReflectionPlan,
     pub ambient: Effect,
     pub emission: Effect,
@@ -230,12 +258,15 @@ impl Plan {
         };
 
         let (culling, shadow_casting) = draw_rules(soup, &used, &lights);
+        let (textures, alpha) = texturing(soup, &mats, opts.texture_filter);
 
         Plan {
             direct,
             lights,
             culling,
             shadow_casting,
+            textures,
+            alpha,
             reflections,
             ambient,
             emission,
@@ -275,6 +306,16 @@ impl Plan {
             self.shadow_casting.reason
         );
         s += &format!(
+            "  textures       {}  {}\n",
+            on(self.textures.enabled),
+            self.textures.reason
+        );
+        s += &format!(
+            "  alpha          {}  {}\n",
+            on(self.alpha.enabled),
+            self.alpha.reason
+        );
+        s += &format!(
             "  reflections    {}  {}\n",
             on(self.reflections.enabled),
             self.reflections.reason
@@ -302,6 +343,84 @@ impl Plan {
     pub fn to_json(&self) -> serde_json::Value {
         serde_json::to_value(self).unwrap_or(serde_json::Value::Null)
     }
+}
+
+/// Whether material `m` reads its albedo map for colour: it has one and a colour the map
+/// can show in (a black tint stays black whatever the texel).
+pub fn colour_mapped(m: &Material) -> bool {
+    m.albedo_map.is_some() && m.albedo().max_element() > 0.0
+}
+
+/// The texture and alpha effects the used materials `mats` call for.
+fn texturing(soup: &Soup, mats: &[&Material], filter: TextureFilter) -> (TexturePlan, AlphaPlan) {
+    let min_alpha = min_alphas(&soup.textures);
+    let uses: Vec<AlphaUse> = mats.iter().map(|m| alpha_use(m, &min_alpha)).collect();
+    let cutout_materials = uses
+        .iter()
+        .filter(|u| matches!(u, AlphaUse::Cutout { .. }))
+        .count();
+    let blend_materials = uses.iter().filter(|u| **u == AlphaUse::Blend).count();
+    let alpha_on = cutout_materials + blend_materials > 0;
+    let textured_materials = mats.iter().filter(|m| colour_mapped(m)).count();
+    // Textures read at all: for colour, or for the alpha of a material that uses it.
+    let mut read = vec![false; soup.textures.len()];
+    for (m, u) in mats.iter().zip(&uses) {
+        if let Some(r) = m
+            .albedo_map
+            .filter(|_| colour_mapped(m) || *u != AlphaUse::Opaque)
+        {
+            if let Some(x) = read.get_mut(r.texture as usize) {
+                *x = true;
+            }
+        }
+    }
+    let textures = read.iter().filter(|&&r| r).count();
+    let bytes: u64 = soup
+        .textures
+        .iter()
+        .zip(&read)
+        .filter(|(_, &r)| r)
+        .map(|(t, _)| crate::texture::sampler_bytes(t))
+        .sum();
+    let how = match filter {
+        TextureFilter::Cone => "each texture's own filter and mip maps, the level from a ray cone",
+        TextureFilter::Bilinear => "bilinear on the full-size images (--texture-filter bilinear)",
+        TextureFilter::Point => "nearest texel of the full-size images (--texture-filter point)",
+    };
+    let texture_plan = TexturePlan {
+        enabled: textured_materials > 0,
+        textured_materials,
+        textures,
+        bytes,
+        filter,
+        reason: if textured_materials > 0 {
+            format!(
+                "{textured_materials} materials with albedo maps, {textures} textures \
+                 ({:.1} MiB with mips): {how}",
+                bytes as f64 / (1u64 << 20) as f64
+            )
+        } else if mats.iter().any(|m| m.albedo_map.is_some()) {
+            "the mapped materials have black albedo".into()
+        } else {
+            "no material has an albedo map".into()
+        },
+    };
+    let alpha_plan = AlphaPlan {
+        enabled: alpha_on,
+        cutout_materials,
+        blend_materials,
+        reason: if alpha_on {
+            format!(
+                "{cutout_materials} cut-out materials (holes for every ray), {blend_materials} \
+                 blended materials (rays continue behind them, shadows pass a share)"
+            )
+        } else if mats.iter().any(|m| m.uses_alpha()) {
+            "the cut-out and blended materials are opaque at every texel".into()
+        } else {
+            "every material is opaque".into()
+        },
+    };
+    (texture_plan, alpha_plan)
 }
 
 /// The culling and shadow-casting rules the soup's used materials and objects call for.

@@ -1,5 +1,6 @@
 //! Parallel rendering over tiles with rayon's work stealing.
 
+use crate::cone::RayCone;
 use crate::counters::{RayCounts, SharedCounts};
 use crate::integrator::{Integrator, Primary};
 use crate::sampling::{pixel_samples, Rng};
@@ -66,7 +67,7 @@ pub fn render(
 ) -> Result<Rendered, RenderError> {
     opts.validate()?;
     let camera = CameraModel::new(&soup.camera, opts.width, opts.height)?;
-    let integrator = Integrator::new(soup, accel, plan, opts.soft_samples);
+    let integrator = Integrator::new(soup, accel, plan, opts.soft_samples, opts.texture_filter);
     let window = opts.window();
     let run = || render_tiles(&camera, &integrator, opts, window, progress);
     let start = Instant::now();
@@ -95,6 +96,8 @@ fn render_tiles(
     window: Window,
     progress: Option<&(dyn Fn(u64, u64) + Sync)>,
 ) -> (Frame, RayCounts) {
+    // One pixel's cone shared by its samples, the same for every pixel.
+    let cone = camera.cone().per_sample(opts.spp);
     let list = tiles(window, opts.tile);
     let total = list.len() as u64;
     let shared = SharedCounts::default();
@@ -106,7 +109,8 @@ fn render_tiles(
             let mut pixels = Vec::with_capacity(tile.pixels() as usize);
             for y in tile.y0..tile.y1 {
                 for x in tile.x0..tile.x1 {
-                    pixels.push(render_pixel(camera, integrator, opts, x, y, &mut counts));
+                    let c = &mut counts;
+                    pixels.push(render_pixel(camera, cone, integrator, opts, x, y, c));
                 }
             }
             shared.add(&counts);
@@ -134,9 +138,11 @@ fn render_tiles(
 /// One pixel: the box-filtered mean of its samples. Its generator is seeded from
 /// (seed, x, y) only, so its value is independent of tiles, threads and crops. The AOVs
 /// come from the sample nearest the pixel centre (averaging depths or object ids across
-/// an edge would describe no surface).
+/// an edge would describe no surface). `cone` is each sample's ray cone
+/// ([`CameraModel::cone`] shared by the `opts.spp` samples).
 pub fn render_pixel(
     camera: &CameraModel,
+    cone: RayCone,
     integrator: &Integrator,
     opts: &RenderOptions,
     x: u32,
@@ -149,7 +155,7 @@ pub fn render_pixel(
     let mut best = (f32::INFINITY, Primary::MISS);
     for (sx, sy) in &samples {
         let ray = camera.ray(x as f32 + sx, y as f32 + sy);
-        let (l, primary) = integrator.camera_sample(&ray, &mut rng, counts);
+        let (l, primary) = integrator.camera_sample(&ray, cone, &mut rng, counts);
         sum += l;
         let d = (sx - 0.5).powi(2) + (sy - 0.5).powi(2);
         if d < best.0 {

@@ -5,6 +5,7 @@
 //! v = 0 is the bottom row, and wrap modes act on integer texel coordinates, so a bilinear
 //! lookup at a border blends the two texels the wrap mode makes neighbours.
 
+use crate::options::TextureFilter;
 use formats::texture::{Filter, Level, Texture, Tiling, Wrap};
 use glam::{Vec2, Vec3, Vec4};
 
@@ -25,6 +26,11 @@ fn mix(a: Vec4, b: Vec4, f: f32) -> Vec4 {
 /// Integer texel coordinate `i` wrapped into [0, n).
 fn wrap(i: i64, n: u32, mode: Wrap) -> u32 {
     let n = n as i64;
+    // Inside the image every mode is the identity; the division below is the slow part of
+    // a lookup, and the neighbours of a wrapped texel are almost always inside.
+    if (0..n).contains(&i) {
+        return i as u32;
+    }
     (match mode {
         Wrap::Repeat => i.rem_euclid(n),
         Wrap::Clamp => i.clamp(0, n - 1),
@@ -86,6 +92,28 @@ impl Sampler {
         }
     }
 
+    /// A lookup at a mesh uv through a material's tiling, filtered as `filter` says:
+    /// [`TextureFilter::Cone`] is [`Sampler::sample_tiled`] (the texture's own filter mode
+    /// and mip maps, the level from the footprint `width`); `Point` and `Bilinear` read the
+    /// full-size image whatever the import settings, ignoring `width`.
+    pub fn lookup(&self, filter: TextureFilter, tiling: &Tiling, uv: Vec2, width: f32) -> Vec4 {
+        match filter {
+            TextureFilter::Cone => self.sample_tiled(tiling, uv, width),
+            TextureFilter::Point => self.point(0, Vec2::from_array(tiling.apply(uv.to_array()))),
+            TextureFilter::Bilinear => {
+                self.bilinear(0, Vec2::from_array(tiling.apply(uv.to_array())))
+            }
+        }
+    }
+
+    /// Bytes the mip chain holds (linear RGBA f32 per texel, every level).
+    pub fn bytes(&self) -> u64 {
+        self.levels
+            .iter()
+            .map(|l| l.texels.len() as u64 * std::mem::size_of::<[f32; 4]>() as u64)
+            .sum()
+    }
+
     /// [`Sampler::sample`] at a mesh uv through a material's tiling.
     pub fn sample_tiled(&self, tiling: &Tiling, uv: Vec2, width: f32) -> Vec4 {
         let t = tiling.apply(uv.to_array());
@@ -99,6 +127,11 @@ impl Sampler {
     fn fetch(&self, level: &Level, x: i64, y: i64) -> Vec4 {
         let x = wrap(x, level.width, self.wrap_u);
         let y = wrap(y, level.height, self.wrap_v);
+        Vec4::from_array(level.texel(x, y))
+    }
+
+    /// The texel at wrapped coordinates (x, y).
+    fn at(level: &Level, x: u32, y: u32) -> Vec4 {
         Vec4::from_array(level.texel(x, y))
     }
 
@@ -116,10 +149,38 @@ impl Sampler {
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
         let (x0, y0) = (x0 as i64, y0 as i64);
-        let bottom = mix(self.fetch(l, x0, y0), self.fetch(l, x0 + 1, y0), fx);
-        let top = mix(self.fetch(l, x0, y0 + 1), self.fetch(l, x0 + 1, y0 + 1), fx);
+        // Each of the four coordinates wrapped once, not once per texel read.
+        let (xa, xb) = (
+            wrap(x0, l.width, self.wrap_u),
+            wrap(x0 + 1, l.width, self.wrap_u),
+        );
+        let (ya, yb) = (
+            wrap(y0, l.height, self.wrap_v),
+            wrap(y0 + 1, l.height, self.wrap_v),
+        );
+        let bottom = mix(Self::at(l, xa, ya), Self::at(l, xb, ya), fx);
+        let top = mix(Self::at(l, xa, yb), Self::at(l, xb, yb), fx);
         mix(bottom, top, fy)
     }
+}
+
+/// Bytes a [`Sampler`] of `t` will hold, without building it: level 0 and, when
+/// mip-mapped, every halving down to 1×1, 16 bytes per texel.
+pub fn sampler_bytes(t: &Texture) -> u64 {
+    let (mut w, mut h) = (t.width.max(1) as u64, t.height.max(1) as u64);
+    let mut texels = w * h;
+    while t.mipmaps && (w > 1 || h > 1) {
+        (w, h) = ((w / 2).max(1), (h / 2).max(1));
+        texels += w * h;
+    }
+    texels * std::mem::size_of::<[f32; 4]>() as u64
+}
+
+/// The smallest alpha of any texel of `t` (0–1): a material whose opacity times this
+/// reaches its cut-off, or 1 for a blend, never shows a hole.
+pub fn min_alpha(t: &Texture) -> f32 {
+    let code = t.texels.chunks_exact(4).map(|c| c[3]).min().unwrap_or(255);
+    formats::texture::decode_u8(code, false)
 }
 
 /// The uv-space footprint of a ray cone of `cone_width` (world units, at the hit) on a
@@ -266,6 +327,28 @@ mod tests {
                 assert_eq!(s.sample(uv, width), want, "{filter:?} width {width}");
             }
         }
+    }
+
+    #[test]
+    fn knob_overrides_and_sizes() {
+        let s = two_by_two(Filter::Trilinear, Wrap::Clamp);
+        let t = Tiling::default();
+        // Half-way between texel centres: point picks one, bilinear blends, and a footprint
+        // of the whole texture reads the 1×1 level.
+        let uv = Vec2::new(0.5, 0.25);
+        assert_eq!(s.lookup(TextureFilter::Point, &t, uv, 1.0), GREEN);
+        assert_eq!(
+            s.lookup(TextureFilter::Bilinear, &t, uv, 1.0),
+            Vec4::new(0.5, 0.5, 0.0, 1.0)
+        );
+        assert_eq!(
+            s.lookup(TextureFilter::Cone, &t, uv, 2.0),
+            Vec4::new(0.5, 0.5, 0.5, 1.0)
+        );
+        let tex = texture(5, 3, &[[0, 0, 0, 7]; 15], Filter::Bilinear, Wrap::Repeat);
+        assert_eq!(sampler_bytes(&tex), Sampler::new(&tex).bytes());
+        assert_eq!(sampler_bytes(&tex), (15 + 2 + 1) * 16);
+        assert_eq!(min_alpha(&tex), 7.0 / 255.0);
     }
 
     #[test]

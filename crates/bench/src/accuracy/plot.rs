@@ -3,12 +3,13 @@
 use super::sweep::SceneResult;
 use plotters::prelude::*;
 
-const KNOBS: [(&str, RGBColor); 5] = [
+const KNOBS: [(&str, RGBColor); 6] = [
     ("spp", RGBColor(31, 119, 180)),
     ("depth", RGBColor(255, 127, 14)),
     ("cutoff", RGBColor(44, 160, 44)),
     ("soft", RGBColor(214, 39, 40)),
     ("tree", RGBColor(148, 103, 189)),
+    ("texture", RGBColor(140, 86, 75)),
 ];
 
 /// The SVG as a string (the caller writes it atomically). Text is left to the SVG

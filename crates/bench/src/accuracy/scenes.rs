@@ -1,12 +1,13 @@
 //! The soups the accuracy sweep renders: Unity scenes converted on the fly, a real mesh
-//! on a mirror floor built in code, and a tiny scene for tests.
+//! on a mirror floor and a textured checkerboard built in code, and a tiny scene for tests.
 
 use anyhow::{bail, Context, Result};
+use formats::texture::{Filter, Texture, TextureRef, Tiling, Wrap};
 use formats::{
     Alpha, Ambient, AmbientMode, Camera, ClearFlags, Cull, Environment, Light, LightKind, Material,
     Object, Projection, Shadows, Soup,
 };
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use std::path::Path;
 
 /// A named soup to sweep.
@@ -199,6 +200,109 @@ pub fn mesh_on_mirror(path: &Path) -> Result<Scene> {
         name: format!("{stem}-on-mirror"),
         soup,
     })
+}
+
+/// A `size`×`size` texture of black and white squares `check` texels wide, sRGB,
+/// trilinear, mip-mapped, repeating: what Unity imports a checker image as by default, bar
+/// the filter mode (bilinear there).
+pub fn checker_texture(size: u32, check: u32) -> Texture {
+    let mut texels = Vec::with_capacity((size * size * 4) as usize);
+    for y in 0..size {
+        for x in 0..size {
+            let c = if (x / check + y / check).is_multiple_of(2) {
+                255
+            } else {
+                0
+            };
+            texels.extend_from_slice(&[c, c, c, 255]);
+        }
+    }
+    Texture {
+        source: "accuracy/checker.png".into(),
+        width: size,
+        height: size,
+        texels,
+        srgb: true,
+        wrap_u: Wrap::Repeat,
+        wrap_v: Wrap::Repeat,
+        filter: Filter::Trilinear,
+        mipmaps: true,
+    }
+}
+
+/// A floor 40 m wide receding 80 m from a camera 1 m above it, textured with a fine
+/// checker (128 texels of 2-texel squares every 4 m: 6.25 cm squares) under a sun and a
+/// little ambient light, no shadows: past a few metres a pixel covers many squares, so
+/// unfiltered lookups alias (moiré) and only the texture filter decides the error.
+pub fn checkerboard() -> Scene {
+    let mut soup = Soup::empty();
+    soup.textures = vec![checker_texture(128, 2)];
+    soup.materials = vec![Material {
+        albedo_map: Some(TextureRef {
+            texture: 0,
+            tiling: Tiling::default(),
+        }),
+        ..material("checker", Vec3::splat(0.9), 0.0, 0.0)
+    }];
+    soup.objects = vec![Object::new("floor", "accuracy")];
+    let (x0, x1, z0, z1) = (-20.0, 20.0, -2.0, 80.0);
+    let corners = [
+        Vec3::new(x0, 0.0, z0),
+        Vec3::new(x0, 0.0, z1),
+        Vec3::new(x1, 0.0, z1),
+        Vec3::new(x1, 0.0, z0),
+    ];
+    // One texture repeat every 4 m.
+    let uv = corners.map(|c| Vec2::new(c.x, c.z) / 4.0);
+    for t in [[0, 1, 2], [0, 2, 3]] {
+        soup.triangles.push(t.map(|i| corners[i]));
+        soup.uvs.push(t.map(|i| uv[i]));
+        soup.normals.push([Vec3::Y; 3]);
+        soup.tri_material.push(0);
+        soup.tri_object.push(0);
+    }
+    soup.lights = vec![Light {
+        name: "sun".into(),
+        kind: LightKind::Directional,
+        position: Vec3::ZERO,
+        direction: Vec3::new(0.3, -1.0, 0.5).normalize(),
+        color: Vec3::ONE,
+        intensity: 1.0,
+        range: 0.0,
+        shadows: Shadows::None,
+        shadow_radius: 0.0,
+        culling_mask: u32::MAX,
+    }];
+    soup.camera = look(Vec3::new(0.0, 1.0, -1.0), Vec3::new(0.0, 0.0, 8.0), 50.0);
+    soup.environment = environment(Vec3::new(0.35, 0.45, 0.6), Vec3::splat(0.1));
+    soup.seal();
+    Scene {
+        name: "checkerboard".into(),
+        soup,
+    }
+}
+
+/// `scene` with every material textured by a 512×512 checker (8-texel squares) projected
+/// from above (uv = (x, z) / 2 m): what textures cost on real geometry, where shadow and
+/// mirror rays dilute the lookups.
+pub fn with_checker(scene: &Scene) -> Scene {
+    let mut soup = scene.soup.clone();
+    soup.textures = vec![checker_texture(512, 8)];
+    for m in &mut soup.materials {
+        m.albedo_map = Some(TextureRef {
+            texture: 0,
+            tiling: Tiling::default(),
+        });
+    }
+    soup.uvs = soup
+        .triangles
+        .iter()
+        .map(|t| t.map(|p| Vec2::new(p.x, p.z) / 2.0))
+        .collect();
+    Scene {
+        name: format!("{}-textured", scene.name),
+        soup,
+    }
 }
 
 /// A tiny scene for tests: a mirror floor, a diffuse box-less wall and a floating

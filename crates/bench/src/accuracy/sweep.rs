@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 use formats::{BuildParams, KdFile};
 use glam::Vec3;
 use kdtree::Accel;
-use render::{Plan, RayCounts, RenderOptions};
+use render::{Plan, RayCounts, RenderOptions, TextureFilter};
 use std::time::Instant;
 
 /// What to measure.
@@ -25,6 +25,8 @@ pub struct Config {
     pub depth: Vec<u32>,
     pub cutoff: Vec<f32>,
     pub soft: Vec<u32>,
+    /// Texture filters, swept on scenes whose plan reads textures.
+    pub texture_filter: Vec<TextureFilter>,
     /// Worker threads (None: one per core).
     pub threads: Option<usize>,
 }
@@ -42,6 +44,7 @@ impl Default for Config {
             depth: (0..=8).collect(),
             cutoff: vec![0.1, 0.03, 0.01, 0.004, 0.001, 0.0],
             soft: vec![1, 2, 4, 8, 16, 32, 64],
+            texture_filter: TextureFilter::ALL.to_vec(),
             threads: None,
         }
     }
@@ -58,8 +61,10 @@ pub fn defaults(cfg: &Config) -> RenderOptions {
     }
 }
 
-/// The converged reference's options: many samples, deep mirrors, no cut-off. Its seed
-/// differs from the sweep's so no point shares its noise with the reference.
+/// The converged reference's options: many samples, deep mirrors, no cut-off, textures
+/// read bilinearly at full size (the samples integrate the texture over each pixel, with
+/// no mip level's blur and no point lookup's steps). Its seed differs from the sweep's so
+/// no point shares its noise with the reference.
 pub fn reference_options(cfg: &Config) -> RenderOptions {
     RenderOptions {
         spp: cfg.reference_spp,
@@ -67,6 +72,7 @@ pub fn reference_options(cfg: &Config) -> RenderOptions {
         soft_samples: cfg.reference_soft,
         cutoff: 0.0,
         seed: 0x0005_eed0_f4ef,
+        texture_filter: TextureFilter::Bilinear,
         ..defaults(cfg)
     }
 }
@@ -75,7 +81,7 @@ pub fn reference_options(cfg: &Config) -> RenderOptions {
 #[derive(Clone, Debug)]
 pub struct Point {
     pub scene: String,
-    /// `spp`, `depth`, `cutoff`, `soft`, `tree`.
+    /// `spp`, `depth`, `cutoff`, `soft`, `texture`, `tree`.
     pub knob: &'static str,
     pub value: String,
     /// Whether this point is the renderer's default setting of the knob.
@@ -271,6 +277,16 @@ pub fn measure(scene: &Scene, cfg: &Config, log: &dyn Fn(&str)) -> Result<SceneR
         let o = soft_opts(soft);
         let d = soft == base.soft_samples;
         point("soft", soft.to_string(), d, &accel, &o, None, Some(&a))?;
+    }
+    if Plan::derive(&scene.soup, &base).textures.enabled {
+        for &f in &cfg.texture_filter {
+            let o = RenderOptions {
+                texture_filter: f,
+                ..base.clone()
+            };
+            let d = f == base.texture_filter;
+            point("texture", f.to_string(), d, &accel, &o, None, None)?;
+        }
     }
     let b = Some(sah_build);
     point("tree", "SAH".into(), true, &accel, &base, b, None)?;

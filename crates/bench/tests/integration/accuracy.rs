@@ -109,3 +109,32 @@ fn bias_is_measured_against_the_sweeps_most_accurate_setting() {
     assert!(md.contains("## Recommended defaults"), "{md}");
     assert!(md.contains("- mirror depth: "), "{md}");
 }
+
+#[test]
+fn the_texture_filter_is_swept_on_textured_scenes_only() {
+    let cfg = Config {
+        reference_spp: 64,
+        spp: vec![1],
+        depth: vec![4],
+        cutoff: vec![0.004],
+        soft: vec![16],
+        ..tiny_config()
+    };
+    let scene = scenes::checkerboard();
+    scene
+        .soup
+        .validate()
+        .expect("the checkerboard soup is valid");
+    let r = sweep::measure(&scene, &cfg, &|_| {}).unwrap();
+    let tex: Vec<_> = r.points.iter().filter(|p| p.knob == "texture").collect();
+    let values: Vec<_> = tex.iter().map(|p| p.value.as_str()).collect();
+    assert_eq!(values, ["point", "bilinear", "cone"]);
+    assert!(tex.iter().all(|p| p.rays.texture_lookups > 0));
+    // Minified, unfiltered lookups alias; the cone's mip level does not.
+    let rmse = |v: &str| tex.iter().find(|p| p.value == v).unwrap().errors.rmse;
+    assert!(rmse("cone") < rmse("point"), "{tex:?}");
+    let md = bench::accuracy::report::markdown(&[r], &cfg, "test", &[]);
+    assert!(md.contains("- texture filter: "), "{md}");
+    let tiny = sweep::measure(&scenes::tiny(), &cfg, &|_| {}).unwrap();
+    assert!(tiny.points.iter().all(|p| p.knob != "texture"));
+}

@@ -4,14 +4,14 @@
 //! kd2exr scene.soup scene.kd -o image.exr [--preview image.png] [--width 1024] [--height 768]
 //!        [--depth 4] [--spp 1] [--seed 0] [--threads N] [--json] [--half]
 //!        [--aov depth,normal,albedo,object] [--exposure 0] [--crop x0,y0,x1,y1]
-//!        [--soft-samples 16] [--cutoff 0.004]
+//!        [--soft-samples 16] [--cutoff 0.004] [--texture-filter cone]
 //! kd2exr merge a.exr b.exr … -o full.exr [--preview full.png] [--exposure 0]
 //! ```
 
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
 use formats::{KdFile, Soup};
-use render::{memory, preview, AovSet, ExrImage, Plan, RenderOptions, Window};
+use render::{memory, preview, AovSet, ExrImage, Plan, RenderOptions, TextureFilter, Window};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -100,6 +100,11 @@ struct RenderArgs {
     /// Stop reflection rays when the path weight falls below this.
     #[arg(long, default_value_t = RenderOptions::default().cutoff)]
     cutoff: f32,
+    /// Texture lookups: point or bilinear on the full-size image, or cone (as Unity: the
+    /// texture's own filter and mip maps, the level from the pixel's footprint).
+    #[arg(long, value_name = "point|bilinear|cone", value_parser = TextureFilter::parse,
+          default_value_t = RenderOptions::default().texture_filter)]
+    texture_filter: TextureFilter,
 }
 
 fn main() {
@@ -195,6 +200,7 @@ fn run(a: RenderArgs) -> Result<()> {
             None => AovSet::default(),
         },
         threads: a.threads,
+        texture_filter: a.texture_filter,
         ..RenderOptions::default()
     };
     finite_exposure(a.exposure)?;
@@ -272,15 +278,25 @@ fn run(a: RenderArgs) -> Result<()> {
         opts.width, opts.height, window, opts.spp, opts.depth, out.seconds, mrays, load_seconds, write_seconds
     );
     eprintln!(
-        "kd2exr: rays: camera {}, shadow {}, soft_shadow {}, reflection {}, pass_through {}, shadow_pass_through {} (total {})",
+        "kd2exr: rays: camera {}, shadow {}, soft_shadow {}, reflection {}, blend_continuation {}, pass_through {}, shadow_pass_through {}, shadow_blend {} (total {})",
         c.camera,
         c.shadow,
         c.soft_shadow,
         c.reflection,
+        c.blend_continuation,
         c.pass_through,
         c.shadow_pass_through,
+        c.shadow_blend,
         c.total()
     );
+    if c.texture_lookups + c.alpha_lookups > 0 {
+        eprintln!(
+            "kd2exr: texture lookups {}, alpha lookups {} ({:.1} MiB of textures with mips)",
+            c.texture_lookups,
+            c.alpha_lookups,
+            plan.textures.bytes as f64 / (1u64 << 20) as f64
+        );
+    }
     if c.sanitized > 0 {
         eprintln!(
             "kd2exr: warning: {} samples were NaN or infinite and were set to 0 (check the scene's materials and lights)",
@@ -295,6 +311,7 @@ fn run(a: RenderArgs) -> Result<()> {
             "window": [window.x0, window.y0, window.x1, window.y1],
             "spp": opts.spp,
             "depth": opts.depth,
+            "texture_filter": opts.texture_filter,
             "seconds": out.seconds,
             "load_seconds": load_seconds,
             "write_seconds": write_seconds,

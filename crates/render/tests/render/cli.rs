@@ -264,3 +264,73 @@ fn a_16k_render_with_aovs_is_refused_before_work_starts_when_it_cannot_fit() {
     assert!(err.contains("GiB") && err.contains("--crop"), "{err}");
     assert!(!o.exists());
 }
+
+#[test]
+fn the_texture_filter_is_an_option_and_lookups_are_reported() {
+    use formats::texture::{TextureRef, Tiling, Wrap};
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = SceneBuilder::new();
+    let t = s.texture(texture(
+        2,
+        2,
+        &[
+            [255, 0, 0, 255],
+            [0, 255, 0, 255],
+            [0, 0, 255, 255],
+            [255; 4],
+        ],
+        Wrap::Repeat,
+    ));
+    let m = s.material(formats::Material {
+        albedo_map: Some(TextureRef {
+            texture: t,
+            tiling: Tiling::default(),
+        }),
+        ..diffuse(Vec3::ONE)
+    });
+    s.floor(0.0, 0.0, 0.0, 20.0, m);
+    s.light(point_light(
+        Vec3::new(0.0, 4.0, 0.0),
+        1.5,
+        12.0,
+        Shadows::Hard,
+    ));
+    s.camera(top_down_camera(Vec3::new(0.0, 10.0, 0.0), 5.0));
+    let (soup, kd) = s.build();
+    let (sp, kp) = (dir.path().join("t.soup"), dir.path().join("t.kd"));
+    soup.write(&sp).unwrap();
+    kd.write(&kp).unwrap();
+    let (sp, kp) = (sp.to_str().unwrap(), kp.to_str().unwrap());
+    let o = dir.path().join("t.exr");
+    let o = o.to_str().unwrap();
+    let size = ["--width", "8", "--height", "6"];
+    let out = kd2exr(
+        &[
+            &[sp, kp, "-o", o, "--json", "--texture-filter", "point"][..],
+            &size,
+        ]
+        .concat(),
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(j["texture_filter"], "point");
+    assert_eq!(j["plan"]["textures"]["enabled"], true);
+    assert_eq!(j["plan"]["textures"]["filter"], "point");
+    assert_eq!(j["rays"]["texture_lookups"], 48, "{j}");
+    assert!(text(&out.stderr).contains("texture lookups 48"));
+    let exr = ExrImage::read(Path::new(o)).unwrap();
+    assert_eq!(
+        exr.attributes
+            .get("unitrace.textureFilter")
+            .map(String::as_str),
+        Some("point")
+    );
+    // A filter that does not exist is bad usage, naming the choices.
+    let out = kd2exr(&[sp, kp, "-o", o, "--texture-filter", "nearest"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out.stderr).contains("point, bilinear, cone"),
+        "{}",
+        text(&out.stderr)
+    );
+}

@@ -1,9 +1,10 @@
 //! Small scenes built in code for the renderer's tests: quads, boxes, lights, cameras.
 
+use formats::texture::{Filter, Texture, Wrap};
 use formats::{
     Alpha, Camera, Cull, KdFile, Light, LightKind, Material, Object, Projection, Shadows, Soup,
 };
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use render::{render_scene, Plan, RenderOptions, Rendered};
 
 pub struct SceneBuilder {
@@ -35,17 +36,41 @@ impl SceneBuilder {
     }
 
     /// A quad with corners `o`, `o + u`, `o + u + v`, `o + v`; its front (and normal) is u × v.
+    /// Its UVs run from (0, 0) at `o` to (1, 1) at `o + u + v`, u along `u`.
     pub fn quad(&mut self, name: &str, o: Vec3, u: Vec3, v: Vec3, material: u32) -> u32 {
+        self.quad_uv(name, o, u, v, material, [Vec2::ZERO, Vec2::ONE])
+    }
+
+    /// [`SceneBuilder::quad`] with UVs from `uv[0]` at `o` to `uv[1]` at `o + u + v`.
+    pub fn quad_uv(
+        &mut self,
+        name: &str,
+        o: Vec3,
+        u: Vec3,
+        v: Vec3,
+        material: u32,
+        uv: [Vec2; 2],
+    ) -> u32 {
         let obj = self.soup.objects.len() as u32;
         self.soup.objects.push(Object::new(name, "test"));
         let n = u.cross(v).normalize();
-        for t in [[o, o + u, o + u + v], [o, o + u + v, o + v]] {
-            self.soup.triangles.push(t);
+        let (a, b) = (uv[0], uv[1]);
+        let corner = [a, Vec2::new(b.x, a.y), b, Vec2::new(a.x, b.y)];
+        let p = [o, o + u, o + u + v, o + v];
+        for t in [[0, 1, 2], [0, 2, 3]] {
+            self.soup.triangles.push(t.map(|i| p[i]));
+            self.soup.uvs.push(t.map(|i| corner[i]));
             self.soup.normals.push([n; 3]);
             self.soup.tri_material.push(material);
             self.soup.tri_object.push(obj);
         }
         obj
+    }
+
+    /// Add a texture; its index for a material's `albedo_map`.
+    pub fn texture(&mut self, t: Texture) -> u32 {
+        self.soup.textures.push(t);
+        self.soup.textures.len() as u32 - 1
     }
 
     /// A horizontal square floor at height `y`, centred on (cx, cz), facing +Y.
@@ -78,6 +103,7 @@ impl SceneBuilder {
             let n = u.cross(v).normalize();
             for t in [[o, o + u, o + u + v], [o, o + u + v, o + v]] {
                 self.soup.triangles.push(t);
+                self.soup.uvs.push([Vec2::ZERO; 3]);
                 self.soup.normals.push([n; 3]);
                 self.soup.tri_material.push(material);
                 self.soup.tri_object.push(obj);
@@ -94,7 +120,12 @@ impl SceneBuilder {
         self.soup.camera = c;
     }
 
+    /// Seal and compile the scene; a scene without textures keeps no UVs, as unity2soup
+    /// writes it.
     pub fn build(mut self) -> (Soup, KdFile) {
+        if self.soup.materials.iter().all(|m| m.albedo_map.is_none()) {
+            self.soup.uvs.clear();
+        }
         self.soup.seal();
         self.soup.validate().expect("test scene is valid");
         let kd = kdtree::build(
@@ -204,6 +235,21 @@ pub fn directional_light(direction: Vec3, intensity: f32, shadows: Shadows) -> L
         shadows,
         shadow_radius: 0.0,
         culling_mask: u32::MAX,
+    }
+}
+
+/// A `w`×`h` texture of linear 8-bit RGBA texels, bottom row first, point-filtered.
+pub fn texture(w: u32, h: u32, texels: &[[u8; 4]], wrap: Wrap) -> Texture {
+    Texture {
+        source: "test.png".into(),
+        width: w,
+        height: h,
+        texels: texels.concat(),
+        srgb: false,
+        wrap_u: wrap,
+        wrap_v: wrap,
+        filter: Filter::Point,
+        mipmaps: true,
     }
 }
 

@@ -9,3 +9,4 @@ mod exr;
 mod lighting;
 mod plan;
 mod robustness;
+mod textures;
