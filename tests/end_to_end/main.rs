@@ -8,3 +8,4 @@ mod million_rays;
 mod pipeline;
 mod reliability;
 mod slurm;
+mod textures;
