@@ -224,13 +224,14 @@ impl ExrImage {
 /// pixels, the scene (its geometry, and the soup's checksum, which also covers materials,
 /// lights and camera), the tree's build parameters and the renderer's version. Crops that
 /// differ in any of them may still cover the image without a gap or a disagreeing overlap.
-const SAME_RENDER: [&str; 9] = [
+const SAME_RENDER: [&str; 10] = [
     "spp",
     "depth",
     "seed",
     "geometryHash",
     "softSamples",
     "cutoff",
+    "textureFilter",
     "soupDigest",
     "treeParams",
     "version",
@@ -450,9 +451,9 @@ mod tests {
     }
 
     #[test]
-    fn merge_names_the_input_of_another_soup_or_tree() {
+    fn merge_names_the_input_of_another_soup_tree_or_texture_filter() {
         let (left, right) = halves();
-        for key in ["soupDigest", "treeParams", "version"] {
+        for key in ["soupDigest", "treeParams", "version", "textureFilter"] {
             let a = crop(left, &[(key, "1")]);
             let b = crop(right, &[(key, "2")]);
             let err = merge_labelled(&[("a.exr".into(), &a), ("b.exr".into(), &b)])
