@@ -96,6 +96,94 @@ pub fn shadow(
         .collect()
 }
 
+/// Where a surface ray goes: to a point (a light; the interval ends just short of it, as
+/// the renderer's shadow rays do) or in a direction (unbounded).
+#[derive(Clone, Copy, Debug)]
+pub enum Toward {
+    Point(Vec3),
+    Direction(Vec3),
+}
+
+/// `n` rays leaving random points of random triangles (each triangle equally likely,
+/// visible or not; uniform over its area), spawned exactly as the renderer spawns
+/// secondary rays (`render::offset`). `toward` picks each ray's target from the RNG and
+/// the triangle's unit geometric normal. Degenerate triangles are skipped.
+pub fn surface(
+    triangles: &[[Vec3; 3]],
+    n: usize,
+    seed: u64,
+    mut toward: impl FnMut(&mut Rng, Vec3) -> Toward,
+) -> Vec<Ray> {
+    use render::offset::{hit_point, intersector_margin, offset_origin, SPAWN_TMIN};
+    use render::offset::SHADOW_TMAX_FRACTION;
+    let mut rng = Rng(seed);
+    let mut out = Vec::with_capacity(n);
+    if triangles.is_empty() {
+        return out;
+    }
+    let mut tries = 0usize;
+    while out.len() < n && tries < 4 * n + 16 {
+        tries += 1;
+        let t = &triangles[((rng.unit() as f64 * triangles.len() as f64) as usize).min(triangles.len() - 1)];
+        let ng = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
+        if ng == Vec3::ZERO || !ng.is_finite() {
+            continue;
+        }
+        let (mut u, mut v) = (rng.unit(), rng.unit());
+        if u + v > 1.0 {
+            (u, v) = (1.0 - u, 1.0 - v);
+        }
+        let (p, err) = hit_point(t, u, v);
+        let (dir, tmax) = match toward(&mut rng, ng) {
+            Toward::Point(l) => {
+                let to = l - p;
+                let d = to.length();
+                (to / d, d)
+            }
+            Toward::Direction(d) => (d, f32::INFINITY),
+        };
+        if !dir.is_finite() || dir == Vec3::ZERO {
+            continue;
+        }
+        let o = offset_origin(p, err, intersector_margin(t), ng, dir);
+        let tmax = if tmax.is_finite() {
+            (l_dist(o, p, dir, tmax)) * SHADOW_TMAX_FRACTION
+        } else {
+            tmax
+        };
+        out.push(Ray::new(o, dir, SPAWN_TMIN, tmax));
+    }
+    out
+}
+
+/// Distance from the spawned origin `o` to the target `tmax` along `dir` from `p`.
+fn l_dist(o: Vec3, p: Vec3, dir: Vec3, tmax: f32) -> f32 {
+    (p + dir * tmax - o).length()
+}
+
+/// A direction uniform on the hemisphere around unit normal `n`.
+pub fn hemisphere(rng: &mut Rng, n: Vec3) -> Vec3 {
+    let z = rng.unit();
+    let phi = std::f32::consts::TAU * rng.unit();
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let (a, b) = n.any_orthonormal_pair();
+    (a * (r * phi.cos()) + b * (r * phi.sin()) + n * z).normalize()
+}
+
+/// How far [`moved_along`] moves origins: 5 mm in the corpus meshes' metres.
+pub const MOVED: f32 = 0.005;
+
+/// `rays` with their origins moved `by` along the ray and their intervals shortened to
+/// match: rays that start clear of the surface they leave, to compare with.
+pub fn moved_along(rays: &[Ray], by: f32) -> Vec<Ray> {
+    rays.iter()
+        .map(|r| {
+            let tmax = if r.tmax.is_finite() { (r.tmax - by).max(r.tmin) } else { r.tmax };
+            Ray::new(r.origin + r.dir * by, r.dir, r.tmin, tmax)
+        })
+        .collect()
+}
+
 /// `n` rays with origins uniform in the bounds and directions uniform on the sphere,
 /// interval [0, ∞). Deterministic for a given seed.
 pub fn random(bounds: [Vec3; 2], n: usize, seed: u64) -> Vec<Ray> {

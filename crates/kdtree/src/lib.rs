@@ -29,6 +29,7 @@ pub use build::events::MAX_TRIANGLES;
 pub use build::median::build_median;
 pub use build::{build, depth_bound};
 pub use formats::Hit;
+pub use traverse::Counts;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ray {
@@ -153,12 +154,12 @@ impl Accel {
     /// Closest hit with t in [tmin, tmax], or None. Ties in t go to the lower triangle
     /// index. NaN/infinite rays, zero directions and tmin > tmax are misses.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        self.tree().closest(ray, |_| true)
+        self.tree().closest(ray, |_| true, &mut ())
     }
 
     /// Whether anything blocks the ray in [tmin, tmax]; stops at the first blocker.
     pub fn occluded(&self, ray: &Ray) -> bool {
-        self.tree().any(ray, |_| true)
+        self.tree().any(ray, |_| true, &mut ())
     }
 
     /// The closest hit that `accept` takes (it is asked about each hit that would be the
@@ -166,13 +167,24 @@ impl Accel {
     /// drawn from every side or at every texel need, without restarting the traversal for
     /// each refused hit. Ties go to the lower index among accepted hits.
     pub fn intersect_filtered(&self, ray: &Ray, accept: impl FnMut(&Hit) -> bool) -> Option<Hit> {
-        self.tree().closest(ray, accept)
+        self.tree().closest(ray, accept, &mut ())
     }
 
     /// Whether a hit that `blocks` takes lies in [tmin, tmax]; stops at the first one.
     /// Hits reach `blocks` in traversal order, not sorted by t.
     pub fn occluded_filtered(&self, ray: &Ray, blocks: impl FnMut(&Hit) -> bool) -> bool {
-        self.tree().any(ray, blocks)
+        self.tree().any(ray, blocks, &mut ())
+    }
+
+    /// [`Accel::intersect`] that also adds what the traversal did to `counts` (benchmarks;
+    /// the plain query is a separate instantiation and counts nothing).
+    pub fn intersect_counted(&self, ray: &Ray, counts: &mut Counts) -> Option<Hit> {
+        self.tree().closest(ray, |_| true, counts)
+    }
+
+    /// [`Accel::occluded`] that also adds what the traversal did to `counts`.
+    pub fn occluded_counted(&self, ray: &Ray, counts: &mut Counts) -> bool {
+        self.tree().any(ray, |_| true, counts)
     }
 
     /// Bytes held for queries: nodes, leaf lists and triangle data.
