@@ -114,8 +114,9 @@ pub fn surface(
     seed: u64,
     mut toward: impl FnMut(&mut Rng, Vec3) -> Toward,
 ) -> Vec<Ray> {
-    use render::offset::{hit_point, intersector_margin, offset_origin, SPAWN_TMIN};
-    use render::offset::SHADOW_TMAX_FRACTION;
+    use render::offset::{
+        hit_point, intersector_margin, offset_origin, SHADOW_TMAX_FRACTION, SPAWN_TMIN,
+    };
     let mut rng = Rng(seed);
     let mut out = Vec::with_capacity(n);
     if triangles.is_empty() {
@@ -124,7 +125,8 @@ pub fn surface(
     let mut tries = 0usize;
     while out.len() < n && tries < 4 * n + 16 {
         tries += 1;
-        let t = &triangles[((rng.unit() as f64 * triangles.len() as f64) as usize).min(triangles.len() - 1)];
+        let t = &triangles
+            [((rng.unit() as f64 * triangles.len() as f64) as usize).min(triangles.len() - 1)];
         let ng = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
         if ng == Vec3::ZERO || !ng.is_finite() {
             continue;
@@ -146,19 +148,17 @@ pub fn surface(
             continue;
         }
         let o = offset_origin(p, err, intersector_margin(t), ng, dir);
-        let tmax = if tmax.is_finite() {
-            (l_dist(o, p, dir, tmax)) * SHADOW_TMAX_FRACTION
+        let (dir, tmax) = if tmax.is_finite() {
+            // As the renderer does: re-aimed and re-measured from the spawned origin.
+            let to = p + dir * tmax - o;
+            let d = to.length();
+            (to / d, d * SHADOW_TMAX_FRACTION)
         } else {
-            tmax
+            (dir, tmax)
         };
         out.push(Ray::new(o, dir, SPAWN_TMIN, tmax));
     }
     out
-}
-
-/// Distance from the spawned origin `o` to the target `tmax` along `dir` from `p`.
-fn l_dist(o: Vec3, p: Vec3, dir: Vec3, tmax: f32) -> f32 {
-    (p + dir * tmax - o).length()
 }
 
 /// A direction uniform on the hemisphere around unit normal `n`.
@@ -178,7 +178,11 @@ pub const MOVED: f32 = 0.005;
 pub fn moved_along(rays: &[Ray], by: f32) -> Vec<Ray> {
     rays.iter()
         .map(|r| {
-            let tmax = if r.tmax.is_finite() { (r.tmax - by).max(r.tmin) } else { r.tmax };
+            let tmax = if r.tmax.is_finite() {
+                (r.tmax - by).max(r.tmin)
+            } else {
+                r.tmax
+            };
             Ray::new(r.origin + r.dir * by, r.dir, r.tmin, tmax)
         })
         .collect()
@@ -235,6 +239,41 @@ mod tests {
         assert!((rays[0].dir.length() - 1.0).abs() < 1e-6);
         let end = rays[0].origin + rays[0].dir * rays[0].tmax;
         assert!((end - Vec3::new(0.0, 10.0, 0.0)).length() < 1e-4);
+    }
+
+    #[test]
+    fn surface_rays_leave_their_triangles_on_the_side_they_go() {
+        let tris = [
+            [Vec3::ZERO, Vec3::X, Vec3::Z],
+            [
+                Vec3::new(0.0, 1.0, 0.0),
+                Vec3::new(1.0, 1.0, 0.0),
+                Vec3::new(0.0, 1.0, 1.0),
+            ],
+        ];
+        let light = Vec3::new(0.3, 10.0, 0.2);
+        let to_light = surface(&tris, 500, 9, |_, _| Toward::Point(light));
+        let hemi = surface(&tris, 500, 9, |rng, n| {
+            Toward::Direction(hemisphere(rng, n))
+        });
+        assert_eq!((to_light.len(), hemi.len()), (500, 500));
+        for r in &to_light {
+            // Every origin is just above one of the two planes y = 0 and y = 1.
+            let above = r.origin.y - r.origin.y.floor();
+            assert!(above > 0.0 && above < 1e-5, "{r:?}");
+            assert_eq!(r.tmin, render::offset::SPAWN_TMIN);
+            let end = r.origin + r.dir * r.tmax;
+            assert!(end.distance(light) < 1e-2 && r.tmax < r.origin.distance(light));
+        }
+        // Normals are −Y for both triangles (X × Z), so hemisphere rays go down.
+        assert!(hemi
+            .iter()
+            .all(|r| r.dir.y < 0.0 && r.tmax == f32::INFINITY));
+        let moved = moved_along(&to_light, MOVED);
+        for (m, r) in moved.iter().zip(&to_light) {
+            assert!((m.origin - (r.origin + r.dir * MOVED)).length() < 1e-6);
+            assert!((m.tmax - (r.tmax - MOVED)).abs() < 1e-5);
+        }
     }
 
     #[test]

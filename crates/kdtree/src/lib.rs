@@ -382,6 +382,32 @@ mod tree_tests {
         ));
     }
 
+    /// The counting instantiation is the same traversal: same answers, and counts that
+    /// add up (every ray that reaches a leaf stepped through the root first).
+    #[test]
+    fn counted_queries_answer_as_the_plain_ones() {
+        let tris = scene();
+        let a = Accel::build(&tris, &BuildParams::default());
+        let mut rng = testkit::Rng(3);
+        let mut total = Counts::default();
+        for _ in 0..2000 {
+            let o = Vec3::new(rng.unit(), rng.unit(), rng.unit()) * 8.0 - Vec3::splat(4.0);
+            let d = Vec3::new(rng.unit(), rng.unit(), rng.unit()) * 2.0 - Vec3::ONE;
+            let r = Ray::new(o, d, 0.0, f32::INFINITY);
+            let mut c = Counts::default();
+            assert_eq!(a.intersect_counted(&r, &mut c), a.intersect(&r));
+            assert_eq!(a.occluded_counted(&r, &mut c), a.occluded(&r));
+            assert!(c.leaves == 0 || c.nodes > 0, "{c:?}");
+            total.nodes += c.nodes;
+            total.leaves += c.leaves;
+            total.tests += c.tests;
+        }
+        assert!(
+            total.nodes > 0 && total.leaves > 0 && total.tests > 0,
+            "{total:?}"
+        );
+    }
+
     #[test]
     fn empty_soup_builds_and_misses() {
         let kd = build(
