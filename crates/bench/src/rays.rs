@@ -1,5 +1,6 @@
 //! The ray sets every contender traces: primary rays from a camera, shadow rays from the
-//! primary hits towards a light above the scene, and random rays inside the bounds.
+//! primary hits towards a light above the scene, random rays inside the bounds, and rays
+//! spawned from random surface points as the renderer spawns secondary rays.
 //! All are generated once per scene, so every contender sees exactly the same rays.
 
 use glam::Vec3;

@@ -1,5 +1,6 @@
 //! The benchmark itself: for each scene, build every contender with 1 and 2 threads,
-//! trace the same primary, shadow and random rays with each, and check that they agree.
+//! trace the same primary, shadow, random and surface-origin rays with each, and check
+//! that they agree.
 
 use crate::agreement::{self, subset_indices, Answers};
 use crate::config::Config;
