@@ -296,17 +296,6 @@ fn prefetch<T>(p: *const T) {
 }
 
 impl Tree<'_> {
-    /// Asks for every triangle of a leaf at once, so their cache misses overlap instead of
-    /// each four-wide group waiting on its own.
-    #[inline(always)]
-    fn prefetch_leaf(&self, leaf: &[u32]) {
-        for &p in leaf {
-            let t = self.tri(p) as *const [[f32; 3]; 3];
-            prefetch(t);
-            prefetch(t.cast::<u8>().wrapping_add(35));
-        }
-    }
-
     #[inline(always)]
     fn node(&self, i: u32) -> KdNode {
         debug_assert!((i as usize) < self.nodes.len());
@@ -401,7 +390,6 @@ impl Tree<'_> {
             }
             let leaf = self.leaf(node);
             count.leaf(leaf.len());
-            self.prefetch_leaf(leaf);
             if leaf.len() >= 2 {
                 for group in leaf.chunks(4) {
                     let bound = triangle::widen(best_t);
@@ -485,7 +473,6 @@ impl Tree<'_> {
             }
             let leaf = self.leaf(node);
             count.leaf(leaf.len());
-            self.prefetch_leaf(leaf);
             if leaf.len() >= 2 {
                 for group in leaf.chunks(4) {
                     let (lanes, hits) = self.test4::<KZ>(s, ray, group, ray.tmax);
