@@ -83,7 +83,7 @@ pub(crate) fn compare(
     let show = |f: Found| {
         if !f.is_hit() {
             "miss".to_string()
-        } else if kind == Kind::Shadow {
+        } else if kind.any_hit() {
             "occluded".to_string()
         } else {
             format!("t={} prim={}", f.t, f.prim)
@@ -102,7 +102,7 @@ pub(crate) fn compare(
         let mut r = Referee::default();
         for (i, k, o) in differ.iter().take(REFEREE_RAYS) {
             let ray = &rays[*i];
-            let truth = if kind == Kind::Shadow {
+            let truth = if kind.any_hit() {
                 let occ = brute::occluded_f64(tris, ray);
                 (occ == k.is_hit(), occ == o.is_hit())
             } else {

@@ -1,6 +1,7 @@
 //! Side-by-side measurements of the k-d tree: build time, SAH cost and memory, and
-//! traversal throughput on primary, shadow and random rays, against brute force and
-//! (with the `embree` feature) Embree 3 on the same triangles and rays, 1 and 2 threads.
+//! traversal throughput on primary, shadow, random and surface-origin rays, against brute
+//! force and (with the `embree` feature) Embree 3 on the same triangles and rays, 1 and 2
+//! threads.
 //! Every run also checks that the contenders agree on the hits.
 //!
 //! [`run::run`] does the work; [`report::markdown`] renders it; the `kdbench` binary is

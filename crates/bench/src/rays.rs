@@ -1,5 +1,6 @@
 //! The ray sets every contender traces: primary rays from a camera, shadow rays from the
-//! primary hits towards a light above the scene, and random rays inside the bounds.
+//! primary hits towards a light above the scene, random rays inside the bounds, and rays
+//! spawned from random surface points as the renderer spawns secondary rays.
 //! All are generated once per scene, so every contender sees exactly the same rays.
 
 use glam::Vec3;
@@ -96,6 +97,98 @@ pub fn shadow(
         .collect()
 }
 
+/// Where a surface ray goes: to a point (a light; the interval ends just short of it, as
+/// the renderer's shadow rays do) or in a direction (unbounded).
+#[derive(Clone, Copy, Debug)]
+pub enum Toward {
+    Point(Vec3),
+    Direction(Vec3),
+}
+
+/// `n` rays leaving random points of random triangles (each triangle equally likely,
+/// visible or not; uniform over its area), spawned exactly as the renderer spawns
+/// secondary rays (`render::offset`). `toward` picks each ray's target from the RNG and
+/// the triangle's unit geometric normal. Degenerate triangles are skipped.
+pub fn surface(
+    triangles: &[[Vec3; 3]],
+    n: usize,
+    seed: u64,
+    mut toward: impl FnMut(&mut Rng, Vec3) -> Toward,
+) -> Vec<Ray> {
+    use render::offset::{
+        hit_point, intersector_margin, offset_origin, SHADOW_TMAX_FRACTION, SPAWN_TMIN,
+    };
+    let mut rng = Rng(seed);
+    let mut out = Vec::with_capacity(n);
+    if triangles.is_empty() {
+        return out;
+    }
+    let mut tries = 0usize;
+    while out.len() < n && tries < 4 * n + 16 {
+        tries += 1;
+        let t = &triangles
+            [((rng.unit() as f64 * triangles.len() as f64) as usize).min(triangles.len() - 1)];
+        let ng = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
+        if ng == Vec3::ZERO || !ng.is_finite() {
+            continue;
+        }
+        let (mut u, mut v) = (rng.unit(), rng.unit());
+        if u + v > 1.0 {
+            (u, v) = (1.0 - u, 1.0 - v);
+        }
+        let (p, err) = hit_point(t, u, v);
+        let (dir, tmax) = match toward(&mut rng, ng) {
+            Toward::Point(l) => {
+                let to = l - p;
+                let d = to.length();
+                (to / d, d)
+            }
+            Toward::Direction(d) => (d, f32::INFINITY),
+        };
+        if !dir.is_finite() || dir == Vec3::ZERO {
+            continue;
+        }
+        let o = offset_origin(p, err, intersector_margin(t), ng, dir);
+        let (dir, tmax) = if tmax.is_finite() {
+            // As the renderer does: re-aimed and re-measured from the spawned origin.
+            let to = p + dir * tmax - o;
+            let d = to.length();
+            (to / d, d * SHADOW_TMAX_FRACTION)
+        } else {
+            (dir, tmax)
+        };
+        out.push(Ray::new(o, dir, SPAWN_TMIN, tmax));
+    }
+    out
+}
+
+/// A direction uniform on the hemisphere around unit normal `n`.
+pub fn hemisphere(rng: &mut Rng, n: Vec3) -> Vec3 {
+    let z = rng.unit();
+    let phi = std::f32::consts::TAU * rng.unit();
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let (a, b) = n.any_orthonormal_pair();
+    (a * (r * phi.cos()) + b * (r * phi.sin()) + n * z).normalize()
+}
+
+/// How far [`moved_along`] moves origins: 5 mm in the corpus meshes' metres.
+pub const MOVED: f32 = 0.005;
+
+/// `rays` with their origins moved `by` along the ray and their intervals shortened to
+/// match: rays that start clear of the surface they leave, to compare with.
+pub fn moved_along(rays: &[Ray], by: f32) -> Vec<Ray> {
+    rays.iter()
+        .map(|r| {
+            let tmax = if r.tmax.is_finite() {
+                (r.tmax - by).max(r.tmin)
+            } else {
+                r.tmax
+            };
+            Ray::new(r.origin + r.dir * by, r.dir, r.tmin, tmax)
+        })
+        .collect()
+}
+
 /// `n` rays with origins uniform in the bounds and directions uniform on the sphere,
 /// interval [0, ∞). Deterministic for a given seed.
 pub fn random(bounds: [Vec3; 2], n: usize, seed: u64) -> Vec<Ray> {
@@ -147,6 +240,41 @@ mod tests {
         assert!((rays[0].dir.length() - 1.0).abs() < 1e-6);
         let end = rays[0].origin + rays[0].dir * rays[0].tmax;
         assert!((end - Vec3::new(0.0, 10.0, 0.0)).length() < 1e-4);
+    }
+
+    #[test]
+    fn surface_rays_leave_their_triangles_on_the_side_they_go() {
+        let tris = [
+            [Vec3::ZERO, Vec3::X, Vec3::Z],
+            [
+                Vec3::new(0.0, 1.0, 0.0),
+                Vec3::new(1.0, 1.0, 0.0),
+                Vec3::new(0.0, 1.0, 1.0),
+            ],
+        ];
+        let light = Vec3::new(0.3, 10.0, 0.2);
+        let to_light = surface(&tris, 500, 9, |_, _| Toward::Point(light));
+        let hemi = surface(&tris, 500, 9, |rng, n| {
+            Toward::Direction(hemisphere(rng, n))
+        });
+        assert_eq!((to_light.len(), hemi.len()), (500, 500));
+        for r in &to_light {
+            // Every origin is just above one of the two planes y = 0 and y = 1.
+            let above = r.origin.y - r.origin.y.floor();
+            assert!(above > 0.0 && above < 1e-5, "{r:?}");
+            assert_eq!(r.tmin, render::offset::SPAWN_TMIN);
+            let end = r.origin + r.dir * r.tmax;
+            assert!(end.distance(light) < 1e-2 && r.tmax < r.origin.distance(light));
+        }
+        // Normals are −Y for both triangles (X × Z), so hemisphere rays go down.
+        assert!(hemi
+            .iter()
+            .all(|r| r.dir.y < 0.0 && r.tmax == f32::INFINITY));
+        let moved = moved_along(&to_light, MOVED);
+        for (m, r) in moved.iter().zip(&to_light) {
+            assert!((m.origin - (r.origin + r.dir * MOVED)).length() < 1e-6);
+            assert!((m.tmax - (r.tmax - MOVED)).abs() < 1e-5);
+        }
     }
 
     #[test]

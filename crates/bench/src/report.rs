@@ -143,10 +143,20 @@ fn traversal(r: &Report, out: &mut String) {
     out.push_str(
         "## Traversal (Mrays/s)\n\n\
          Brute force runs on a subset of each ray set (see the header). The ratio rows are \
-         kdtree ÷ Embree on the same rays with the same thread count.\n\n\
-         | scene | contender | threads | primary | shadow | random |\n\
-         |---|---|---:|---:|---:|---:|\n",
+         kdtree ÷ Embree on the same rays with the same thread count. Surface rays leave \
+         random points of random triangles (offset as the renderer offsets secondary rays) \
+         toward the shadow rays' light or into the normal's hemisphere; \"any\" columns \
+         trace the same rays as any-hit queries.\n\n\
+         | scene | contender | threads |",
     );
+    for k in Kind::ALL {
+        let _ = write!(out, " {} |", k.name());
+    }
+    out.push_str("\n|---|---|---:|");
+    for _ in Kind::ALL {
+        out.push_str("---:|");
+    }
+    out.push('\n');
     for s in &r.scenes {
         let contenders = [KDTREE, MEDIAN, EMBREE, BRUTE];
         for who in contenders {
@@ -202,18 +212,20 @@ fn traversal(r: &Report, out: &mut String) {
         .map(|s| {
             let n = |k| trace(s, KDTREE, r.config.threads[0], k).map_or(0, |t| t.rays);
             format!(
-                "{}: {}/{}/{}",
+                "{}: {}/{}/{}/{}/{}",
                 s.name,
                 n(Kind::Primary),
                 n(Kind::Shadow),
-                n(Kind::Random)
+                n(Kind::Random),
+                n(Kind::SurfaceLight),
+                n(Kind::SurfaceHemisphere)
             )
         })
         .collect();
     if !r.config.threads.is_empty() && !counts.is_empty() {
         let _ = writeln!(
             out,
-            "\nRays per set (primary/shadow/random): {}.",
+            "\nRays per set (primary/shadow/random/surface→light/surface→hemisphere): {}.",
             counts.join("; ")
         );
     }
@@ -227,9 +239,16 @@ fn agreement(r: &Report, out: &mut String) {
          shadow: same occlusion answer. The bar is 99.99% of rays. Where the k-d tree and \
          Embree (or the median-split tree) differ, brute force (f64) re-traces up to 200 of those rays per set: the last \
          column counts how often it sides with each (both on ties, neither when all three differ).\n\n\
-         | scene | contender | primary differ | shadow differ | random differ | agreement | verdict | brute force sides with kdtree / other, of |\n\
-         |---|---|---:|---:|---:|---:|:---:|---:|\n",
+         | scene | contender |",
     );
+    for k in Kind::ALL {
+        let _ = write!(out, " {} differ |", k.name());
+    }
+    out.push_str(" agreement | verdict | brute force sides with kdtree / other, of |\n|---|---|");
+    for _ in Kind::ALL {
+        out.push_str("---:|");
+    }
+    out.push_str("---:|:---:|---:|\n");
     for s in &r.scenes {
         for who in [EMBREE, MEDIAN, BRUTE] {
             let rows: Vec<_> = s.agreement.iter().filter(|a| a.other == who).collect();
@@ -251,19 +270,49 @@ fn agreement(r: &Report, out: &mut String) {
                     kdtree_right: a.kdtree_right + b.kdtree_right,
                     other_right: a.other_right + b.other_right,
                 });
+            let cells: Vec<String> = Kind::ALL.iter().map(|&k| cell(k)).collect();
             let _ = writeln!(
                 out,
-                "| {} | {who} | {} | {} | {} | {:.4}% | {} | {} |",
+                "| {} | {who} | {} | {:.4}% | {} | {} |",
                 s.name,
-                cell(Kind::Primary),
-                cell(Kind::Shadow),
-                cell(Kind::Random),
+                cells.join(" | "),
                 worst * 100.0,
                 if ok { "ok" } else { "**FAIL**" },
                 opt(referee, |r| format!(
                     "{} / {} of {}",
                     r.kdtree_right, r.other_right, r.checked
                 ))
+            );
+        }
+    }
+    out.push('\n');
+}
+
+/// The k-d tree's work per surface ray, for both origin placements.
+fn work(r: &Report, out: &mut String) {
+    if r.scenes.iter().all(|s| s.work.is_empty()) {
+        return;
+    }
+    out.push_str(
+        "## k-d tree work per surface ray\n\n\
+         Interior nodes stepped through, leaves reached and triangle tests per ray (one \
+         counting pass, not timed), with the origins as spawned and moved 5 mm along the \
+         ray.\n\n\
+         | scene | rays | origin | nodes | leaves | tests |\n\
+         |---|---|---|---:|---:|---:|\n",
+    );
+    for s in &r.scenes {
+        for w in &s.work {
+            let per = |x: u64| x as f64 / w.rays.max(1) as f64;
+            let _ = writeln!(
+                out,
+                "| {} | {} | {} | {:.1} | {:.2} | {:.1} |",
+                s.name,
+                w.kind.name(),
+                if w.moved { "+5 mm" } else { "on surface" },
+                per(w.counts.nodes),
+                per(w.counts.leaves),
+                per(w.counts.tests)
             );
         }
     }
@@ -280,6 +329,7 @@ pub fn markdown(r: &Report) -> String {
     targets(r, &mut out);
     builds(r, &mut out);
     traversal(r, &mut out);
+    work(r, &mut out);
     agreement(r, &mut out);
     if !r.notes.is_empty() {
         out.push_str("## Notes\n\n");

@@ -8,17 +8,54 @@ pub enum Kind {
     Primary,
     Shadow,
     Random,
+    /// From random surface points toward the light, closest hit.
+    SurfaceLight,
+    /// The same rays, any hit.
+    SurfaceLightAny,
+    /// From random surface points into the normal's hemisphere, closest hit.
+    SurfaceHemisphere,
+    /// The same rays, any hit.
+    SurfaceHemisphereAny,
 }
 
 impl Kind {
-    pub const ALL: [Kind; 3] = [Kind::Primary, Kind::Shadow, Kind::Random];
+    pub const ALL: [Kind; 7] = [
+        Kind::Primary,
+        Kind::Shadow,
+        Kind::Random,
+        Kind::SurfaceLight,
+        Kind::SurfaceLightAny,
+        Kind::SurfaceHemisphere,
+        Kind::SurfaceHemisphereAny,
+    ];
     pub fn name(self) -> &'static str {
         match self {
             Kind::Primary => "primary",
             Kind::Shadow => "shadow",
             Kind::Random => "random",
+            Kind::SurfaceLight => "surface→light",
+            Kind::SurfaceLightAny => "surface→light any",
+            Kind::SurfaceHemisphere => "surface→hemisphere",
+            Kind::SurfaceHemisphereAny => "surface→hemisphere any",
         }
     }
+    /// Traced as any-hit (occlusion) queries rather than closest hits.
+    pub fn any_hit(self) -> bool {
+        matches!(
+            self,
+            Kind::Shadow | Kind::SurfaceLightAny | Kind::SurfaceHemisphereAny
+        )
+    }
+}
+
+/// The k-d tree's work per ray on one ray set, with the origins as generated (just off
+/// the surface) or moved 5 mm along the ray.
+#[derive(Clone, Debug)]
+pub struct WorkRow {
+    pub kind: Kind,
+    pub moved: bool,
+    pub rays: usize,
+    pub counts: kdtree::Counts,
 }
 
 #[derive(Clone, Debug)]
@@ -97,6 +134,7 @@ pub struct SceneResult {
     pub builds: Vec<BuildRow>,
     pub traces: Vec<TraceRow>,
     pub agreement: Vec<AgreeRow>,
+    pub work: Vec<WorkRow>,
     /// Per thread count: (CPU seconds, wall seconds) this process spent tracing. Their
     /// ratio is the number of cores the run actually got on a shared machine.
     pub cpu: std::collections::BTreeMap<usize, (f64, f64)>,

@@ -1,5 +1,6 @@
 //! The benchmark itself: for each scene, build every contender with 1 and 2 threads,
-//! trace the same primary, shadow and random rays with each, and check that they agree.
+//! trace the same primary, shadow, random and surface-origin rays with each, and check
+//! that they agree.
 
 use crate::agreement::{self, subset_indices, Answers};
 use crate::config::Config;
@@ -10,7 +11,7 @@ use crate::error::BenchError;
 use crate::header::{header, load_average};
 use crate::measure::{median, pool, process_cpu_seconds, timed, trace};
 use crate::rays::{self, View};
-use crate::results::{BuildRow, Kind, Report, Role, SceneResult, TraceRow};
+use crate::results::{BuildRow, Kind, Report, Role, SceneResult, TraceRow, WorkRow};
 use crate::scenes::{self, Scene};
 use formats::BuildParams;
 use glam::Vec3;
@@ -39,11 +40,10 @@ impl Bench<'_> {
             for _ in 0..self.cfg.runs.max(1) {
                 for (c, (_, tracer)) in who.iter().enumerate() {
                     let start = Instant::now();
-                    let a = match kind {
-                        Kind::Shadow => {
-                            Answers::Occluded(trace(pool, rays, |r| tracer.occluded(r)))
-                        }
-                        _ => Answers::Closest(trace(pool, rays, |r| tracer.closest(r))),
+                    let a = if kind.any_hit() {
+                        Answers::Occluded(trace(pool, rays, |r| tracer.occluded(r)))
+                    } else {
+                        Answers::Closest(trace(pool, rays, |r| tracer.closest(r)))
                     };
                     times[c].push(start.elapsed().as_secs_f64());
                     answers[c] = Some(a);
@@ -151,6 +151,19 @@ impl Bench<'_> {
     }
 }
 
+/// The k-d tree's nodes, leaves and triangle tests summed over `rays` (one thread).
+fn work(accel: &Accel, kind: Kind, rays: &[Ray]) -> kdtree::Counts {
+    let mut c = kdtree::Counts::default();
+    for r in rays {
+        if kind.any_hit() {
+            accel.occluded_counted(r, &mut c);
+        } else {
+            accel.intersect_counted(r, &mut c);
+        }
+    }
+    c
+}
+
 fn run_scene(
     cfg: &Config,
     scene: &Scene,
@@ -177,6 +190,7 @@ fn run_scene(
             builds: vec![],
             traces: vec![],
             agreement: vec![],
+            work: vec![],
             cpu: Default::default(),
         },
     };
@@ -229,6 +243,13 @@ fn run_scene(
     let primary = rays::primary(&view, cfg.image);
     let random = rays::random(bounds, cfg.random_rays, 0x5EED ^ n as u64);
     let brute = (n <= cfg.brute_max_triangles).then_some(Brute(tris));
+    let light = rays::light_above(bounds);
+    let surface_light = rays::surface(tris, cfg.random_rays, 0x5EEF ^ n as u64, |_, _| {
+        rays::Toward::Point(light)
+    });
+    let surface_hemisphere = rays::surface(tris, cfg.random_rays, 0x5EF0 ^ n as u64, |rng, ng| {
+        rays::Toward::Direction(rays::hemisphere(rng, ng))
+    });
 
     let mut shadow = vec![];
     for kind in Kind::ALL {
@@ -236,7 +257,30 @@ fn run_scene(
             Kind::Primary => &primary,
             Kind::Shadow => &shadow,
             Kind::Random => &random,
+            Kind::SurfaceLight | Kind::SurfaceLightAny => &surface_light,
+            Kind::SurfaceHemisphere | Kind::SurfaceHemisphereAny => &surface_hemisphere,
         };
+        if matches!(
+            kind,
+            Kind::SurfaceLight
+                | Kind::SurfaceLightAny
+                | Kind::SurfaceHemisphere
+                | Kind::SurfaceHemisphereAny
+        ) {
+            for moved in [false, true] {
+                let counts = if moved {
+                    work(&accel, kind, &rays::moved_along(set, rays::MOVED))
+                } else {
+                    work(&accel, kind, set)
+                };
+                b.out.work.push(WorkRow {
+                    kind,
+                    moved,
+                    rays: set.len(),
+                    counts,
+                });
+            }
+        }
         // The k-d tree first: its answers are the reference the others are checked on.
         let mut who: Vec<(&str, &dyn Tracer)> = vec![(KDTREE, &accel)];
         if let Some(m) = &median {

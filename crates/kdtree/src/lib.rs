@@ -29,6 +29,7 @@ pub use build::events::MAX_TRIANGLES;
 pub use build::median::build_median;
 pub use build::{build, depth_bound};
 pub use formats::Hit;
+pub use traverse::Counts;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ray {
@@ -153,12 +154,12 @@ impl Accel {
     /// Closest hit with t in [tmin, tmax], or None. Ties in t go to the lower triangle
     /// index. NaN/infinite rays, zero directions and tmin > tmax are misses.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        self.tree().closest(ray, |_| true)
+        self.tree().closest(ray, |_| true, &mut ())
     }
 
     /// Whether anything blocks the ray in [tmin, tmax]; stops at the first blocker.
     pub fn occluded(&self, ray: &Ray) -> bool {
-        self.tree().any(ray, |_| true)
+        self.tree().any(ray, |_| true, &mut ())
     }
 
     /// The closest hit that `accept` takes (it is asked about each hit that would be the
@@ -166,13 +167,24 @@ impl Accel {
     /// drawn from every side or at every texel need, without restarting the traversal for
     /// each refused hit. Ties go to the lower index among accepted hits.
     pub fn intersect_filtered(&self, ray: &Ray, accept: impl FnMut(&Hit) -> bool) -> Option<Hit> {
-        self.tree().closest(ray, accept)
+        self.tree().closest(ray, accept, &mut ())
     }
 
     /// Whether a hit that `blocks` takes lies in [tmin, tmax]; stops at the first one.
     /// Hits reach `blocks` in traversal order, not sorted by t.
     pub fn occluded_filtered(&self, ray: &Ray, blocks: impl FnMut(&Hit) -> bool) -> bool {
-        self.tree().any(ray, blocks)
+        self.tree().any(ray, blocks, &mut ())
+    }
+
+    /// [`Accel::intersect`] that also adds what the traversal did to `counts` (benchmarks;
+    /// the plain query is a separate instantiation and counts nothing).
+    pub fn intersect_counted(&self, ray: &Ray, counts: &mut Counts) -> Option<Hit> {
+        self.tree().closest(ray, |_| true, counts)
+    }
+
+    /// [`Accel::occluded`] that also adds what the traversal did to `counts`.
+    pub fn occluded_counted(&self, ray: &Ray, counts: &mut Counts) -> bool {
+        self.tree().any(ray, |_| true, counts)
     }
 
     /// Bytes held for queries: nodes, leaf lists and triangle data.
@@ -368,6 +380,32 @@ mod tree_tests {
             Accel::from_triangles(&tris, &kd),
             Err(AccelError::Corrupt { .. })
         ));
+    }
+
+    /// The counting instantiation is the same traversal: same answers, and counts that
+    /// add up (every ray that reaches a leaf stepped through the root first).
+    #[test]
+    fn counted_queries_answer_as_the_plain_ones() {
+        let tris = scene();
+        let a = Accel::build(&tris, &BuildParams::default());
+        let mut rng = testkit::Rng(3);
+        let mut total = Counts::default();
+        for _ in 0..2000 {
+            let o = Vec3::new(rng.unit(), rng.unit(), rng.unit()) * 8.0 - Vec3::splat(4.0);
+            let d = Vec3::new(rng.unit(), rng.unit(), rng.unit()) * 2.0 - Vec3::ONE;
+            let r = Ray::new(o, d, 0.0, f32::INFINITY);
+            let mut c = Counts::default();
+            assert_eq!(a.intersect_counted(&r, &mut c), a.intersect(&r));
+            assert_eq!(a.occluded_counted(&r, &mut c), a.occluded(&r));
+            assert!(c.leaves == 0 || c.nodes > 0, "{c:?}");
+            total.nodes += c.nodes;
+            total.leaves += c.leaves;
+            total.tests += c.tests;
+        }
+        assert!(
+            total.nodes > 0 && total.leaves > 0 && total.tests > 0,
+            "{total:?}"
+        );
     }
 
     #[test]

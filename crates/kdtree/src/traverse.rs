@@ -22,6 +22,41 @@ use crate::Ray;
 use formats::{Hit, KdNode};
 use std::mem::MaybeUninit;
 
+/// What a traversal did, for benchmarks that explain its cost: interior nodes stepped
+/// through, leaves reached and triangle tests (a four-wide group counts its real entries).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Counts {
+    pub nodes: u64,
+    pub leaves: u64,
+    pub tests: u64,
+}
+
+/// Where a traversal reports its steps. The plain queries use `()`, whose methods are
+/// empty, so counting costs them nothing once inlined.
+pub(crate) trait Counter {
+    fn node(&mut self);
+    fn leaf(&mut self, tests: usize);
+}
+
+impl Counter for () {
+    #[inline(always)]
+    fn node(&mut self) {}
+    #[inline(always)]
+    fn leaf(&mut self, _tests: usize) {}
+}
+
+impl Counter for Counts {
+    #[inline(always)]
+    fn node(&mut self) {
+        self.nodes += 1;
+    }
+    #[inline(always)]
+    fn leaf(&mut self, tests: usize) {
+        self.leaves += 1;
+        self.tests += tests as u64;
+    }
+}
+
 /// Entries of the traversal stack (≥ the build's depth bound, which is at most 60).
 pub const STACK: usize = 64;
 
@@ -237,12 +272,7 @@ fn take_step_branch_free(
     let tp = (node.split() - s.o[a]) * s.inv[a];
     let first = if s.inv[a] > 0.0 { below } else { above };
     let second = below ^ above ^ first;
-    #[cfg(target_arch = "x86_64")]
-    {
-        use core::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-        // SAFETY: a prefetch never faults and reads nothing; SSE is part of x86_64.
-        unsafe { _mm_prefetch::<_MM_HINT_T0>(nodes.as_ptr().wrapping_add(second as usize).cast()) };
-    }
+    prefetch(nodes.as_ptr().wrapping_add(second as usize));
     let only_first = tp > pad_up(*t1);
     let only_second = !only_first & (tp < pad_down(t0));
     let both = !only_first & !only_second;
@@ -250,6 +280,19 @@ fn take_step_branch_free(
     *sp += usize::from(both);
     *node_i = if only_second { second } else { first };
     *t1 = if both { near_end(tp, *t1) } else { *t1 };
+}
+
+/// Asks for the cache line at `p` ahead of its use; a no-op elsewhere than x86_64.
+#[inline(always)]
+fn prefetch<T>(p: *const T) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use core::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        // SAFETY: a prefetch never faults and reads nothing; SSE is part of x86_64.
+        unsafe { _mm_prefetch::<_MM_HINT_T0>(p.cast()) };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = p;
 }
 
 impl Tree<'_> {
@@ -309,23 +352,29 @@ impl Tree<'_> {
     /// and may refuse it (a culled face, a cut-out texel); refused hits are passed through
     /// inside the same traversal, with no restart from the root.
     #[inline(always)]
-    pub fn closest<F: FnMut(&Hit) -> bool>(&self, ray: &Ray, mut accept: F) -> Option<Hit> {
+    pub fn closest<F: FnMut(&Hit) -> bool, C: Counter>(
+        &self,
+        ray: &Ray,
+        mut accept: F,
+        count: &mut C,
+    ) -> Option<Hit> {
         let s = setup(ray, self.bounds)?;
         // One instantiation per dominant axis: the triangle test's permutation is then a
         // constant (see `triangle::intersect_along`).
         match s.pre.kz {
-            0 => self.closest_along::<0, F>(ray, &s, &mut accept),
-            1 => self.closest_along::<1, F>(ray, &s, &mut accept),
-            _ => self.closest_along::<2, F>(ray, &s, &mut accept),
+            0 => self.closest_along::<0, F, C>(ray, &s, &mut accept, count),
+            1 => self.closest_along::<1, F, C>(ray, &s, &mut accept, count),
+            _ => self.closest_along::<2, F, C>(ray, &s, &mut accept, count),
         }
     }
 
     #[inline(always)]
-    fn closest_along<const KZ: usize, F: FnMut(&Hit) -> bool>(
+    fn closest_along<const KZ: usize, F: FnMut(&Hit) -> bool, C: Counter>(
         &self,
         ray: &Ray,
         s: &Setup,
         accept: &mut F,
+        count: &mut C,
     ) -> Option<Hit> {
         let mut best = Hit::MISS;
         let mut best_t = ray.tmax;
@@ -335,10 +384,12 @@ impl Tree<'_> {
         loop {
             let node = self.node(node_i);
             if !node.is_leaf() {
+                count.node();
                 take_step(s, node, &mut node_i, t0, &mut t1, &mut stack, &mut sp);
                 continue;
             }
             let leaf = self.leaf(node);
+            count.leaf(leaf.len());
             if leaf.len() >= 2 {
                 for group in leaf.chunks(4) {
                     let bound = triangle::widen(best_t);
@@ -377,23 +428,29 @@ impl Tree<'_> {
     /// Whether any triangle that `blocks` (soup index, t, u, v) is hit in [tmin, tmax];
     /// stops at the first one found, in whatever order the cells give them.
     #[inline(always)]
-    pub fn any<F: FnMut(&Hit) -> bool>(&self, ray: &Ray, mut blocks: F) -> bool {
+    pub fn any<F: FnMut(&Hit) -> bool, C: Counter>(
+        &self,
+        ray: &Ray,
+        mut blocks: F,
+        count: &mut C,
+    ) -> bool {
         let Some(s) = setup(ray, self.bounds) else {
             return false;
         };
         match s.pre.kz {
-            0 => self.any_along::<0, F>(ray, &s, &mut blocks),
-            1 => self.any_along::<1, F>(ray, &s, &mut blocks),
-            _ => self.any_along::<2, F>(ray, &s, &mut blocks),
+            0 => self.any_along::<0, F, C>(ray, &s, &mut blocks, count),
+            1 => self.any_along::<1, F, C>(ray, &s, &mut blocks, count),
+            _ => self.any_along::<2, F, C>(ray, &s, &mut blocks, count),
         }
     }
 
     #[inline(always)]
-    fn any_along<const KZ: usize, F: FnMut(&Hit) -> bool>(
+    fn any_along<const KZ: usize, F: FnMut(&Hit) -> bool, C: Counter>(
         &self,
         ray: &Ray,
         s: &Setup,
         blocks: &mut F,
+        count: &mut C,
     ) -> bool {
         let mut stack = new_stack();
         let mut sp = 0;
@@ -401,6 +458,7 @@ impl Tree<'_> {
         loop {
             let node = self.node(node_i);
             if !node.is_leaf() {
+                count.node();
                 take_step_branch_free(
                     self.nodes,
                     s,
@@ -414,6 +472,7 @@ impl Tree<'_> {
                 continue;
             }
             let leaf = self.leaf(node);
+            count.leaf(leaf.len());
             if leaf.len() >= 2 {
                 for group in leaf.chunks(4) {
                     let (lanes, hits) = self.test4::<KZ>(s, ray, group, ray.tmax);

@@ -2,7 +2,7 @@
 //! `cargo run --release -p bench --bin kdtune -- KT KI BONUS MAX_DEPTH LEAF_SIZE FILE…`
 //! builds each soup or OBJ (or `gen:N`, kdbench's generated scene of N triangles) with
 //! those parameters and prints build time (best of up to 9 builds, all threads), primary,
-//! shadow and random-ray Mrays/s (best of 15, 1 thread), the tree's statistics and a
+//! shadow, random and surface-origin (closest/any hit) Mrays/s (best of 15, 1 thread), the tree's statistics and a
 //! digest of its nodes (equal digests, identical trees). Only ratios within one run mean
 //! anything on a noisy machine.
 
@@ -78,6 +78,16 @@ fn run() -> Result<()> {
         let (ts, occluded) = best_of(15, || sh.iter().filter(|r| a.occluded(r)).count());
         let random = rays::random(b, 1 << 16, 7);
         let (tr, _) = best_of(15, || random.iter().filter_map(|r| a.intersect(r)).count());
+        let light = rays::light_above(b);
+        let sl = rays::surface(tris, 1 << 16, 11, |_, _| rays::Toward::Point(light));
+        let (tsl, _) = best_of(15, || sl.iter().filter_map(|r| a.intersect(r)).count());
+        let (tsla, _) = best_of(15, || sl.iter().filter(|r| a.occluded(r)).count());
+        let sh2 = rays::surface(tris, 1 << 16, 12, |rng, n| {
+            rays::Toward::Direction(rays::hemisphere(rng, n))
+        });
+        let (tsh, _) = best_of(15, || sh2.iter().filter_map(|r| a.intersect(r)).count());
+        let (tsha, _) = best_of(15, || sh2.iter().filter(|r| a.occluded(r)).count());
+        let mr = |n: usize, t: f64| n as f64 / t / 1e6;
         let st = &kd.stats;
         // FNV-1a over the nodes and leaf lists: equal digests mean an identical tree.
         let digest = kd
@@ -90,7 +100,8 @@ fn run() -> Result<()> {
             });
         println!(
             "{}: {} triangles, build {:.1} ms, primary {:.3} Mrays/s, shadow {:.3} Mrays/s \
-             ({occluded} occluded), random {:.3} Mrays/s, nodes {}, leaves {}, max leaf {}, \
+             ({occluded} occluded), random {:.3} Mrays/s, surface→light {:.3}/{:.3} any, \
+             surface→hemisphere {:.3}/{:.3} any Mrays/s, nodes {}, leaves {}, max leaf {}, \
              depth {}, refs/tri {:.2}, SAH {:.1}, bytes/tri {:.1}, tree {digest:016x}",
             s.name,
             tris.len(),
@@ -98,6 +109,10 @@ fn run() -> Result<()> {
             prim.len() as f64 / tp / 1e6,
             sh.len() as f64 / ts / 1e6,
             random.len() as f64 / tr / 1e6,
+            mr(sl.len(), tsl),
+            mr(sl.len(), tsla),
+            mr(sh2.len(), tsh),
+            mr(sh2.len(), tsha),
             st.nodes,
             st.leaves,
             st.max_leaf_triangles,

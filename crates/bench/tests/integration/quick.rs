@@ -58,10 +58,12 @@ fn quick_run_has_every_row_and_the_contenders_agree() {
     assert_eq!(m.nodes, Some(median.nodes.len() as u64));
     assert!(m.sah_cost.unwrap() > direct.stats.sah_cost);
 
-    // Trace rows: every contender, brute force too (the scene is small), × 2 × 3 kinds.
+    // Trace rows: every contender, brute force too (the scene is small), × 2 × every kind.
     let mut all = contenders.clone();
     all.push(BRUTE);
-    assert_eq!(s.traces.len(), all.len() * 2 * 3);
+    let kinds = Kind::ALL.len();
+    assert_eq!(kinds, 7);
+    assert_eq!(s.traces.len(), all.len() * 2 * kinds);
     let rays = |who: &str, kind: Kind| {
         s.traces
             .iter()
@@ -78,12 +80,27 @@ fn quick_run_has_every_row_and_the_contenders_agree() {
         "{shadow} shadow rays"
     );
     assert_eq!(rays(BRUTE, Kind::Primary), 512);
+    for k in [
+        Kind::SurfaceLight,
+        Kind::SurfaceLightAny,
+        Kind::SurfaceHemisphere,
+        Kind::SurfaceHemisphereAny,
+    ] {
+        assert_eq!(rays(KDTREE, k), 2048, "{k:?}");
+        assert_eq!(rays(BRUTE, k), 512, "{k:?}");
+    }
+    // The k-d tree's work on each surface set, as spawned and moved 5 mm.
+    assert_eq!(s.work.len(), 4 * 2);
+    for w in &s.work {
+        assert_eq!(w.rays, 2048);
+        assert!(w.counts.nodes > 0 && w.counts.leaves > 0, "{w:?}");
+    }
     for r in &s.traces {
         assert!(r.mrays_per_s() > 0.0 && r.mrays_per_s().is_finite());
     }
 
     // Agreement: each non-reference contender on each kind, nothing differs.
-    assert_eq!(s.agreement.len(), (all.len() - 1) * 3);
+    assert_eq!(s.agreement.len(), (all.len() - 1) * kinds);
     for a in &s.agreement {
         assert!(a.compared > 0);
         assert_eq!(
@@ -101,7 +118,7 @@ fn quick_run_has_every_row_and_the_contenders_agree() {
     assert!(md.contains(&format!("| {name} | kdtree median | 1 |")));
     assert!(md.contains(&format!("| {name} | brute force | 1 |")));
     assert!(md.contains(&format!(
-        "| {name} | brute force | 0 / 512 | 0 / {} | 0 / 512 | 100.0000% | ok | – |",
+        "| {name} | brute force | 0 / 512 | 0 / {} | 0 / 512 | 0 / 512 | 0 / 512 | 0 / 512 | 0 / 512 | 100.0000% | ok | – |",
         shadow.min(512)
     )));
     assert_eq!(
@@ -112,6 +129,7 @@ fn quick_run_has_every_row_and_the_contenders_agree() {
     for section in [
         "## Build",
         "## Traversal",
+        "## k-d tree work per surface ray",
         "## Agreement",
         "- machine: nproc",
     ] {
