@@ -127,14 +127,40 @@ pub fn intersect_along<const KZ: usize>(
     if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
         return None;
     }
-    finish([u, v, w], [a[2], b[2], c[2]], r.sz, tmin, tmax)
+    let xy = [max3(ax, bx, cx), max3(ay, by, cy)];
+    finish([u, v, w], [a[2], b[2], c[2]], xy, r.sz, tmin, tmax)
+}
+
+/// The largest magnitude of three values.
+#[inline(always)]
+fn max3(a: f32, b: f32, c: f32) -> f32 {
+    a.abs().max(b.abs()).max(c.abs())
+}
+
+/// γₙ = n·u / (1 − n·u), u = 2⁻²⁴: Higham's bound on n roundings.
+const fn gamma(n: i32) -> f32 {
+    let u = f32::EPSILON * 0.5;
+    (n as f32 * u) / (1.0 - n as f32 * u)
 }
 
 /// The part of the test after the edge functions `uvw` agree in sign: the determinant,
 /// the distance from the vertices' `z` (relative to the origin, before the z shear) and
 /// the interval. Shared by the one- and four-triangle tests so they give the same bits.
+///
+/// A hit no farther than the bound on t's own rounding is refused (pbrt-v4's δt): the
+/// sign of such a t is not known. `xy` holds the largest |x| and |y| of the sheared
+/// vertices. Without this, a ray spawned a hair below a large triangle's plane (a small
+/// face lying flat on a big floor, the ray leaving downwards) could find that plane at a
+/// tiny positive t: on a 24 m triangle t rounds at the ULPs of metres.
 #[inline(always)]
-fn finish(uvw: [f32; 3], z: [f32; 3], sz: f32, tmin: f32, tmax: f32) -> Option<RawHit> {
+fn finish(
+    uvw: [f32; 3],
+    z: [f32; 3],
+    xy: [f32; 2],
+    sz: f32,
+    tmin: f32,
+    tmax: f32,
+) -> Option<RawHit> {
     let [u, v, w] = uvw;
     let det = u + v + w;
     if det == 0.0 || det.is_nan() {
@@ -150,6 +176,17 @@ fn finish(uvw: [f32; 3], z: [f32; 3], sz: f32, tmin: f32, tmax: f32) -> Option<R
     let t = tt / adet;
     if !(t >= tmin && t <= tmax) {
         // Overflow of tmax·det or rounding of the final division: stay inside the interval.
+        return None;
+    }
+    let max_z = max3(sz * z[0], sz * z[1], sz * z[2]);
+    let [max_x, max_y] = xy;
+    let dz = gamma(3) * max_z;
+    let dx = gamma(5) * (max_x + max_z);
+    let dy = gamma(5) * (max_y + max_z);
+    let de = 2.0 * (gamma(2) * max_x * max_y + dy * max_x + dx * max_y);
+    let max_e = max3(u, v, w);
+    let dt = 3.0 * (gamma(3) * max_e * max_z + de * max_z + dz * max_e) * inv.abs();
+    if t <= dt {
         return None;
     }
     Some(RawHit {
@@ -218,7 +255,15 @@ pub fn intersect4_along<const KZ: usize>(
         if outside[l] {
             return None;
         }
-        finish([u[l], v[l], w[l]], [az[l], bz[l], cz[l]], r.sz, tmin, tmax)
+        let xy = [max3(ax[l], bx[l], cx[l]), max3(ay[l], by[l], cy[l])];
+        finish(
+            [u[l], v[l], w[l]],
+            [az[l], bz[l], cz[l]],
+            xy,
+            r.sz,
+            tmin,
+            tmax,
+        )
     })
 }
 
@@ -357,5 +402,44 @@ mod tests {
         assert!(intersect(&r, &line, 0.0, 10.0).is_none());
         let point = [[0.0, 0.0, 0.0]; 3];
         assert!(intersect(&r, &point, 0.0, 10.0).is_none());
+    }
+
+    /// A ray that starts just below a large triangle's plane and leaves it downwards (a
+    /// secondary ray from a small face lying flat on a big floor) must not find the floor:
+    /// on a 24 m triangle t rounds at the ULPs of metres, far more than the 10⁻⁷ m the
+    /// origin lies below the plane, so a hit closer than that rounding bound is refused.
+    #[test]
+    fn a_hit_closer_than_its_rounding_bound_is_refused() {
+        let floor = [[-12.0, 0.0, -12.0], [12.0, 0.0, -12.0], [0.0, 0.0, 12.0]];
+        let dir = Vec3::new(1.0, -0.3, 0.2).normalize();
+        let mut refused = 0;
+        for i in 0..200 {
+            let o = Vec3::new(
+                3.0 + i as f32 * 0.013,
+                -9e-8 * (1 + i % 7) as f32,
+                2.0 - i as f32 * 0.007,
+            );
+            let r = RayPre::new(o, dir).unwrap();
+            // In exact arithmetic the plane y = 0 is behind every one of these origins.
+            assert!(o.y < 0.0 && dir.y < 0.0);
+            if intersect(&r, &floor, f32::MIN_POSITIVE, f32::INFINITY).is_none() {
+                refused += 1;
+            }
+            let group = intersect4_along_any(&r, [&floor; 4]);
+            assert!(group.iter().all(Option::is_none), "four-wide, origin {o}");
+        }
+        assert_eq!(refused, 200);
+        // A real hit far beyond the rounding bound is kept.
+        let r = RayPre::new(Vec3::new(0.0, 1.0, 0.0), dir).unwrap();
+        let h = intersect(&r, &floor, f32::MIN_POSITIVE, f32::INFINITY).unwrap();
+        assert!((h.t - 1.0 / -dir.y).abs() < 1e-5, "{}", h.t);
+    }
+
+    fn intersect4_along_any(r: &RayPre, tri: [&[[f32; 3]; 3]; 4]) -> [Option<RawHit>; 4] {
+        match r.kz {
+            0 => intersect4_along::<0>(r, tri, f32::MIN_POSITIVE, f32::INFINITY),
+            1 => intersect4_along::<1>(r, tri, f32::MIN_POSITIVE, f32::INFINITY),
+            _ => intersect4_along::<2>(r, tri, f32::MIN_POSITIVE, f32::INFINITY),
+        }
     }
 }
