@@ -521,11 +521,28 @@ impl<'a> Integrator<'a> {
         // culling test alone, as it did before alpha existed.
         match (self.culling, self.alpha) {
             (false, false) => self.accel.intersect(ray),
-            (true, false) => self.accel.intersect_filtered(ray, |hit| {
-                let through = self.culled(hit.prim as usize, ray.dir);
-                counts.pass_through += through as u64;
-                !through
-            }),
+            (true, false) => {
+                // Most rays meet a drawn face first, and most culled faces a filter would
+                // be asked about lie behind that face anyway: so the plain query, and the
+                // filtered one only from a refused hit on (same answer, ties included).
+                let first = self.accel.intersect(ray)?;
+                if !self.culled(first.prim as usize, ray.dir) {
+                    return Some(first);
+                }
+                counts.pass_through += 1;
+                let rest = Ray {
+                    tmin: first.t,
+                    ..*ray
+                };
+                self.accel.intersect_filtered(&rest, |hit| {
+                    if hit.prim == first.prim {
+                        return false;
+                    }
+                    let through = self.culled(hit.prim as usize, ray.dir);
+                    counts.pass_through += through as u64;
+                    !through
+                })
+            }
             (_, true) => self.first_visible_alpha(ray, cone, counts),
         }
     }
