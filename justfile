@@ -50,8 +50,11 @@ gallery: build
     for dir in scenes/*/; do
         name=$(basename "$dir")
         [ "$name" = gen ] || [ "$name" = baseline ] && continue
-        for scene in "$dir"Assets/Scenes/*.unity; do
-            just --quiet scene "$scene" "gallery/$name" --width 480 --height 360 --spp 4
+        scenes=("$dir"Assets/Scenes/*.unity)
+        for scene in "${scenes[@]}"; do
+            out=$name
+            [ ${#scenes[@]} -gt 1 ] && out=$name-$(basename "$scene" .unity)
+            just --quiet scene "$scene" "gallery/$out" --width 480 --height 360 --spp 4
         done
     done
     ls out/gallery/*.png
