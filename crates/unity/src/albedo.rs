@@ -8,7 +8,17 @@ use crate::emit::Emitter;
 use crate::texture::{albedo_slot, load, Import};
 use crate::yaml::Node;
 use formats::texture::{TextureRef, Tiling};
+use rayon::prelude::*;
 use std::path::{Component, Path, PathBuf};
+
+/// An image a material uses, decoded once the whole scene has been walked.
+pub(crate) struct PendingTexture {
+    path: PathBuf,
+    rel: String,
+    import: Import,
+    /// The materials that use it, as warnings name them.
+    users: Vec<String>,
+}
 
 impl Emitter<'_, '_> {
     /// The albedo map of Material `body`; `what` names the material in warnings.
@@ -24,7 +34,9 @@ impl Emitter<'_, '_> {
         self.texture_ref(&path, slot.tiling, what)
     }
 
-    /// The soup texture of the image at `path` with `tiling`, decoded on first use.
+    /// The soup texture of the image at `path` with `tiling`. The image is only named
+    /// here; [`Emitter::decode_textures`] decodes every named image at the end, all at once
+    /// on every core (decoding dominates converting a textured scene).
     pub(crate) fn texture_ref(
         &mut self,
         path: &Path,
@@ -34,28 +46,59 @@ impl Emitter<'_, '_> {
         let import = Import::read(path);
         // The same image imported twice with different settings is two textures to Unity.
         let key = format!("{}\n{import:?}", path.display());
-        let got = match self.textures.get(&key) {
-            Some(r) => r.clone(),
+        let texture = match self.textures.get(&key) {
+            Some(&i) => i,
             None => {
-                let rel = self.g.project.rel(path);
-                let r = load(path, &rel, &import)
-                    .map(|t| {
-                        self.soup.textures.push(t);
-                        (self.soup.textures.len() - 1) as u32
-                    })
-                    .map_err(|e| e.to_string());
-                self.textures.insert(key, r.clone());
-                r
+                let i = self.pending_textures.len() as u32;
+                self.pending_textures.push(PendingTexture {
+                    path: path.to_path_buf(),
+                    rel: self.g.project.rel(path),
+                    import,
+                    users: Vec::new(),
+                });
+                self.textures.insert(key, i);
+                i
             }
         };
-        match got {
-            Ok(texture) => Some(TextureRef { texture, tiling }),
-            Err(e) => {
-                self.soup
-                    .warnings
-                    .push(format!("{what}: {e}; drawn with its tint alone"));
-                None
+        self.pending_textures[texture as usize]
+            .users
+            .push(what.to_string());
+        Some(TextureRef { texture, tiling })
+    }
+
+    /// Decode every texture [`Emitter::texture_ref`] named, in parallel, into the soup. A
+    /// texture that cannot be read is dropped from the materials that use it, with one
+    /// warning per material; UVs go too when no texture is left.
+    pub(crate) fn decode_textures(&mut self) {
+        let pending = std::mem::take(&mut self.pending_textures);
+        let decoded: Vec<_> = pending
+            .par_iter()
+            .map(|p| load(&p.path, &p.rel, &p.import))
+            .collect();
+        let mut index = Vec::with_capacity(decoded.len());
+        for (p, d) in pending.iter().zip(decoded) {
+            match d {
+                Ok(t) => {
+                    index.push(Some(self.soup.textures.len() as u32));
+                    self.soup.textures.push(t);
+                }
+                Err(e) => {
+                    index.push(None);
+                    for what in &p.users {
+                        self.soup
+                            .warnings
+                            .push(format!("{what}: {e}; drawn with its tint alone"));
+                    }
+                }
             }
+        }
+        for m in &mut self.soup.materials {
+            m.albedo_map = m
+                .albedo_map
+                .and_then(|r| index[r.texture as usize].map(|texture| TextureRef { texture, ..r }));
+        }
+        if self.soup.materials.iter().all(|m| m.albedo_map.is_none()) {
+            self.soup.uvs = Vec::new();
         }
     }
 

@@ -44,8 +44,10 @@ pub(crate) struct Emitter<'g, 'p> {
     pub(crate) meshes: HashMap<String, Option<Arc<Mesh>>>,
     /// Material source key → soup material index.
     pub(crate) materials: HashMap<String, u32>,
-    /// Texture file and import settings → soup texture index, or why it cannot be read.
-    pub(crate) textures: HashMap<String, Result<u32, String>>,
+    /// Texture file and import settings → index into `pending_textures`.
+    pub(crate) textures: HashMap<String, u32>,
+    /// The images materials use, in first-use order, decoded at the end.
+    pub(crate) pending_textures: Vec<crate::albedo::PendingTexture>,
     /// (model, texture name as the model writes it) → the file found for it: the search
     /// walks folders, and every instance of a model asks again.
     pub(crate) model_textures: HashMap<(std::path::PathBuf, String), Option<std::path::PathBuf>>,
@@ -88,6 +90,7 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
         meshes: HashMap::new(),
         materials: HashMap::new(),
         textures: HashMap::new(),
+        pending_textures: Vec::new(),
         model_textures: HashMap::new(),
         material_origins: Vec::new(),
         extracted: HashMap::new(),
@@ -153,6 +156,7 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
             e.light(gi, c)?;
         }
     }
+    e.decode_textures();
     e.soup.warnings.extend(camera_warnings);
     if let Some(ambient) = g
         .render_settings
