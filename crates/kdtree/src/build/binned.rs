@@ -5,7 +5,7 @@
 //! events per reference and level, with random reads of each triangle's side; large cells
 //! instead keep a plain list of references (28 bytes each) and find the split like this:
 //!
-//! 1. One pass bins every event (start, end, planar) of every axis into [`BINS`] equal
+//! 1. One pass bins every event (start, end, planar) of every axis into `BINS` (256) equal
 //!    slabs, counting kinds and keeping each slab's lowest and highest position.
 //! 2. Per slab, the SAH is bounded from above (the cost at its lowest or highest event,
 //!    with counts that can only be worse) and from below (the best area at either end of
