@@ -40,8 +40,9 @@ export KD2EXR
 
 # The tiles need the frame size for their bands, and merge needs the preview exposure;
 # everything else passes through to every tile unchanged.
+# (clap puts an option's default on its own line or after its text: read the help as one line.)
 default_of() {
-    "$KD2EXR" --help | sed -n "s/.*--$1 <[A-Z_]*>.*\[default: \([^]]*\)\].*/\1/p"
+    "$KD2EXR" --help | tr '\n' ' ' | sed -n "s/.*--$1 <[A-Z_]*>[^[]*\[default: \([^]]*\)\].*/\1/p"
 }
 width=$(default_of width) height=$(default_of height)
 args=() merge_args=()
