@@ -15,10 +15,8 @@
 
 use crate::FormatError;
 use serde::{de::DeserializeOwned, Serialize};
-use std::fs::File;
 use std::io::{Seek, SeekFrom, Write};
 use std::path::Path;
-use std::sync::mpsc;
 
 pub const HEADER_LEN: usize = 52;
 
@@ -31,35 +29,76 @@ fn config() -> bincode::config::Configuration<bincode::config::LittleEndian, bin
         .with_fixed_int_encoding()
 }
 
-/// Serialise `value` as an artifact with the given magic and version.
-pub fn encode<T: Serialize>(
-    value: &T,
-    magic: &[u8; 8],
-    version: u32,
-    path: &Path,
-) -> Result<Vec<u8>, FormatError> {
-    let payload =
-        bincode::serde::encode_to_vec(value, config()).map_err(|e| FormatError::Encode {
-            path: path.to_path_buf(),
-            detail: e.to_string(),
-        })?;
-    let mut out = Vec::with_capacity(HEADER_LEN + payload.len());
-    out.extend_from_slice(magic);
-    out.extend_from_slice(&version.to_le_bytes());
-    out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
-    out.extend_from_slice(blake3::hash(&payload).as_bytes());
-    out.extend_from_slice(&payload);
+/// An artifact type: its frame constants and how its payload is written and read.
+///
+/// Payloads are bincode (see [`config`]), but their bulk — per-triangle arrays, tree nodes —
+/// goes through [`PayloadWriter::array`] and [`PayloadReader::array`], which write and read
+/// the very bytes bincode would (a u64 count, then the elements little-endian) as one block
+/// instead of one call per number. A two-million-triangle soup is 168 MB; serialising it
+/// float by float was the largest part of writing it.
+pub trait Artifact: Sized {
+    const MAGIC: &'static [u8; 8];
+    const VERSION: u32;
+    /// What error messages call it ("soup", "k-d tree").
+    const KIND: &'static str;
+    fn write_payload<W: Write + Send>(&self, p: &mut PayloadWriter<W>) -> Result<(), FormatError>;
+    /// The payload's fields in order; an error says what does not decode, and where.
+    fn read_payload(r: &mut PayloadReader) -> Result<Self, String>;
+    /// Cross-references a reader relies on, checked after decoding.
+    fn validate(&self) -> Result<(), String>;
+}
+
+/// The whole artifact file as bytes: what [`write`] puts in the file.
+pub fn encode<A: Artifact>(value: &A, path: &Path) -> Result<Vec<u8>, FormatError> {
+    let mut out = vec![0u8; HEADER_LEN];
+    let mut p = PayloadWriter::new(&mut out, path);
+    value.write_payload(&mut p)?;
+    let header = header::<A>(p.len, p.hasher.finalize());
+    out[..HEADER_LEN].copy_from_slice(&header);
     Ok(out)
 }
 
-/// Validate the frame of `bytes` (read from `path`) and decode its payload.
-pub fn decode<T: DeserializeOwned>(
-    bytes: &[u8],
+fn header<A: Artifact>(len: u64, hash: blake3::Hash) -> [u8; HEADER_LEN] {
+    let mut header = [0u8; HEADER_LEN];
+    header[..8].copy_from_slice(A::MAGIC);
+    header[8..12].copy_from_slice(&A::VERSION.to_le_bytes());
+    header[12..20].copy_from_slice(&len.to_le_bytes());
+    header[20..].copy_from_slice(hash.as_bytes());
+    header
+}
+
+/// Validate the frame of `bytes` (read from `path`), decode its payload and check the
+/// result's cross-references.
+pub fn decode<A: Artifact>(bytes: &[u8], path: &Path) -> Result<A, FormatError> {
+    let payload = checked_payload(bytes, A::MAGIC, A::KIND, A::VERSION, path)?;
+    let corrupt = |detail| FormatError::Corrupt {
+        path: path.to_path_buf(),
+        detail,
+    };
+    let mut r = PayloadReader {
+        bytes: payload,
+        pos: 0,
+    };
+    let value = A::read_payload(&mut r).map_err(corrupt)?;
+    if r.pos != payload.len() {
+        return Err(corrupt(format!(
+            "payload decoded from {} of {} bytes",
+            r.pos,
+            payload.len()
+        )));
+    }
+    value.validate().map_err(corrupt)?;
+    Ok(value)
+}
+
+/// The payload of `bytes` once magic, version, length and checksum are right.
+fn checked_payload<'a>(
+    bytes: &'a [u8],
     magic: &[u8; 8],
     kind: &'static str,
     version: u32,
     path: &Path,
-) -> Result<T, FormatError> {
+) -> Result<&'a [u8], FormatError> {
     let p = || path.to_path_buf();
     if bytes.len() < 8 || &bytes[..8] != magic {
         if bytes.is_empty() {
@@ -109,23 +148,132 @@ pub fn decode<T: DeserializeOwned>(
         });
     }
     let payload = &bytes[HEADER_LEN..];
-    if blake3::hash(payload).as_bytes() != &bytes[20..52] {
+    let mut hasher = blake3::Hasher::new();
+    hash_into(&mut hasher, payload);
+    if hasher.finalize().as_bytes() != &bytes[20..52] {
         return Err(FormatError::Corrupt {
             path: p(),
             detail: "payload checksum mismatch (bytes changed after writing)".into(),
         });
     }
-    let (value, used) = decode_payload(payload).map_err(|e| FormatError::Corrupt {
-        path: p(),
-        detail: format!("payload does not decode: {e}"),
-    })?;
-    if used != payload.len() {
-        return Err(FormatError::Corrupt {
-            path: p(),
-            detail: format!("payload decoded from {used} of {} bytes", payload.len()),
-        });
+    Ok(payload)
+}
+
+/// Below this many bytes one thread hashes faster than the pool starts (BLAKE3's own advice
+/// is 128 KiB and up).
+pub(crate) const PARALLEL_HASH_MIN: usize = 1 << 20;
+
+/// BLAKE3 of large blocks on all cores; the digest is the same however it is split.
+pub(crate) fn hash_into(h: &mut blake3::Hasher, bytes: &[u8]) {
+    if bytes.len() < PARALLEL_HASH_MIN {
+        h.update(bytes);
+    } else {
+        h.update_rayon(bytes);
     }
-    Ok(value)
+}
+
+/// Where a payload's bytes go, hashed on their way.
+pub struct PayloadWriter<'p, W> {
+    out: W,
+    hasher: blake3::Hasher,
+    len: u64,
+    path: &'p Path,
+}
+
+impl<'p, W: Write + Send> PayloadWriter<'p, W> {
+    fn new(out: W, path: &'p Path) -> Self {
+        PayloadWriter {
+            out,
+            hasher: blake3::Hasher::new(),
+            len: 0,
+            path,
+        }
+    }
+
+    /// A `Vec<T>` of plain numbers, encoded as bincode encodes it: the element count as u64,
+    /// then the elements, little-endian, as one block.
+    pub fn array<T: bytemuck::Pod + Serialize>(&mut self, items: &[T]) -> Result<(), FormatError> {
+        #[cfg(target_endian = "little")]
+        {
+            self.bytes(&(items.len() as u64).to_le_bytes())?;
+            self.bytes(bytemuck::cast_slice(items))
+        }
+        #[cfg(not(target_endian = "little"))]
+        self.value(&items)
+    }
+
+    /// Anything else, through bincode's serde route.
+    pub fn value<T: Serialize + ?Sized>(&mut self, value: &T) -> Result<(), FormatError> {
+        let bytes =
+            bincode::serde::encode_to_vec(value, config()).map_err(|e| FormatError::Encode {
+                path: self.path.to_path_buf(),
+                detail: e.to_string(),
+            })?;
+        self.bytes(&bytes)
+    }
+
+    /// Large blocks are hashed (on all cores) while the kernel copies them into the file.
+    fn bytes(&mut self, bytes: &[u8]) -> Result<(), FormatError> {
+        let written = if bytes.len() < PARALLEL_HASH_MIN {
+            self.hasher.update(bytes);
+            self.out.write_all(bytes)
+        } else {
+            let (hasher, out) = (&mut self.hasher, &mut self.out);
+            rayon::join(|| hasher.update_rayon(bytes), || out.write_all(bytes)).1
+        };
+        written.map_err(|e| FormatError::io(self.path, e))?;
+        self.len += bytes.len() as u64;
+        Ok(())
+    }
+}
+
+/// The decoding side of [`PayloadWriter`]: a cursor over a payload whose checksum is good.
+pub struct PayloadReader<'a> {
+    bytes: &'a [u8],
+    pos: usize,
+}
+
+impl PayloadReader<'_> {
+    /// What [`PayloadWriter::array`] wrote, named `what` in errors. The count is checked
+    /// against the bytes left before anything is allocated.
+    pub fn array<T: bytemuck::Pod + DeserializeOwned>(
+        &mut self,
+        what: &str,
+    ) -> Result<Vec<T>, String> {
+        #[cfg(target_endian = "little")]
+        {
+            let at = self.pos;
+            let rest = &self.bytes[at..];
+            let Some(count) = rest.get(..8) else {
+                return Err(format!(
+                    "payload does not decode: it ends at byte {at}, inside the count of {what}"
+                ));
+            };
+            let count = u64::from_le_bytes(count.try_into().expect("8 bytes"));
+            let size = usize::try_from(count)
+                .ok()
+                .and_then(|n| n.checked_mul(std::mem::size_of::<T>()))
+                .filter(|&size| size <= rest.len() - 8)
+                .ok_or_else(|| {
+                    format!(
+                        "payload does not decode: {count} {what} at byte {at} need more than the {} bytes left",
+                        rest.len() - 8
+                    )
+                })?;
+            self.pos += 8 + size;
+            Ok(bytemuck::pod_collect_to_vec(&rest[8..8 + size]))
+        }
+        #[cfg(not(target_endian = "little"))]
+        self.value(what)
+    }
+
+    /// A value bincode's serde route wrote, named `what` in errors.
+    pub fn value<T: DeserializeOwned>(&mut self, what: &str) -> Result<T, String> {
+        let (value, used) = decode_payload(&self.bytes[self.pos..])
+            .map_err(|e| format!("payload does not decode: {what} at byte {}: {e}", self.pos))?;
+        self.pos += used;
+        Ok(value)
+    }
 }
 
 /// Decode a payload with a byte limit no smaller than the payload and at most 4× it.
@@ -165,33 +313,20 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FormatError> {
     persist(tmp, path)
 }
 
-/// Serialise `value` as an artifact straight into `path`: the bytes of [`encode`], written
-/// atomically as by [`write_atomic`], without the payload ever being whole in memory.
+/// Write `value` to `path` atomically (as [`write_atomic`]), the bytes of [`encode`]
+/// streamed into the file without the payload ever being whole in memory.
 ///
 /// The file is not synced to disk (see the comment at the rename for why that is safe).
-///
-/// A soup of two million triangles is 168 MB; building it in memory first cost a fresh
-/// allocation (page faults), a copy into the framed buffer and a serial hash before the
-/// first byte reached the file. Here the serialiser fills `CHUNK`-sized buffers that a
-/// second thread hashes and writes while the next one fills. The header's length and
-/// checksum are known only at the end, so the header is written zeroed and overwritten in
-/// place before the rename: a reader never sees the file until it is complete.
-pub fn write_encoded<T: Serialize>(
-    value: &T,
-    magic: &[u8; 8],
-    version: u32,
-    path: &Path,
-) -> Result<(), FormatError> {
+/// The header's length and checksum are known only at the end, so it is written zeroed and
+/// overwritten in place before the rename: a reader never sees the file until it is complete.
+pub fn write<A: Artifact>(value: &A, path: &Path) -> Result<(), FormatError> {
     let mut tmp = temp_beside(path)?;
     let file = tmp.as_file_mut();
     file.write_all(&[0; HEADER_LEN])
         .map_err(|e| FormatError::io(path, e))?;
-    let (len, hash) = stream_payload(value, file, path)?;
-    let mut header = [0u8; HEADER_LEN];
-    header[..8].copy_from_slice(magic);
-    header[8..12].copy_from_slice(&version.to_le_bytes());
-    header[12..20].copy_from_slice(&len.to_le_bytes());
-    header[20..].copy_from_slice(hash.as_bytes());
+    let mut p = PayloadWriter::new(&mut *file, path);
+    value.write_payload(&mut p)?;
+    let header = header::<A>(p.len, p.hasher.finalize());
     file.seek(SeekFrom::Start(0))
         .and_then(|_| file.write_all(&header))
         .map_err(|e| FormatError::io(path, e))?;
@@ -204,108 +339,6 @@ pub fn write_encoded<T: Serialize>(
     tmp.persist(path)
         .map_err(|e| FormatError::io(path, e.error))?;
     Ok(())
-}
-
-/// Size of the buffers between the serialiser and the writing thread: large enough that a
-/// `write` call costs little against its copy, small enough to stay in the cache.
-const CHUNK: usize = 1 << 20;
-
-/// Serialise `value` into `file` at its current position; the payload's length and BLAKE3.
-fn stream_payload<T: Serialize>(
-    value: &T,
-    file: &mut File,
-    path: &Path,
-) -> Result<(u64, blake3::Hash), FormatError> {
-    // Two full buffers in flight let the serialiser run ahead of one slow write without
-    // the memory growing; emptied buffers come back so no chunk faults in fresh pages.
-    let (full_tx, full_rx) = mpsc::sync_channel::<Vec<u8>>(2);
-    let (free_tx, free_rx) = mpsc::channel::<Vec<u8>>();
-    std::thread::scope(|s| {
-        let sink = s.spawn(move || -> std::io::Result<(u64, blake3::Hash)> {
-            let mut hasher = blake3::Hasher::new();
-            let mut len = 0u64;
-            for mut chunk in full_rx {
-                hasher.update(&chunk);
-                file.write_all(&chunk)?;
-                len += chunk.len() as u64;
-                chunk.clear();
-                // The serialiser may already be done and gone; the buffer is then dropped.
-                let _ = free_tx.send(chunk);
-            }
-            Ok((len, hasher.finalize()))
-        });
-        let mut w = ChunkWriter {
-            buf: Vec::with_capacity(CHUNK),
-            full: full_tx,
-            free: free_rx,
-        };
-        let encoded = bincode::serde::encode_into_std_write(value, &mut w, config());
-        let sent = w.send();
-        // Closing the channel ends the sink's loop.
-        drop(w);
-        let sunk = match sink.join() {
-            Ok(r) => r,
-            Err(panic) => std::panic::resume_unwind(panic),
-        };
-        // A failed write stops the sink, which makes the serialiser's next send fail too:
-        // the write's own error is the one worth reporting.
-        let (len, hash) = sunk.map_err(|e| FormatError::io(path, e))?;
-        encoded.map_err(|e| FormatError::Encode {
-            path: path.to_path_buf(),
-            detail: e.to_string(),
-        })?;
-        sent.map_err(|e| FormatError::io(path, e))?;
-        Ok((len, hash))
-    })
-}
-
-/// The serialiser's end of the pipe to the writing thread.
-struct ChunkWriter {
-    buf: Vec<u8>,
-    full: mpsc::SyncSender<Vec<u8>>,
-    free: mpsc::Receiver<Vec<u8>>,
-}
-
-impl ChunkWriter {
-    /// Hand the filled buffer to the writing thread and continue in an emptied one.
-    #[cold]
-    #[inline(never)]
-    fn send(&mut self) -> std::io::Result<()> {
-        if self.buf.is_empty() {
-            return Ok(());
-        }
-        let next = self
-            .free
-            .try_recv()
-            .unwrap_or_else(|_| Vec::with_capacity(CHUNK));
-        let full = std::mem::replace(&mut self.buf, next);
-        self.full.send(full).map_err(|_| {
-            std::io::Error::new(std::io::ErrorKind::BrokenPipe, "the writing thread stopped")
-        })
-    }
-}
-
-// bincode writes each number through `write_all`: the default's retry loop around `write`
-// made the four-byte appends a third of the whole conversion, hence both inlined here.
-impl Write for ChunkWriter {
-    #[inline]
-    fn write(&mut self, data: &[u8]) -> std::io::Result<usize> {
-        self.write_all(data)?;
-        Ok(data.len())
-    }
-
-    #[inline]
-    fn write_all(&mut self, data: &[u8]) -> std::io::Result<()> {
-        if self.buf.len() + data.len() > CHUNK {
-            self.send()?;
-        }
-        self.buf.extend_from_slice(data);
-        Ok(())
-    }
-
-    fn flush(&mut self) -> std::io::Result<()> {
-        Ok(())
-    }
 }
 
 /// A temporary file in `path`'s folder, so that the final rename stays on one file system.

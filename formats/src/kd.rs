@@ -86,7 +86,10 @@ pub struct TreeStats {
 ///   the child above the split; the child below is the next node in the array.
 /// * Leaf: `flags >> 2` is the number of triangles; `data` is the offset of its first
 ///   triangle index in [`KdFile::leaf_tris`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, bytemuck::Pod, bytemuck::Zeroable,
+)]
+#[repr(C)]
 pub struct KdNode {
     pub flags: u32,
     pub data: u32,
@@ -197,23 +200,52 @@ impl KdFile {
     }
 
     pub fn to_bytes(&self, path: &Path) -> Result<Vec<u8>, FormatError> {
-        envelope::encode(self, MAGIC, VERSION, path)
+        envelope::encode(self, path)
     }
 
     pub fn from_bytes(bytes: &[u8], path: &Path) -> Result<Self, FormatError> {
-        let kd: KdFile = envelope::decode(bytes, MAGIC, "k-d tree", VERSION, path)?;
-        kd.validate().map_err(|detail| FormatError::Corrupt {
-            path: path.to_path_buf(),
-            detail,
-        })?;
-        Ok(kd)
+        envelope::decode(bytes, path)
     }
 
+    /// Write atomically (temp file + rename), the bytes of [`KdFile::to_bytes`] streamed.
     pub fn write(&self, path: &Path) -> Result<(), FormatError> {
-        envelope::write_atomic(path, &self.to_bytes(path)?)
+        envelope::write(self, path)
     }
 
     pub fn read(path: &Path) -> Result<Self, FormatError> {
         Self::from_bytes(&envelope::read_file(path)?, path)
+    }
+}
+
+/// The fields in the order of KD.md (the order of the struct, so the bytes are those of its
+/// serde encoding), nodes and leaf lists as blocks.
+impl envelope::Artifact for KdFile {
+    const MAGIC: &'static [u8; 8] = MAGIC;
+    const VERSION: u32 = VERSION;
+    const KIND: &'static str = "k-d tree";
+
+    fn write_payload<W: std::io::Write + Send>(
+        &self,
+        p: &mut envelope::PayloadWriter<W>,
+    ) -> Result<(), FormatError> {
+        p.value(&(&self.geometry_hash, &self.params, &self.stats, &self.bounds))?;
+        p.array(&self.nodes)?;
+        p.array(&self.leaf_tris)
+    }
+
+    fn read_payload(r: &mut envelope::PayloadReader) -> Result<Self, String> {
+        let (geometry_hash, params, stats, bounds) = r.value("the header fields")?;
+        Ok(KdFile {
+            geometry_hash,
+            params,
+            stats,
+            bounds,
+            nodes: r.array("nodes")?,
+            leaf_tris: r.array("leaf_tris")?,
+        })
+    }
+
+    fn validate(&self) -> Result<(), String> {
+        KdFile::validate(self)
     }
 }

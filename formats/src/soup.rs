@@ -338,20 +338,11 @@ pub fn geometry_hash(triangles: &[[Vec3; 3]]) -> Digest {
     *h.finalize().as_bytes()
 }
 
-/// Below this many bytes one thread hashes faster than the pool starts (BLAKE3's own advice
-/// is 128 KiB and up).
-const PARALLEL_HASH_MIN: usize = 1 << 20;
-
 /// On a little-endian machine the positions in memory are the hashed bytes themselves, so
 /// two million triangles (75 MB) are hashed in place on all cores.
 #[cfg(target_endian = "little")]
 fn hash_positions(h: &mut blake3::Hasher, triangles: &[[Vec3; 3]]) {
-    let bytes: &[u8] = bytemuck::cast_slice(triangles);
-    if bytes.len() < PARALLEL_HASH_MIN {
-        h.update(bytes);
-    } else {
-        h.update_rayon(bytes);
-    }
+    envelope::hash_into(h, bytemuck::cast_slice(triangles));
 }
 
 #[cfg(not(target_endian = "little"))]
@@ -503,24 +494,102 @@ impl Soup {
     }
 
     pub fn to_bytes(&self, path: &Path) -> Result<Vec<u8>, FormatError> {
-        envelope::encode(self, MAGIC, VERSION, path)
+        envelope::encode(self, path)
     }
 
     pub fn from_bytes(bytes: &[u8], path: &Path) -> Result<Self, FormatError> {
-        let soup: Soup = envelope::decode(bytes, MAGIC, "soup", VERSION, path)?;
-        soup.validate().map_err(|detail| FormatError::Corrupt {
-            path: path.to_path_buf(),
-            detail,
-        })?;
-        Ok(soup)
+        envelope::decode(bytes, path)
     }
 
     /// Write atomically (temp file + rename), the bytes of [`Soup::to_bytes`] streamed.
     pub fn write(&self, path: &Path) -> Result<(), FormatError> {
-        envelope::write_encoded(self, MAGIC, VERSION, path)
+        envelope::write(self, path)
     }
 
     pub fn read(path: &Path) -> Result<Self, FormatError> {
         Self::from_bytes(&envelope::read_file(path)?, path)
+    }
+}
+
+/// The fields after the per-triangle arrays, in payload order.
+type SoupRest = (
+    Vec<Object>,
+    Vec<Material>,
+    Vec<Texture>,
+    Vec<Light>,
+    Camera,
+    Environment,
+    Vec<String>,
+    u64,
+    Digest,
+);
+
+/// The fields in the order of SOUP.md (the order of the struct, so the bytes are those of its
+/// serde encoding), the per-triangle arrays as blocks.
+impl envelope::Artifact for Soup {
+    const MAGIC: &'static [u8; 8] = MAGIC;
+    const VERSION: u32 = VERSION;
+    const KIND: &'static str = "soup";
+
+    fn write_payload<W: std::io::Write + Send>(
+        &self,
+        p: &mut envelope::PayloadWriter<W>,
+    ) -> Result<(), FormatError> {
+        p.array(&self.triangles)?;
+        p.array(&self.normals)?;
+        p.array(&self.uvs)?;
+        p.array(&self.tri_material)?;
+        p.array(&self.tri_object)?;
+        p.value(&(
+            &self.objects,
+            &self.materials,
+            &self.textures,
+            &self.lights,
+            &self.camera,
+            &self.environment,
+            &self.warnings,
+            self.dropped_degenerate,
+            &self.geometry_hash,
+        ))
+    }
+
+    fn read_payload(r: &mut envelope::PayloadReader) -> Result<Self, String> {
+        let triangles = r.array("triangles")?;
+        let normals = r.array("normals")?;
+        let uvs = r.array("uvs")?;
+        let tri_material = r.array("tri_material")?;
+        let tri_object = r.array("tri_object")?;
+        let rest: SoupRest = r.value("the fields after tri_object")?;
+        let (
+            objects,
+            materials,
+            textures,
+            lights,
+            camera,
+            environment,
+            warnings,
+            dropped_degenerate,
+            geometry_hash,
+        ) = rest;
+        Ok(Soup {
+            triangles,
+            normals,
+            uvs,
+            tri_material,
+            tri_object,
+            objects,
+            materials,
+            textures,
+            lights,
+            camera,
+            environment,
+            warnings,
+            dropped_degenerate,
+            geometry_hash,
+        })
+    }
+
+    fn validate(&self) -> Result<(), String> {
+        Soup::validate(self)
     }
 }

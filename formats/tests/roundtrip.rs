@@ -99,9 +99,9 @@ fn soup_round_trips_through_a_file() {
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
 }
 
-/// `Soup::write` streams the payload in chunks and patches the header afterwards; the file
-/// must be the very bytes `to_bytes` frames in memory, also when the payload spans many
-/// chunks and a string straddles a chunk's end.
+/// `Soup::write` streams the payload into the file, its arrays as blocks, and patches the
+/// header afterwards; the file must be the very bytes `to_bytes` frames in memory, and those
+/// the bytes of the struct's own serde encoding that SOUP.md documents.
 #[test]
 fn streamed_soup_file_is_the_encoded_bytes() {
     let dir = tempfile::tempdir().unwrap();
@@ -140,6 +140,11 @@ fn streamed_soup_file_is_the_encoded_bytes() {
     let bytes = std::fs::read(&path).unwrap();
     assert!(bytes.len() > 4 << 20, "{} bytes", bytes.len());
     assert!(bytes == s.to_bytes(&path).unwrap());
+    let config = bincode::config::standard()
+        .with_little_endian()
+        .with_fixed_int_encoding();
+    let serde_payload = bincode::serde::encode_to_vec(&s, config).unwrap();
+    assert!(bytes[52..] == serde_payload[..]);
     assert_eq!(Soup::read(&path).unwrap(), s);
 }
 
@@ -147,7 +152,14 @@ fn streamed_soup_file_is_the_encoded_bytes() {
 fn kd_round_trips() {
     let p = Path::new("t.kd");
     let k = sample_kd();
-    assert_eq!(KdFile::from_bytes(&k.to_bytes(p).unwrap(), p).unwrap(), k);
+    let bytes = k.to_bytes(p).unwrap();
+    assert_eq!(KdFile::from_bytes(&bytes, p).unwrap(), k);
+    // Nodes and leaf lists are written as blocks; the bytes are still the struct's serde
+    // encoding that KD.md documents.
+    let config = bincode::config::standard()
+        .with_little_endian()
+        .with_fixed_int_encoding();
+    assert!(bytes[52..] == bincode::serde::encode_to_vec(&k, config).unwrap()[..]);
 }
 
 #[test]
