@@ -147,7 +147,12 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
         }
         if let Some(smr) = class_of(docs::SKINNED_MESH_RENDERER) {
             if enabled(&g.objs[smr]) {
-                e.skinned_object(gi, smr)?;
+                if let Some(why) = lod_hidden.get(&smr) {
+                    let line = format!("object {:?}: {why}; not converted", e.path(gi));
+                    e.skipped.push(line);
+                } else {
+                    e.skinned_object(gi, smr)?;
+                }
             }
         }
         if class_of(docs::TERRAIN).is_some() {

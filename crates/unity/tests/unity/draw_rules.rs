@@ -334,6 +334,41 @@ fn a_scaled_group_measures_by_its_largest_axis_at_its_reference_point() {
 }
 
 #[test]
+fn a_skinned_renderer_in_a_level_not_shown_is_dropped_too() {
+    // Size 1, 60° FOV: 1 m away → 0.866 (LOD0), 2 m → 0.433 (LOD1).
+    let scene = |d: f32| {
+        let mut sc = Scene::default();
+        sc.camera(&Tf::at(0.0, 0.0, -d));
+        let near = quad(&mut sc, 10, "Body_LOD0", 0, "");
+        let (body, _) = sc.object("Body_LOD1", &Tf::at(0.0, 0.0, 0.0), 0, true);
+        sc.raw(&format!(
+            "--- !u!137 &95\nSkinnedMeshRenderer:\n  m_GameObject: {{fileID: {body}}}\n  m_Enabled: 1\n  m_Materials:\n  - {{fileID: 10303, guid: 0000000000000000f000000000000000, type: 0}}\n  m_Mesh: {{fileID: {QUAD}, guid: {BUILTIN}, type: 3}}\n  m_Bones: []\n"
+        ));
+        let (go, _) = sc.object("Body", &Tf::at(0.0, 0.0, 0.0), 0, true);
+        sc.raw(&format!(
+            "--- !u!205 &90\nLODGroup:\n  m_GameObject: {{fileID: {go}}}\n  m_Enabled: 1\n  m_Size: 1\n  m_LODs:\n  - screenRelativeHeight: 0.5\n    renderers:\n    - renderer: {{fileID: {near}}}\n  - screenRelativeHeight: 0.2\n    renderers:\n    - renderer: {{fileID: 95}}\n"
+        ));
+        let (_d, root) = project(&[("Assets/s.unity", &sc.text)]);
+        unity::convert_report(&root.join("Assets/s.unity"), &unity::Options::default()).unwrap()
+    };
+    let r = scene(1.0);
+    assert!(object(&r.soup, "Body_LOD0").is_some());
+    assert!(object(&r.soup, "Body_LOD1").is_none(), "{:?}", r.skipped);
+    assert_eq!(
+        r.skipped,
+        ["object \"Body_LOD1\": LOD1 of LODGroup \"Body\"; the camera shows LOD0 (relative screen height 0.866); not converted"]
+    );
+    // Shown, the skinned renderer is drawn (rigidly, its Quad having no skin).
+    let r = scene(2.0);
+    assert!(object(&r.soup, "Body_LOD0").is_none());
+    assert!(
+        object(&r.soup, "Body_LOD1").is_some(),
+        "{:?}",
+        r.soup.warnings
+    );
+}
+
+#[test]
 fn without_a_camera_a_lod_group_keeps_lod0() {
     let mut sc = Scene::default();
     let near = quad(&mut sc, 10, "Tree_LOD0", 0, "");
