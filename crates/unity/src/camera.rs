@@ -77,6 +77,7 @@ impl Emitter<'_, '_> {
         let Some(camera) = convert(b, world, self.path(go)) else {
             return Err(self.non_finite(go, "camera orientation is degenerate".into()));
         };
+        self.lod_camera = Some((world.w_axis.xyz(), camera.projection));
         self.soup.camera = camera;
         self.camera_mask = crate::layer::culling_mask(b);
         self.soup.environment.clear = clear_flags(b);

@@ -13,6 +13,7 @@ pub const MATERIAL: u32 = 21;
 pub const MESH_RENDERER: u32 = 23;
 pub const MESH_FILTER: u32 = 33;
 pub const MESH: u32 = 43;
+pub const QUALITY_SETTINGS: u32 = 47;
 pub const RENDER_SETTINGS: u32 = 104;
 pub const LIGHT: u32 = 108;
 pub const SKINNED_MESH_RENDERER: u32 = 137;

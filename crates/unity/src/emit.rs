@@ -59,6 +59,9 @@ pub(crate) struct Emitter<'g, 'p> {
     pub(crate) extracted: HashMap<(std::path::PathBuf, String), Option<std::path::PathBuf>>,
     /// The chosen camera's culling mask (see [`crate::layer`]).
     pub(crate) camera_mask: u32,
+    /// The chosen camera's Unity-space position and projection, which pick each
+    /// LODGroup's level (see [`crate::lod`]); `None` when the scene has no camera.
+    pub(crate) lod_camera: Option<(Vec3, formats::Projection)>,
     /// Renderers not drawn by Unity's own rules, one line each for `--list`.
     pub(crate) skipped: Vec<String>,
 }
@@ -72,8 +75,8 @@ pub struct Emitted {
     /// override, a model importer remap, a `Materials/` folder, the model's own, or the
     /// default).
     pub material_origins: Vec<Vec<(u32, String)>>,
-    /// Renderers Unity does not draw by design (outside the camera's culling mask, above
-    /// LOD0), one line each.
+    /// Renderers Unity does not draw by design (outside the camera's culling mask, in a
+    /// LOD level the camera does not show), one line each.
     pub skipped: Vec<String>,
 }
 
@@ -95,6 +98,7 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
         material_origins: Vec::new(),
         extracted: HashMap::new(),
         camera_mask: crate::layer::EVERYTHING,
+        lod_camera: None,
         skipped: Vec::new(),
     };
     e.soup.warnings = g.warnings.clone();
@@ -143,7 +147,12 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
         }
         if let Some(smr) = class_of(docs::SKINNED_MESH_RENDERER) {
             if enabled(&g.objs[smr]) {
-                e.skinned_object(gi, smr)?;
+                if let Some(why) = lod_hidden.get(&smr) {
+                    let line = format!("object {:?}: {why}; not converted", e.path(gi));
+                    e.skipped.push(line);
+                } else {
+                    e.skinned_object(gi, smr)?;
+                }
             }
         }
         if class_of(docs::TERRAIN).is_some() {

@@ -68,8 +68,8 @@ pub struct Report {
     pub cameras: usize,
     /// Per soup object: each soup material it uses and where the material came from.
     pub material_origins: Vec<Vec<(u32, String)>>,
-    /// Renderers Unity does not draw by design (outside the camera's culling mask, above
-    /// LOD0), one line each.
+    /// Renderers Unity does not draw by design (outside the camera's culling mask, in a
+    /// LOD level the camera does not show), one line each.
     pub skipped: Vec<String>,
 }
 

@@ -51,6 +51,9 @@ pub struct Project {
     /// `Packages/manifest.json` names the High Definition Render Pipeline, whose lights
     /// are in physical units.
     pub hdrp: bool,
+    /// `ProjectSettings/QualitySettings.asset`'s lodBias at its current quality level; 1
+    /// when the file is absent or does not say (see [`crate::lod`]).
+    pub lod_bias: f32,
     /// `root` canonicalised once: `rel` runs for every object and message.
     canonical_root: PathBuf,
     files: Mutex<HashMap<PathBuf, FileResult>>,
@@ -96,6 +99,10 @@ impl Project {
         let guids = GuidIndex::build(&assets);
         let hdrp = std::fs::read_to_string(root.join("Packages").join("manifest.json"))
             .is_ok_and(|m| m.contains("com.unity.render-pipelines.high-definition"));
+        let lod_bias = std::fs::read(root.join("ProjectSettings").join("QualitySettings.asset"))
+            .ok()
+            .and_then(|b| crate::lod::lod_bias(&String::from_utf8_lossy(&b)))
+            .unwrap_or(1.0);
         let canonical_root = root.canonicalize().unwrap_or_else(|_| root.clone());
         Project {
             canonical_root,
@@ -103,6 +110,7 @@ impl Project {
             assets,
             guids,
             hdrp,
+            lod_bias,
             files: Mutex::default(),
             models: Mutex::default(),
             mats: Mutex::default(),

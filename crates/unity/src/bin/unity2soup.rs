@@ -22,9 +22,9 @@ struct Args {
     #[arg(long)]
     strict: bool,
     /// List every converted object (triangles, source, materials, layer, shadows), every
-    /// material (texture, tiling, opacity, alpha mode), every
-    /// renderer Unity's draw rules skip (camera culling mask, LOD above 0), light and
-    /// warning on stderr.
+    /// material (texture, tiling, opacity, alpha mode), every renderer Unity's draw rules
+    /// skip (camera culling mask, LOD levels the camera does not show), light and warning
+    /// on stderr.
     #[arg(long)]
     list: bool,
 }

@@ -113,6 +113,7 @@ fn a_light_without_a_mask_lights_every_layer() {
 
 #[test]
 fn only_lod0_of_a_lod_group_is_converted() {
+    // Size 4 seen from 5 m with a 60° FOV: 2 / (5·tan 30°) = 0.693 ≥ 0.6, so LOD0.
     let mut sc = Scene::default();
     sc.camera(&Tf::at(0.0, 0.0, -5.0));
     let near = quad(&mut sc, 10, "Tree_LOD0", 0, "");
@@ -120,7 +121,7 @@ fn only_lod0_of_a_lod_group_is_converted() {
     let both = quad(&mut sc, 30, "Trunk", 0, "");
     let (go, _) = sc.object("Tree", &Tf::at(0.0, 0.0, 0.0), 0, true);
     sc.raw(&format!(
-        "--- !u!205 &90\nLODGroup:\n  m_GameObject: {{fileID: {go}}}\n  m_Enabled: 1\n  serializedVersion: 2\n  m_LODs:\n  - screenRelativeHeight: 0.6\n    fadeTransitionWidth: 0\n    renderers:\n    - renderer: {{fileID: {near}}}\n    - renderer: {{fileID: {both}}}\n  - screenRelativeHeight: 0.1\n    fadeTransitionWidth: 0\n    renderers:\n    - renderer: {{fileID: {far}}}\n    - renderer: {{fileID: {both}}}\n"
+        "--- !u!205 &90\nLODGroup:\n  m_GameObject: {{fileID: {go}}}\n  m_Enabled: 1\n  serializedVersion: 2\n  m_LocalReferencePoint: {{x: 0, y: 0, z: 0}}\n  m_Size: 4\n  m_LODs:\n  - screenRelativeHeight: 0.6\n    fadeTransitionWidth: 0\n    renderers:\n    - renderer: {{fileID: {near}}}\n    - renderer: {{fileID: {both}}}\n  - screenRelativeHeight: 0.1\n    fadeTransitionWidth: 0\n    renderers:\n    - renderer: {{fileID: {far}}}\n    - renderer: {{fileID: {both}}}\n"
     ));
     let (_d, root) = project(&[("Assets/s.unity", &sc.text)]);
     let r =
@@ -133,6 +134,257 @@ fn only_lod0_of_a_lod_group_is_converted() {
         r.skipped[0].contains("LOD1 of LODGroup \"Tree\""),
         "{}",
         r.skipped[0]
+    );
+    assert!(
+        r.skipped[0].contains("the camera shows LOD0 (relative screen height 0.693)"),
+        "{}",
+        r.skipped[0]
+    );
+}
+
+/// How a LODGroup test sees its group: the camera, the group's Transform and its
+/// `m_LocalReferencePoint`, and the project's `QualitySettings.asset`.
+struct LodView<'a> {
+    camera: Tf,
+    /// `Some(orthographic size)` for an orthographic camera; else 60° perspective.
+    ortho: Option<f32>,
+    group: Tf,
+    reference: [f32; 3],
+    quality: Option<&'a str>,
+}
+
+impl LodView<'_> {
+    /// A camera `d` metres down −Z from a size-1 group at the origin, 60° FOV.
+    fn at(d: f32) -> Self {
+        LodView {
+            camera: Tf::at(0.0, 0.0, -d),
+            ortho: None,
+            group: Tf::at(0.0, 0.0, 0.0),
+            reference: [0.0; 3],
+            quality: None,
+        }
+    }
+}
+
+/// Group "Tree" of size 1 with three levels (thresholds 0.5, 0.2, 0.05): Tree_LOD0,
+/// Tree_LOD1 and Tree_LOD2, and Trunk in LOD1 and LOD2, seen as `v` says.
+fn lod_report(v: &LodView) -> unity::Report {
+    let mut sc = Scene::default();
+    let (cam, _) = sc.object("Main Camera", &v.camera, 0, true);
+    let (ortho, size) = match v.ortho {
+        Some(s) => (1, s),
+        None => (0, 5.0),
+    };
+    sc.raw(&format!(
+        "--- !u!20 &900\nCamera:\n  m_GameObject: {{fileID: {cam}}}\n  m_Enabled: 1\n  m_ClearFlags: 2\n  near clip plane: 0.3\n  field of view: 60\n  orthographic: {ortho}\n  orthographic size: {size}\n  m_Depth: -1\n"
+    ));
+    let l0 = quad(&mut sc, 10, "Tree_LOD0", 0, "");
+    let l1 = quad(&mut sc, 20, "Tree_LOD1", 0, "");
+    let l2 = quad(&mut sc, 30, "Tree_LOD2", 0, "");
+    let trunk = quad(&mut sc, 40, "Trunk", 0, "");
+    let (go, _) = sc.object("Tree", &v.group, 0, true);
+    let [x, y, z] = v.reference;
+    sc.raw(&format!(
+        "--- !u!205 &90\nLODGroup:\n  m_GameObject: {{fileID: {go}}}\n  m_Enabled: 1\n  serializedVersion: 2\n  m_LocalReferencePoint: {{x: {x}, y: {y}, z: {z}}}\n  m_Size: 1\n  m_FadeMode: 0\n  m_AnimateCrossFading: 0\n  m_LastLODIsBillboard: 0\n  m_LODs:\n  - screenRelativeHeight: 0.5\n    fadeTransitionWidth: 0\n    renderers:\n    - renderer: {{fileID: {l0}}}\n  - screenRelativeHeight: 0.2\n    fadeTransitionWidth: 0\n    renderers:\n    - renderer: {{fileID: {l1}}}\n    - renderer: {{fileID: {trunk}}}\n  - screenRelativeHeight: 0.05\n    fadeTransitionWidth: 0\n    renderers:\n    - renderer: {{fileID: {l2}}}\n    - renderer: {{fileID: {trunk}}}\n"
+    ));
+    let mut files = vec![("Assets/s.unity", sc.text.as_str())];
+    if let Some(q) = v.quality {
+        files.push(("ProjectSettings/QualitySettings.asset", q));
+    }
+    let (_d, root) = project(&files);
+    unity::convert_report(&root.join("Assets/s.unity"), &unity::Options::default()).unwrap()
+}
+
+/// The objects of [`lod_report`]'s scene that reached the soup, in a fixed order.
+fn lod_drawn(r: &unity::Report) -> Vec<&'static str> {
+    ["Tree_LOD0", "Tree_LOD1", "Tree_LOD2", "Trunk"]
+        .into_iter()
+        .filter(|n| object(&r.soup, n).is_some())
+        .collect()
+}
+
+/// The skip line of object `name`.
+fn skip_line<'a>(r: &'a unity::Report, name: &str) -> &'a str {
+    let tag = format!("object {name:?}: ");
+    r.skipped
+        .iter()
+        .find(|l| l.starts_with(&tag))
+        .unwrap_or_else(|| panic!("{name} skipped: {:?}", r.skipped))
+}
+
+/// A project whose current quality level (the second) has lodBias 2; the first has 0.3.
+const QUALITY_BIAS_2: &str = "%YAML 1.1\n%TAG !u! tag:unity3d.com,2011:\n--- !u!47 &1\nQualitySettings:\n  m_ObjectHideFlags: 0\n  serializedVersion: 5\n  m_CurrentQuality: 1\n  m_QualitySettings:\n  - serializedVersion: 2\n    name: Very Low\n    shadowCascade4Split: {x: 0.06666667, y: 0.2, z: 0.46666667}\n    lodBias: 0.3\n    maximumLODLevel: 0\n    excludedTargetPlatforms: []\n  - serializedVersion: 2\n    name: High\n    shadowCascade4Split: {x: 0.06666667, y: 0.2, z: 0.46666667}\n    lodBias: 2\n    maximumLODLevel: 0\n    excludedTargetPlatforms: []\n  m_PerPlatformDefaultQuality:\n    Standalone: 1\n";
+
+#[test]
+fn a_lod_group_shows_the_level_its_screen_height_picks() {
+    // Size 1 at d metres, 60° FOV: relative height 0.5 / (d·tan 30°) = 0.866 / d.
+    // d = 1 → 0.866 ≥ 0.5: LOD0.
+    let r = lod_report(&LodView::at(1.0));
+    assert_eq!(lod_drawn(&r), ["Tree_LOD0"], "{:?}", r.skipped);
+    assert_eq!(r.skipped.len(), 3, "{:?}", r.skipped);
+    assert_eq!(
+        skip_line(&r, "Tree_LOD1"),
+        "object \"Tree_LOD1\": LOD1 of LODGroup \"Tree\"; the camera shows LOD0 (relative screen height 0.866); not converted"
+    );
+    assert!(skip_line(&r, "Trunk").contains("LOD1 of LODGroup \"Tree\""));
+    assert!(skip_line(&r, "Tree_LOD2").contains("LOD2 of LODGroup \"Tree\""));
+
+    // d = 2 → 0.433: below 0.5, at least 0.2: LOD1, with Trunk (also listed in LOD2).
+    let r = lod_report(&LodView::at(2.0));
+    assert_eq!(lod_drawn(&r), ["Tree_LOD1", "Trunk"], "{:?}", r.skipped);
+    assert_eq!(r.skipped.len(), 2, "{:?}", r.skipped);
+    assert_eq!(
+        skip_line(&r, "Tree_LOD0"),
+        "object \"Tree_LOD0\": LOD0 of LODGroup \"Tree\"; the camera shows LOD1 (relative screen height 0.433); not converted"
+    );
+    assert!(skip_line(&r, "Tree_LOD2").contains("LOD2 of LODGroup \"Tree\"; the camera shows LOD1"));
+
+    // d = 5 → 0.173: LOD2.
+    let r = lod_report(&LodView::at(5.0));
+    assert_eq!(lod_drawn(&r), ["Tree_LOD2", "Trunk"], "{:?}", r.skipped);
+    assert!(
+        skip_line(&r, "Tree_LOD1").contains("the camera shows LOD2 (relative screen height 0.173)")
+    );
+
+    // d = 20 → 0.043 < 0.05: Unity culls the group, every level with it.
+    let r = lod_report(&LodView::at(20.0));
+    assert!(lod_drawn(&r).is_empty(), "{:?}", r.skipped);
+    assert_eq!(r.skipped.len(), 4, "{:?}", r.skipped);
+    assert_eq!(
+        skip_line(&r, "Trunk"),
+        "object \"Trunk\": culled: LODGroup \"Tree\" is below its last level's screen height (relative screen height 0.043 < LOD2's 0.050); not converted"
+    );
+    assert!(r.soup.warnings.is_empty(), "{:?}", r.soup.warnings);
+}
+
+#[test]
+fn the_quality_levels_lod_bias_divides_the_distance() {
+    // lodBias 2 (the current level's, not the first level's 0.3): d = 2 → 0.866 / (2 / 2)
+    // = 0.866: LOD0 where lodBias 1 shows LOD1.
+    let mut v = LodView::at(2.0);
+    v.quality = Some(QUALITY_BIAS_2);
+    let r = lod_report(&v);
+    assert_eq!(lod_drawn(&r), ["Tree_LOD0"], "{:?}", r.skipped);
+    assert!(
+        skip_line(&r, "Tree_LOD1").contains("the camera shows LOD0 (relative screen height 0.866)")
+    );
+    // d = 20 → 0.087: LOD2 where lodBias 1 culls the group.
+    let mut v = LodView::at(20.0);
+    v.quality = Some(QUALITY_BIAS_2);
+    let r = lod_report(&v);
+    assert_eq!(lod_drawn(&r), ["Tree_LOD2", "Trunk"], "{:?}", r.skipped);
+    assert!(skip_line(&r, "Tree_LOD0").contains("relative screen height 0.087"));
+    // A file that does not say (no current level's lodBias) leaves the bias at 1.
+    let mut v = LodView::at(2.0);
+    let odd = QUALITY_BIAS_2.replace("m_CurrentQuality: 1", "m_CurrentQuality: 7");
+    v.quality = Some(&odd);
+    assert_eq!(lod_drawn(&lod_report(&v)), ["Tree_LOD1", "Trunk"]);
+    let mut v = LodView::at(2.0);
+    v.quality = Some("not YAML at all {[");
+    assert_eq!(lod_drawn(&lod_report(&v)), ["Tree_LOD1", "Trunk"]);
+}
+
+#[test]
+fn an_orthographic_camera_measures_by_its_size_not_its_distance() {
+    // Orthographic size 4: relative height 0.5 / 4 = 0.125, near or far: LOD2.
+    for d in [1.0, 100.0] {
+        let mut v = LodView::at(d);
+        v.ortho = Some(4.0);
+        let r = lod_report(&v);
+        assert_eq!(
+            lod_drawn(&r),
+            ["Tree_LOD2", "Trunk"],
+            "d {d}: {:?}",
+            r.skipped
+        );
+        assert!(skip_line(&r, "Tree_LOD0").contains("relative screen height 0.125"));
+    }
+    // Orthographic size 2: 0.25: LOD1.
+    let mut v = LodView::at(100.0);
+    v.ortho = Some(2.0);
+    assert_eq!(lod_drawn(&lod_report(&v)), ["Tree_LOD1", "Trunk"]);
+    // Unity's run-time rule divides the orthographic size by lodBias too: size 4 with
+    // lodBias 2 → 0.5 / (4 / 2) = 0.25: LOD1.
+    let mut v = LodView::at(1.0);
+    v.ortho = Some(4.0);
+    v.quality = Some(QUALITY_BIAS_2);
+    let r = lod_report(&v);
+    assert_eq!(lod_drawn(&r), ["Tree_LOD1", "Trunk"], "{:?}", r.skipped);
+    assert!(skip_line(&r, "Tree_LOD0").contains("relative screen height 0.250"));
+}
+
+#[test]
+fn a_scaled_group_measures_by_its_largest_axis_at_its_reference_point() {
+    // Scale (1, −3, 2): world size 1 · max(|1|, |−3|, |2|) = 3. Reference point (0, 0, 1)
+    // → (0, 0, 2) in the world; the camera at z = −1 is 3 m from it.
+    // 3 · 0.5 / (3 · tan 30°) = 0.866: LOD0 (unscaled it would be 0.289: LOD1).
+    let mut v = LodView::at(1.0);
+    v.group = Tf::at(0.0, 0.0, 0.0).scale(1.0, -3.0, 2.0);
+    v.reference = [0.0, 0.0, 1.0];
+    let r = lod_report(&v);
+    assert_eq!(lod_drawn(&r), ["Tree_LOD0"], "{:?}", r.skipped);
+    assert!(skip_line(&r, "Tree_LOD1").contains("relative screen height 0.866"));
+    // Scale 3 on every axis, camera 5 m away: 1.5 / (5 · tan 30°) = 0.520: LOD0, where
+    // the unscaled group (0.173) shows LOD2.
+    let mut v = LodView::at(5.0);
+    v.group = Tf::at(0.0, 0.0, 0.0).scale(3.0, 3.0, 3.0);
+    let r = lod_report(&v);
+    assert_eq!(lod_drawn(&r), ["Tree_LOD0"], "{:?}", r.skipped);
+    assert!(skip_line(&r, "Tree_LOD2").contains("relative screen height 0.520"));
+}
+
+#[test]
+fn a_skinned_renderer_in_a_level_not_shown_is_dropped_too() {
+    // Size 1, 60° FOV: 1 m away → 0.866 (LOD0), 2 m → 0.433 (LOD1).
+    let scene = |d: f32| {
+        let mut sc = Scene::default();
+        sc.camera(&Tf::at(0.0, 0.0, -d));
+        let near = quad(&mut sc, 10, "Body_LOD0", 0, "");
+        let (body, _) = sc.object("Body_LOD1", &Tf::at(0.0, 0.0, 0.0), 0, true);
+        sc.raw(&format!(
+            "--- !u!137 &95\nSkinnedMeshRenderer:\n  m_GameObject: {{fileID: {body}}}\n  m_Enabled: 1\n  m_Materials:\n  - {{fileID: 10303, guid: 0000000000000000f000000000000000, type: 0}}\n  m_Mesh: {{fileID: {QUAD}, guid: {BUILTIN}, type: 3}}\n  m_Bones: []\n"
+        ));
+        let (go, _) = sc.object("Body", &Tf::at(0.0, 0.0, 0.0), 0, true);
+        sc.raw(&format!(
+            "--- !u!205 &90\nLODGroup:\n  m_GameObject: {{fileID: {go}}}\n  m_Enabled: 1\n  m_Size: 1\n  m_LODs:\n  - screenRelativeHeight: 0.5\n    renderers:\n    - renderer: {{fileID: {near}}}\n  - screenRelativeHeight: 0.2\n    renderers:\n    - renderer: {{fileID: 95}}\n"
+        ));
+        let (_d, root) = project(&[("Assets/s.unity", &sc.text)]);
+        unity::convert_report(&root.join("Assets/s.unity"), &unity::Options::default()).unwrap()
+    };
+    let r = scene(1.0);
+    assert!(object(&r.soup, "Body_LOD0").is_some());
+    assert!(object(&r.soup, "Body_LOD1").is_none(), "{:?}", r.skipped);
+    assert_eq!(
+        r.skipped,
+        ["object \"Body_LOD1\": LOD1 of LODGroup \"Body\"; the camera shows LOD0 (relative screen height 0.866); not converted"]
+    );
+    // Shown, the skinned renderer is drawn (rigidly, its Quad having no skin).
+    let r = scene(2.0);
+    assert!(object(&r.soup, "Body_LOD0").is_none());
+    assert!(
+        object(&r.soup, "Body_LOD1").is_some(),
+        "{:?}",
+        r.soup.warnings
+    );
+}
+
+#[test]
+fn without_a_camera_a_lod_group_keeps_lod0() {
+    let mut sc = Scene::default();
+    let near = quad(&mut sc, 10, "Tree_LOD0", 0, "");
+    let far = quad(&mut sc, 20, "Tree_LOD1", 0, "");
+    let (go, _) = sc.object("Tree", &Tf::at(0.0, 0.0, 500.0), 0, true);
+    sc.raw(&format!(
+        "--- !u!205 &90\nLODGroup:\n  m_GameObject: {{fileID: {go}}}\n  m_Enabled: 1\n  m_Size: 1\n  m_LODs:\n  - screenRelativeHeight: 0.6\n    renderers:\n    - renderer: {{fileID: {near}}}\n  - screenRelativeHeight: 0.1\n    renderers:\n    - renderer: {{fileID: {far}}}\n"
+    ));
+    let (_d, root) = project(&[("Assets/s.unity", &sc.text)]);
+    let r =
+        unity::convert_report(&root.join("Assets/s.unity"), &unity::Options::default()).unwrap();
+    assert!(object(&r.soup, "Tree_LOD0").is_some());
+    assert!(object(&r.soup, "Tree_LOD1").is_none());
+    assert_eq!(
+        r.skipped,
+        ["object \"Tree_LOD1\": LOD1 of LODGroup \"Tree\"; there is no camera; LOD0 kept; not converted"]
     );
 }
 
