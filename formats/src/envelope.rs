@@ -53,8 +53,8 @@ pub fn encode<A: Artifact>(value: &A, path: &Path) -> Result<Vec<u8>, FormatErro
     let mut out = vec![0u8; HEADER_LEN];
     let mut p = PayloadWriter::new(&mut out, path);
     value.write_payload(&mut p)?;
-    let header = header::<A>(p.len, p.hasher.finalize());
-    out[..HEADER_LEN].copy_from_slice(&header);
+    let (len, hash) = p.finish()?;
+    out[..HEADER_LEN].copy_from_slice(&header::<A>(len, hash));
     Ok(out)
 }
 
@@ -172,18 +172,25 @@ pub(crate) fn hash_into(h: &mut blake3::Hasher, bytes: &[u8]) {
     }
 }
 
-/// Where a payload's bytes go, hashed on their way.
+/// Where a payload's bytes go, hashed on their way. Small writes (bincode writes field by
+/// field) are gathered in a buffer; blocks of [`PASS_THROUGH`] bytes or more go straight
+/// from the caller's memory to the hash and the file.
 pub struct PayloadWriter<'p, W> {
     out: W,
+    buf: Vec<u8>,
     hasher: blake3::Hasher,
     len: u64,
     path: &'p Path,
 }
 
+/// Writes at least this large bypass the buffer (and its copy).
+const PASS_THROUGH: usize = 64 << 10;
+
 impl<'p, W: Write + Send> PayloadWriter<'p, W> {
     fn new(out: W, path: &'p Path) -> Self {
         PayloadWriter {
             out,
+            buf: Vec::with_capacity(PASS_THROUGH),
             hasher: blake3::Hasher::new(),
             len: 0,
             path,
@@ -195,8 +202,9 @@ impl<'p, W: Write + Send> PayloadWriter<'p, W> {
     pub fn array<T: bytemuck::Pod + Serialize>(&mut self, items: &[T]) -> Result<(), FormatError> {
         #[cfg(target_endian = "little")]
         {
-            self.bytes(&(items.len() as u64).to_le_bytes())?;
-            self.bytes(bytemuck::cast_slice(items))
+            self.write_all(&(items.len() as u64).to_le_bytes())
+                .and_then(|()| self.write_all(bytemuck::cast_slice(items)))
+                .map_err(|e| FormatError::io(self.path, e))
         }
         #[cfg(not(target_endian = "little"))]
         self.value(&items)
@@ -204,26 +212,64 @@ impl<'p, W: Write + Send> PayloadWriter<'p, W> {
 
     /// Anything else, through bincode's serde route.
     pub fn value<T: Serialize + ?Sized>(&mut self, value: &T) -> Result<(), FormatError> {
-        let bytes =
-            bincode::serde::encode_to_vec(value, config()).map_err(|e| FormatError::Encode {
-                path: self.path.to_path_buf(),
+        let path = self.path;
+        bincode::serde::encode_into_std_write(value, self, config()).map_err(|e| {
+            FormatError::Encode {
+                path: path.to_path_buf(),
                 detail: e.to_string(),
-            })?;
-        self.bytes(&bytes)
+            }
+        })?;
+        Ok(())
+    }
+
+    /// The payload's length and BLAKE3, once everything is written.
+    fn finish(mut self) -> Result<(u64, blake3::Hash), FormatError> {
+        self.flush().map_err(|e| FormatError::io(self.path, e))?;
+        Ok((self.len, self.hasher.finalize()))
     }
 
     /// Large blocks are hashed (on all cores) while the kernel copies them into the file.
-    fn bytes(&mut self, bytes: &[u8]) -> Result<(), FormatError> {
-        let written = if bytes.len() < PARALLEL_HASH_MIN {
+    fn pass(&mut self, bytes: &[u8]) -> std::io::Result<()> {
+        if bytes.len() < PARALLEL_HASH_MIN {
             self.hasher.update(bytes);
-            self.out.write_all(bytes)
+            self.out.write_all(bytes)?;
         } else {
             let (hasher, out) = (&mut self.hasher, &mut self.out);
-            rayon::join(|| hasher.update_rayon(bytes), || out.write_all(bytes)).1
-        };
-        written.map_err(|e| FormatError::io(self.path, e))?;
+            rayon::join(|| hasher.update_rayon(bytes), || out.write_all(bytes)).1?;
+        }
         self.len += bytes.len() as u64;
         Ok(())
+    }
+}
+
+impl<W: Write + Send> Write for PayloadWriter<'_, W> {
+    fn write(&mut self, data: &[u8]) -> std::io::Result<usize> {
+        self.write_all(data)?;
+        Ok(data.len())
+    }
+
+    // bincode writes every number through `write_all`: inlined, a four-byte append is a
+    // few instructions rather than the default retry loop around `write`.
+    #[inline]
+    fn write_all(&mut self, data: &[u8]) -> std::io::Result<()> {
+        if self.buf.len() + data.len() > PASS_THROUGH {
+            self.flush()?;
+        }
+        if data.len() >= PASS_THROUGH {
+            self.pass(data)
+        } else {
+            self.buf.extend_from_slice(data);
+            Ok(())
+        }
+    }
+
+    #[cold]
+    fn flush(&mut self) -> std::io::Result<()> {
+        let buf = std::mem::take(&mut self.buf);
+        let passed = self.pass(&buf);
+        self.buf = buf;
+        self.buf.clear();
+        passed
     }
 }
 
@@ -326,7 +372,8 @@ pub fn write<A: Artifact>(value: &A, path: &Path) -> Result<(), FormatError> {
         .map_err(|e| FormatError::io(path, e))?;
     let mut p = PayloadWriter::new(&mut *file, path);
     value.write_payload(&mut p)?;
-    let header = header::<A>(p.len, p.hasher.finalize());
+    let (len, hash) = p.finish()?;
+    let header = header::<A>(len, hash);
     file.seek(SeekFrom::Start(0))
         .and_then(|_| file.write_all(&header))
         .map_err(|e| FormatError::io(path, e))?;
@@ -336,6 +383,32 @@ pub fn write<A: Artifact>(value: &A, path: &Path) -> Result<(), FormatError> {
     // a fifth of the conversion). After a power cut an unsynced artifact can come back
     // empty or with zeroed blocks; its header's length and BLAKE3 then fail, so every
     // reader rejects it with an error naming the file and it is rebuilt, never used.
+    replace(tmp, path)
+}
+
+/// Put the complete temporary file in `path`'s place, atomically for readers.
+///
+/// Renaming over an existing file makes ext4 (with its default `auto_da_alloc`) write the
+/// new file's blocks out before the rename returns, its guard against the empty files that
+/// unsynced rename-replacements leave after a crash: about 100 ms for a 168 MB soup, a third
+/// of the conversion. The artifacts carry their own guard (length and checksum), so where
+/// the target exists the two names are exchanged instead, which the heuristic leaves
+/// alone, and the old file, now under the temporary name, is deleted. Readers see the old
+/// file or the new one, whole, as with a rename. A file system that cannot exchange gets
+/// the plain rename.
+fn replace(tmp: tempfile::NamedTempFile, path: &Path) -> Result<(), FormatError> {
+    #[cfg(target_os = "linux")]
+    {
+        use rustix::fs::{renameat_with, RenameFlags, CWD};
+        // Only a regular file is exchanged: a folder (or a link) in the way must meet the
+        // rename's refusal, not be moved aside under the temporary name.
+        let replaces_file = std::fs::symlink_metadata(path).is_ok_and(|m| m.is_file());
+        if replaces_file && renameat_with(CWD, tmp.path(), CWD, path, RenameFlags::EXCHANGE).is_ok()
+        {
+            // Dropping the temporary file deletes what its name now holds: the old artifact.
+            return tmp.close().map_err(|e| FormatError::io(path, e));
+        }
+    }
     tmp.persist(path)
         .map_err(|e| FormatError::io(path, e.error))?;
     Ok(())

@@ -39,7 +39,9 @@ pub struct Texture {
     pub source: String,
     pub width: u32,
     pub height: u32,
-    /// `width · height · 4` bytes, RGBA, bottom row first.
+    /// `width · height · 4` bytes, RGBA, bottom row first. (Encoded as bytes: the same
+    /// bincode layout as a `Vec<u8>`, written and read as one block.)
+    #[serde(with = "serde_bytes")]
     pub texels: Vec<u8>,
     /// Colour channels are sRGB-encoded (alpha never is).
     pub srgb: bool,

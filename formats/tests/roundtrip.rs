@@ -125,6 +125,10 @@ fn streamed_soup_file_is_the_encoded_bytes() {
     s.warnings = (0..2000)
         .map(|i| format!("warning {i} {}", "x".repeat(i)))
         .collect();
+    // Texels larger than the writer's buffer pass through it as one block.
+    s.textures[0].width = 256;
+    s.textures[0].height = 256;
+    s.textures[0].texels = (0..256 * 256 * 4).map(|i| (i * 7 % 251) as u8).collect();
     s.seal();
     // The geometry hash is over the coordinates as f32 little-endian, however it is computed.
     let mut le = Vec::new();
@@ -146,6 +150,20 @@ fn streamed_soup_file_is_the_encoded_bytes() {
     let serde_payload = bincode::serde::encode_to_vec(&s, config).unwrap();
     assert!(bytes[52..] == serde_payload[..]);
     assert_eq!(Soup::read(&path).unwrap(), s);
+}
+
+/// Texels are encoded as bytes (one block); bincode lays those out exactly as the
+/// `Vec<u8>` that SOUP.md documents.
+#[test]
+fn texel_bytes_encode_as_a_vec_of_u8() {
+    let config = bincode::config::standard()
+        .with_little_endian()
+        .with_fixed_int_encoding();
+    let texels: Vec<u8> = (0..=255).collect();
+    let as_seq = bincode::serde::encode_to_vec(&texels, config).unwrap();
+    let as_bytes = bincode::serde::encode_to_vec(serde_bytes::Bytes::new(&texels), config).unwrap();
+    assert_eq!(as_seq.len(), 8 + 256);
+    assert_eq!(as_seq, as_bytes);
 }
 
 #[test]
@@ -473,4 +491,44 @@ fn culling_keeps_the_side_the_winding_shows() {
     assert!(Cull::Front.skips(n, towards_front));
     assert!(!Cull::None.skips(n, -towards_front));
     assert!(!Cull::Back.skips(n, Vec3::X), "edge-on hits are kept");
+}
+
+/// An artifact written over an existing one replaces it (the names are exchanged, then the
+/// old file is deleted): the new bytes at the path, the old file gone, no temporary left.
+#[test]
+fn writing_over_an_artifact_replaces_it_and_leaves_nothing_behind() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scene.soup");
+    let mut s = sample_soup();
+    s.write(&path).unwrap();
+    assert_eq!(Soup::read(&path).unwrap(), s);
+    s.warnings.push("second".into());
+    s.write(&path).unwrap();
+    assert_eq!(Soup::read(&path).unwrap(), s);
+    let kd = dir.path().join("t.kd");
+    sample_kd().write(&kd).unwrap();
+    sample_kd().write(&kd).unwrap();
+    let mut names: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["scene.soup", "t.kd"]);
+}
+
+/// A folder where the artifact should go is refused as before, and left where it is.
+#[test]
+fn writing_over_a_folder_fails_and_keeps_the_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scene.soup");
+    std::fs::create_dir(&path).unwrap();
+    std::fs::write(path.join("inside"), b"x").unwrap();
+    let msg = sample_soup().write(&path).unwrap_err().to_string();
+    assert!(msg.contains("scene.soup"), "{msg}");
+    assert_eq!(std::fs::read(path.join("inside")).unwrap(), b"x");
+    let names: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(names, ["scene.soup"]);
 }

@@ -34,8 +34,10 @@ fn scene() -> String {
     s += &object(20, "Front", 0, [0.0, 1.0, 0.0], false, QUAD);
     s += &object(30, "OnLayer8", 8, [4.0, 1.0, 0.0], false, CUBE);
     s += &object(40, "Far", 0, [0.0, 4.0, 0.0], false, CUBE);
-    // The LODGroup shows Front up close (LOD0) and Far (LOD1) from afar.
-    s += "--- !u!1 &50\nGameObject:\n  m_Component:\n  - component: {fileID: 51}\n  - component: {fileID: 52}\n  m_Layer: 0\n  m_Name: Group\n  m_IsActive: 1\n--- !u!4 &51\nTransform:\n  m_GameObject: {fileID: 50}\n  m_LocalRotation: {x: 0, y: 0, z: 0, w: 1}\n  m_LocalPosition: {x: 0, y: 0, z: 0}\n  m_LocalScale: {x: 1, y: 1, z: 1}\n  m_Children: []\n  m_Father: {fileID: 0}\n--- !u!205 &52\nLODGroup:\n  m_GameObject: {fileID: 50}\n  m_Enabled: 1\n  serializedVersion: 2\n  m_LODs:\n  - screenRelativeHeight: 0.5\n    renderers:\n    - renderer: {fileID: 23}\n  - screenRelativeHeight: 0.1\n    renderers:\n    - renderer: {fileID: 43}\n";
+    // The LODGroup shows Front up close (LOD0) and Far (LOD1) from afar: 12 m across and
+    // 10.05 m from the camera, its relative screen height is 6 / (10.05 · tan 30°) = 1.03,
+    // above LOD0's 0.5.
+    s += "--- !u!1 &50\nGameObject:\n  m_Component:\n  - component: {fileID: 51}\n  - component: {fileID: 52}\n  m_Layer: 0\n  m_Name: Group\n  m_IsActive: 1\n--- !u!4 &51\nTransform:\n  m_GameObject: {fileID: 50}\n  m_LocalRotation: {x: 0, y: 0, z: 0, w: 1}\n  m_LocalPosition: {x: 0, y: 0, z: 0}\n  m_LocalScale: {x: 1, y: 1, z: 1}\n  m_Children: []\n  m_Father: {fileID: 0}\n--- !u!205 &52\nLODGroup:\n  m_GameObject: {fileID: 50}\n  m_Enabled: 1\n  serializedVersion: 2\n  m_LocalReferencePoint: {x: 0, y: 0, z: 0}\n  m_Size: 12\n  m_LODs:\n  - screenRelativeHeight: 0.5\n    renderers:\n    - renderer: {fileID: 23}\n  - screenRelativeHeight: 0.1\n    renderers:\n    - renderer: {fileID: 43}\n";
     s
 }
 

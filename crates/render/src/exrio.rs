@@ -107,8 +107,13 @@ impl ExrImage {
         Some(self.channel(name)?.value_by_flat_index(i).to_f32())
     }
 
-    /// Encode as an EXR file in memory.
+    /// Encode as an EXR file in memory, ZIP-compressed in blocks of 16 scan lines.
     pub fn encode(&self) -> std::result::Result<Vec<u8>, String> {
+        self.encode_with(Encoding::SMALL_LOSSLESS)
+    }
+
+    /// Encode with another compression and block layout (what `exrwrite` compares).
+    pub fn encode_with(&self, encoding: Encoding) -> std::result::Result<Vec<u8>, String> {
         let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = self
             .channels
             .iter()
@@ -133,12 +138,7 @@ impl ExrImage {
             };
             attrs.other.insert(k, AttributeValue::Text(v));
         }
-        let layer = Layer::new(
-            size,
-            attrs,
-            Encoding::SMALL_LOSSLESS,
-            AnyChannels::sort(list),
-        );
+        let layer = Layer::new(size, attrs, encoding, AnyChannels::sort(list));
         let display = IntegerBounds::new((0, 0), (self.width as usize, self.height as usize));
         let image = Image::new(ImageAttributes::new(display), layer);
         let mut out = Cursor::new(Vec::new());

@@ -182,11 +182,11 @@ fn run(cli: Cli) -> Result<()> {
             std::fs::create_dir_all(dir)
                 .with_context(|| format!("cannot create cache folder {}", dir.display()))?;
             let path = dir.join(params.cache_name(&soup.geometry_hash));
-            let valid = path.exists()
-                && KdFile::read(&path)
-                    .is_ok_and(|kd| kd.geometry_hash == soup.geometry_hash && kd.params == params);
-            if valid {
-                return report(&cli, &soup, &KdFile::read(&path)?, &path, "hit", start);
+            let cached = path.exists().then(|| KdFile::read(&path).ok()).flatten();
+            if let Some(kd) =
+                cached.filter(|kd| kd.geometry_hash == soup.geometry_hash && kd.params == params)
+            {
+                return report(&cli, &soup, &kd, &path, "hit", start);
             }
             (path, "miss")
         }
