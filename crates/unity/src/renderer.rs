@@ -235,7 +235,9 @@ impl Emitter<'_, '_> {
     }
 }
 
-/// Zero area, repeated or collinear vertices (up to float noise).
+/// Zero area, repeated or collinear vertices (up to float noise): |e1 × e2| ≤ 10⁻⁹·|e1|·|e2|,
+/// compared squared, so that no square root is taken for the millions of triangles that
+/// pass.
 fn degenerate(p: [Vec3; 3]) -> bool {
     if p[0] == p[1] || p[1] == p[2] || p[0] == p[2] {
         return true;
@@ -243,6 +245,5 @@ fn degenerate(p: [Vec3; 3]) -> bool {
     let a = p[0].as_dvec3();
     let e1 = p[1].as_dvec3() - a;
     let e2 = p[2].as_dvec3() - a;
-    let c = e1.cross(e2).length();
-    c <= 1e-9 * e1.length() * e2.length()
+    e1.cross(e2).length_squared() <= 1e-18 * e1.length_squared() * e2.length_squared()
 }
