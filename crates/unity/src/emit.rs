@@ -150,7 +150,7 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
                 if let Some(why) = lod_hidden.get(&smr) {
                     let line = format!("object {:?}: {why}; not converted", e.path(gi));
                     e.skipped.push(line);
-                } else {
+                } else if e.camera_draws(gi) {
                     e.skinned_object(gi, smr)?;
                 }
             }

@@ -369,6 +369,29 @@ fn a_skinned_renderer_in_a_level_not_shown_is_dropped_too() {
 }
 
 #[test]
+fn a_skinned_renderer_outside_the_cameras_culling_mask_is_not_converted() {
+    let mut sc = Scene::default();
+    sc.camera(&Tf::at(0.0, 0.0, -5.0));
+    sc.raw("  m_CullingMask:\n    serializedVersion: 2\n    m_Bits: 1\n");
+    for (go, name, layer) in [(60, "Seen", 0), (70, "Hidden", 5)] {
+        let (t, smr) = (go + 1, go + 2);
+        sc.raw(&format!(
+            "--- !u!1 &{go}\nGameObject:\n  m_Component:\n  - component: {{fileID: {t}}}\n  - component: {{fileID: {smr}}}\n  m_Layer: {layer}\n  m_Name: {name}\n  m_IsActive: 1\n--- !u!4 &{t}\nTransform:\n  m_GameObject: {{fileID: {go}}}\n  m_LocalRotation: {{x: 0, y: 0, z: 0, w: 1}}\n  m_LocalPosition: {{x: 0, y: 0, z: 0}}\n  m_LocalScale: {{x: 1, y: 1, z: 1}}\n  m_Children: []\n  m_Father: {{fileID: 0}}\n--- !u!137 &{smr}\nSkinnedMeshRenderer:\n  m_GameObject: {{fileID: {go}}}\n  m_Enabled: 1\n  m_Materials:\n  - {{fileID: 10303, guid: 0000000000000000f000000000000000, type: 0}}\n  m_Mesh: {{fileID: {QUAD}, guid: {BUILTIN}, type: 3}}\n  m_Bones: []\n"
+        ));
+    }
+    let (_d, root) = project(&[("Assets/s.unity", &sc.text)]);
+    let r =
+        unity::convert_report(&root.join("Assets/s.unity"), &unity::Options::default()).unwrap();
+    assert_eq!(r.soup.objects.len(), 1);
+    assert_eq!(r.soup.objects[0].name, "Seen");
+    assert_eq!(r.soup.triangles.len(), 2);
+    assert_eq!(
+        r.skipped,
+        ["object \"Hidden\": layer 5 is outside camera \"Main Camera\"'s culling mask; not converted"]
+    );
+}
+
+#[test]
 fn without_a_camera_a_lod_group_keeps_lod0() {
     let mut sc = Scene::default();
     let near = quad(&mut sc, 10, "Tree_LOD0", 0, "");
