@@ -178,6 +178,13 @@ fn sphere_points(b: &mut Builder, seg: u32, rings: u32, r: f32, y_of: impl Fn(f3
                 let phi = TAU * si as f32 / seg as f32;
                 let n = Vec3::new(st * phi.cos(), ct, -st * phi.sin());
                 let p = Vec3::new(n.x * r, y_of(n.y * r), n.z * r);
+                // Unity's Sphere layout: v the latitude, 0 at the south pole; u the
+                // longitude, 0 (and 1) on Unity's −X side (this builder's +X), rising
+                // counter-clockwise seen from above. The seam columns exist twice already.
+                b.uv.push(Vec2::new(
+                    si as f32 / seg as f32,
+                    1.0 - ri as f32 / rings as f32,
+                ));
                 b.v(p, n)
             })
             .collect();
@@ -221,7 +228,8 @@ fn capsule(seg: u32, half_rings: u32) -> Mesh {
         }
     });
     // The equator row sits at y = 0 from the closure above; rebuild it as two rows so
-    // the side spans y ∈ [−0.5, 0.5].
+    // the side spans y ∈ [−0.5, 0.5]. Unity's Capsule layout is not known here: no UVs.
+    b.uv.clear();
     let m = b.done();
     fix_capsule_equator(m, seg)
 }
@@ -382,9 +390,34 @@ mod tests {
             assert_eq!(*uv, Vec2::new(p.x + 0.5, p.y + 0.5), "{p}");
         }
         assert!(q.uvs.contains(&Vec2::ZERO) && q.uvs.contains(&Vec2::ONE));
-        for id in [10206, 10207, 10208] {
+        for id in [10206, 10208] {
             assert!(mesh(id).unwrap().uvs.is_empty(), "{id}");
         }
+    }
+
+    #[test]
+    fn sphere_uvs_are_latitude_and_longitude_from_unitys_minus_x() {
+        let m = mesh(10207).unwrap();
+        assert_eq!(m.uvs.len(), m.positions.len());
+        let at = |p: Vec3| -> Vec<Vec2> {
+            let found: Vec<Vec2> = (0..m.positions.len())
+                .filter(|&i| (m.positions[i] - p).length() < 1e-6)
+                .map(|i| m.uvs[i])
+                .collect();
+            assert!(!found.is_empty(), "no vertex at {p}");
+            found
+        };
+        // Unity space, on the equator: −X is the seam (u 0 on one side, 1 on the other),
+        // then −Z, +X and +Z a quarter turn apart, counter-clockwise seen from above.
+        let mut seam = at(Vec3::new(-0.5, 0.0, 0.0));
+        seam.sort_by(|a, b| a.x.total_cmp(&b.x));
+        assert_eq!(seam, [Vec2::new(0.0, 0.5), Vec2::new(1.0, 0.5)]);
+        assert_eq!(at(Vec3::new(0.0, 0.0, -0.5)), [Vec2::new(0.25, 0.5)]);
+        assert_eq!(at(Vec3::new(0.5, 0.0, 0.0)), [Vec2::new(0.5, 0.5)]);
+        assert_eq!(at(Vec3::new(0.0, 0.0, 0.5)), [Vec2::new(0.75, 0.5)]);
+        // The poles: v = 1 at the top, 0 at the bottom, whatever the longitude.
+        assert!(at(Vec3::new(0.0, 0.5, 0.0)).iter().all(|uv| uv.y == 1.0));
+        assert!(at(Vec3::new(0.0, -0.5, 0.0)).iter().all(|uv| uv.y == 0.0));
     }
 
     /// The UV of the Unity-space corner `p` of the face with normal `n`.
