@@ -41,21 +41,20 @@ fn yes(ok: bool) -> &'static str {
 fn targets(r: &Report, out: &mut String) {
     let mut rows = vec![];
     for s in &r.scenes {
-        let key = s.role == Role::Baseline || s.name.contains("bunny");
-        if key {
-            for kind in [Kind::Primary, Kind::Shadow] {
-                if let Some(x) = ratio(s, 1, kind) {
-                    rows.push((
-                        format!(
-                            "{}: {} rays, 1 thread, kdtree ≥ 0.7× Embree",
-                            s.name,
-                            kind.name()
-                        ),
-                        format!("{x:.2}×"),
-                        x >= 0.7,
-                    ));
-                }
-            }
+        // Every ray kind at or above Embree's single-ray speed: the row shows the slowest.
+        let worst = Kind::ALL
+            .iter()
+            .filter_map(|&kind| ratio(s, 1, kind).map(|x| (x, kind)))
+            .min_by(|a, b| a.0.total_cmp(&b.0));
+        if let Some((x, kind)) = worst {
+            rows.push((
+                format!(
+                    "{}: every ray kind, 1 thread, kdtree ≥ 1.0× Embree (slowest shown)",
+                    s.name
+                ),
+                format!("{x:.2}× ({})", kind.name()),
+                x >= 1.0,
+            ));
         }
         if s.role == Role::Baseline {
             let best = r
@@ -76,9 +75,9 @@ fn targets(r: &Report, out: &mut String) {
             if let Some(secs) = build_secs(s, KDTREE, 2) {
                 let rate = s.triangles as f64 / secs / 1e6;
                 rows.push((
-                    format!("{}: build ≥ 1 M triangles/s on 2 cores", s.name),
+                    format!("{}: build ≥ 2 M triangles/s on 2 cores", s.name),
                     format!("{rate:.2} M/s"),
-                    rate >= 1.0,
+                    rate >= 2.0,
                 ));
             }
             if let (Some(a), Some(b)) = (build_secs(s, KDTREE, 1), build_secs(s, KDTREE, 2)) {
