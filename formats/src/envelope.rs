@@ -31,7 +31,7 @@ fn config() -> bincode::config::Configuration<bincode::config::LittleEndian, bin
 
 /// An artifact type: its frame constants and how its payload is written and read.
 ///
-/// Payloads are bincode (see [`config`]), but their bulk — per-triangle arrays, tree nodes —
+/// Payloads are bincode (little-endian, fixed-width integers), but their bulk — per-triangle arrays, tree nodes —
 /// goes through [`PayloadWriter::array`] and [`PayloadReader::array`], which write and read
 /// the very bytes bincode would (a u64 count, then the elements little-endian) as one block
 /// instead of one call per number. A two-million-triangle soup is 168 MB; serialising it
@@ -48,7 +48,7 @@ pub trait Artifact: Sized {
     fn validate(&self) -> Result<(), String>;
 }
 
-/// The whole artifact file as bytes: what [`write`] puts in the file.
+/// The whole artifact file as bytes: what [`write()`] puts in the file.
 pub fn encode<A: Artifact>(value: &A, path: &Path) -> Result<Vec<u8>, FormatError> {
     let mut out = vec![0u8; HEADER_LEN];
     let mut p = PayloadWriter::new(&mut out, path);
@@ -173,7 +173,7 @@ pub(crate) fn hash_into(h: &mut blake3::Hasher, bytes: &[u8]) {
 }
 
 /// Where a payload's bytes go, hashed on their way. Small writes (bincode writes field by
-/// field) are gathered in a buffer; blocks of [`PASS_THROUGH`] bytes or more go straight
+/// field) are gathered in a buffer; blocks of 64 KiB or more go straight
 /// from the caller's memory to the hash and the file.
 pub struct PayloadWriter<'p, W> {
     out: W,
