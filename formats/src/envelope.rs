@@ -31,10 +31,10 @@ fn config() -> bincode::config::Configuration<bincode::config::LittleEndian, bin
 
 /// An artifact type: its frame constants and how its payload is written and read.
 ///
-/// Payloads are bincode (little-endian, fixed-width integers), but their bulk — per-triangle arrays, tree nodes —
-/// goes through [`PayloadWriter::array`] and [`PayloadReader::array`], which write and read
-/// the very bytes bincode would (a u64 count, then the elements little-endian) as one block
-/// instead of one call per number. A two-million-triangle soup is 168 MB; serialising it
+/// Payloads are bincode (little-endian, fixed-width integers), but their bulk — per-triangle
+/// arrays, tree nodes — goes through [`PayloadWriter::array`] and [`PayloadReader::array`],
+/// which write and read the very bytes bincode would (a u64 count, then the elements
+/// little-endian) as one block instead of one call per number. A two-million-triangle soup is 168 MB; serialising it
 /// float by float was the largest part of writing it.
 pub trait Artifact: Sized {
     const MAGIC: &'static [u8; 8];
