@@ -559,7 +559,6 @@ impl envelope::Artifact for Soup {
         let uvs = r.array("uvs")?;
         let tri_material = r.array("tri_material")?;
         let tri_object = r.array("tri_object")?;
-        let rest: SoupRest = r.value("the fields after tri_object")?;
         let (
             objects,
             materials,
@@ -570,7 +569,7 @@ impl envelope::Artifact for Soup {
             warnings,
             dropped_degenerate,
             geometry_hash,
-        ) = rest;
+        ): SoupRest = r.value("the fields after tri_object")?;
         Ok(Soup {
             triangles,
             normals,

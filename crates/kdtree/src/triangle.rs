@@ -147,8 +147,8 @@ const fn gamma(n: i32) -> f32 {
 /// the distance from the vertices' `z` (relative to the origin, before the z shear) and
 /// the interval. Shared by the one- and four-triangle tests so they give the same bits.
 ///
-/// A hit no farther than the bound on t's own rounding is refused (pbrt-v4's δt): the
-/// sign of such a t is not known. `xy` holds the largest |x| and |y| of the sheared
+/// A hit no farther than the bound on t's own rounding error is refused: the sign of such
+/// a t is not known. `xy` holds the largest |x| and |y| of the sheared
 /// vertices. Without this, a ray spawned a hair below a large triangle's plane (a small
 /// face lying flat on a big floor, the ray leaving downwards) could find that plane at a
 /// tiny positive t: on a 24 m triangle t rounds at the ULPs of metres.

@@ -133,26 +133,15 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
         }
         let comps = e.go_comps.get(&gi).cloned().unwrap_or_default();
         let class_of = |c: u32| comps.iter().copied().find(|&i| g.objs[i].class == c);
-        if let Some(mf) = class_of(docs::MESH_FILTER) {
-            if let Some(mr) = class_of(docs::MESH_RENDERER) {
-                if enabled(&g.objs[mr]) {
-                    if let Some(why) = lod_hidden.get(&mr) {
-                        let line = format!("object {:?}: {why}; not converted", e.path(gi));
-                        e.skipped.push(line);
-                    } else if e.camera_draws(gi) {
-                        e.mesh_object(gi, mf, mr)?;
-                    }
-                }
+        let mesh = (class_of(docs::MESH_FILTER), class_of(docs::MESH_RENDERER));
+        if let (Some(mf), Some(mr)) = mesh {
+            if e.draws(gi, mr, &lod_hidden) {
+                e.mesh_object(gi, mf, mr)?;
             }
         }
         if let Some(smr) = class_of(docs::SKINNED_MESH_RENDERER) {
-            if enabled(&g.objs[smr]) {
-                if let Some(why) = lod_hidden.get(&smr) {
-                    let line = format!("object {:?}: {why}; not converted", e.path(gi));
-                    e.skipped.push(line);
-                } else if e.camera_draws(gi) {
-                    e.skinned_object(gi, smr)?;
-                }
+            if e.draws(gi, smr, &lod_hidden) {
+                e.skinned_object(gi, smr)?;
             }
         }
         if class_of(docs::TERRAIN).is_some() {
@@ -186,4 +175,21 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
 /// A component's `m_Enabled` (on unless it says 0).
 pub(crate) fn enabled(o: &Obj) -> bool {
     o.body.i64_at("m_Enabled") != Some(0)
+}
+
+impl Emitter<'_, '_> {
+    /// Whether Unity draws `renderer` on GameObject `go`: enabled, listed in no LOD level
+    /// the camera leaves out (`lod_hidden`), on a layer the camera draws. An enabled
+    /// renderer that is not drawn is named in `skipped` with the reason.
+    fn draws(&mut self, go: usize, renderer: usize, lod_hidden: &HashMap<usize, String>) -> bool {
+        if !enabled(&self.g.objs[renderer]) {
+            return false;
+        }
+        if let Some(why) = lod_hidden.get(&renderer) {
+            let line = format!("object {:?}: {why}; not converted", self.path(go));
+            self.skipped.push(line);
+            return false;
+        }
+        self.camera_draws(go)
+    }
 }

@@ -161,13 +161,7 @@ pub fn project() -> Project {
     square_on(&mut b, "Tiled").scene("Tiling", NO_AMBIENT);
     // (d) A cut-out Quad whose left half is a hole, 1 m in front of a wall; the sun comes
     // from the front left, so the right half's shadow falls on the wall to its right.
-    b.camera(Xform::at(0.0, 0.0, -3.0), CameraDesc::default())
-        .mesh(
-            "Wall",
-            unity::QUAD,
-            "Wall",
-            Xform::at(0.0, 0.0, 1.0).uniform(6.0),
-        )
+    before_wall(&mut b)
         .mesh("Cutout", unity::QUAD, "Cutout", Xform::at(0.0, 0.0, 0.0))
         .light(
             "Sun",
@@ -176,6 +170,15 @@ pub fn project() -> Project {
         )
         .scene("Cutout", NO_AMBIENT);
     // (e) A red Quad of tint alpha 0.5 (Transparent mode) in front of the wall.
+    before_wall(&mut b)
+        .mesh("Glass", unity::QUAD, "HalfRed", Xform::at(0.0, 0.0, 0.0))
+        .light("Sun", Xform::at(0.0, 3.0, -3.0), sun())
+        .scene("Transparent", NO_AMBIENT);
+    b.done()
+}
+
+/// A perspective camera 3 m in front of a 6 m wall (a Quad 1 m behind the origin).
+fn before_wall(b: &mut Builder) -> &mut Builder {
     b.camera(Xform::at(0.0, 0.0, -3.0), CameraDesc::default())
         .mesh(
             "Wall",
@@ -183,10 +186,6 @@ pub fn project() -> Project {
             "Wall",
             Xform::at(0.0, 0.0, 1.0).uniform(6.0),
         )
-        .mesh("Glass", unity::QUAD, "HalfRed", Xform::at(0.0, 0.0, 0.0))
-        .light("Sun", Xform::at(0.0, 3.0, -3.0), sun())
-        .scene("Transparent", NO_AMBIENT);
-    b.done()
 }
 
 /// A camera 2 m in front of a 1×1 Quad drawn with `look`, lit square-on.
