@@ -17,7 +17,7 @@
 //! rules cost lives in the bench crate.
 
 use crate::aabb::Aabb;
-use crate::triangle::{self, RawHit, RayPre};
+use crate::triangle::{self, Hits4, RawHit, RayPre};
 use crate::Ray;
 use formats::{Hit, KdNode};
 use std::mem::MaybeUninit;
@@ -331,7 +331,7 @@ impl Tree<'_> {
         ray: &Ray,
         group: &[u32],
         tmax: f32,
-    ) -> ([u32; 4], [Option<RawHit>; 4]) {
+    ) -> ([u32; 4], Hits4) {
         let last = group[group.len() - 1];
         let lanes: [u32; 4] = std::array::from_fn(|l| *group.get(l).unwrap_or(&last));
         let tris = lanes.map(|p| self.tri(p));
@@ -394,8 +394,8 @@ impl Tree<'_> {
                 for group in leaf.chunks(4) {
                     let bound = triangle::widen(best_t);
                     let (lanes, hits) = self.test4::<KZ>(s, ray, group, bound);
-                    for (p, h) in lanes.into_iter().zip(hits) {
-                        if let Some(h) = h {
+                    for (l, p) in lanes.into_iter().enumerate() {
+                        if let Some(h) = hits.lane(l) {
                             keep_closer(&mut best, &mut best_t, self.soup_index(p), h, accept);
                         }
                     }
@@ -476,8 +476,8 @@ impl Tree<'_> {
             if leaf.len() >= 2 {
                 for group in leaf.chunks(4) {
                     let (lanes, hits) = self.test4::<KZ>(s, ray, group, ray.tmax);
-                    for (p, h) in lanes.into_iter().zip(hits) {
-                        if let Some(h) = h {
+                    for (l, p) in lanes.into_iter().enumerate() {
+                        if let Some(h) = hits.lane(l) {
                             if blocks(&candidate(self.soup_index(p), h)) {
                                 return true;
                             }

@@ -181,17 +181,8 @@ fn finish(
     // The bound is a few ulps of the vertices' depth from the origin unless the triangle
     // is seen almost edge-on, so it is worked out only for a t below 2⁻¹⁰ of that depth.
     let max_z = max3(sz * z[0], sz * z[1], sz * z[2]);
-    if t < max_z * (1.0 / 1024.0) {
-        let [max_x, max_y] = xy;
-        let dz = gamma(3) * max_z;
-        let dx = gamma(5) * (max_x + max_z);
-        let dy = gamma(5) * (max_y + max_z);
-        let de = 2.0 * (gamma(2) * max_x * max_y + dy * max_x + dx * max_y);
-        let max_e = max3(u, v, w);
-        let dt = 3.0 * (gamma(3) * max_e * max_z + de * max_z + dz * max_e) * inv.abs();
-        if t <= dt {
-            return None;
-        }
+    if t < max_z * (1.0 / 1024.0) && t <= t_error([u, v, w], max_z, xy, inv) {
+        return None;
     }
     Some(RawHit {
         t,
@@ -200,29 +191,62 @@ fn finish(
     })
 }
 
-/// [`intersect_along`] for four triangles at once: the translation, shear and edge
-/// functions run lane by lane on `[f32; 4]` (which the compiler turns into SIMD), the
-/// rest only for lanes whose edge functions agree in sign. Each lane's arithmetic is the
+/// The answers of [`intersect4_along`], lane by lane: `hit[l]` says whether lane `l` hit,
+/// and `t`, `u`, `v` hold its hit where it did (anything elsewhere).
+#[derive(Clone, Copy, Debug)]
+pub struct Hits4 {
+    pub hit: [bool; 4],
+    pub t: [f32; 4],
+    pub u: [f32; 4],
+    pub v: [f32; 4],
+}
+
+impl Hits4 {
+    /// Lane `l`'s answer as the scalar test gives it.
+    #[inline(always)]
+    pub fn lane(&self, l: usize) -> Option<RawHit> {
+        self.hit[l].then_some(RawHit {
+            t: self.t[l],
+            u: self.u[l],
+            v: self.v[l],
+        })
+    }
+}
+
+/// The bound on the rounding error of a hit's t: `uvw` the edge functions, `max_z` the
+/// largest |z| of the sheared vertices, `xy` their largest |x| and |y|, `inv` 1/det.
+#[inline(always)]
+fn t_error(uvw: [f32; 3], max_z: f32, xy: [f32; 2], inv: f32) -> f32 {
+    let [max_x, max_y] = xy;
+    let dz = gamma(3) * max_z;
+    let dx = gamma(5) * (max_x + max_z);
+    let dy = gamma(5) * (max_y + max_z);
+    let de = 2.0 * (gamma(2) * max_x * max_y + dy * max_x + dx * max_y);
+    let max_e = max3(uvw[0], uvw[1], uvw[2]);
+    3.0 * (gamma(3) * max_e * max_z + de * max_z + dz * max_e) * inv.abs()
+}
+
+/// [`intersect_along`] for four triangles at once, every step lane by lane on `[f32; 4]`
+/// with masks instead of early returns, so the compiler turns all of it into SIMD and
+/// nothing leaves registers until the caller reads the hits. Each lane's arithmetic is the
 /// scalar test's, in the same order, so each lane's answer has the same bits as
-/// `intersect_along` on that triangle; a group with an edge function exactly zero is
-/// handed to the scalar test whole, for its f64 decision.
+/// `intersect_along` on that triangle (lanes that miss compute values nobody reads); a
+/// group with an edge function exactly zero is handed to the scalar test whole, for its
+/// f64 decision.
 #[inline(always)]
 pub fn intersect4_along<const KZ: usize>(
     r: &RayPre,
     tri: [&[[f32; 3]; 3]; 4],
     tmin: f32,
     tmax: f32,
-) -> [Option<RawHit>; 4] {
+) -> Hits4 {
     debug_assert_eq!(r.kz, KZ);
     let kx = (KZ + 1) % 3;
     let ky = (KZ + 2) % 3;
-    let (sx, sy, o) = (r.sx, r.sy, r.origin);
-    // Written as `tri.map(…)` instead, the same gathers made bunny and nefertiti rays 5–9 %
-    // slower (kdtune, three interleaved rounds, 2026-12-01): the compiler lays it out worse.
+    let (sx, sy, sz, o) = (r.sx, r.sy, r.sz, r.origin);
     let lanes = |f: &dyn Fn(&[[f32; 3]; 3]) -> f32| -> [f32; 4] {
         [f(tri[0]), f(tri[1]), f(tri[2]), f(tri[3])]
     };
-    // Vertex v's coordinate k relative to the origin.
     let az = lanes(&|t| t[0][KZ] - o[KZ]);
     let bz = lanes(&|t| t[1][KZ] - o[KZ]);
     let cz = lanes(&|t| t[2][KZ] - o[KZ]);
@@ -234,7 +258,7 @@ pub fn intersect4_along<const KZ: usize>(
     let mut cy = lanes(&|t| t[2][ky] - o[ky]);
     let (mut u, mut v, mut w) = ([0f32; 4], [0f32; 4], [0f32; 4]);
     let mut zero = false;
-    let mut outside = [false; 4];
+    let mut inside = [false; 4];
     for l in 0..4 {
         ax[l] -= sx * az[l];
         ay[l] -= sy * az[l];
@@ -246,29 +270,59 @@ pub fn intersect4_along<const KZ: usize>(
         v[l] = ax[l] * cy[l] - ay[l] * cx[l];
         w[l] = bx[l] * ay[l] - by[l] * ax[l];
         zero |= (u[l] == 0.0) | (v[l] == 0.0) | (w[l] == 0.0);
-        outside[l] = ((u[l] < 0.0) | (v[l] < 0.0) | (w[l] < 0.0))
-            & ((u[l] > 0.0) | (v[l] > 0.0) | (w[l] > 0.0));
+        inside[l] = !(((u[l] < 0.0) | (v[l] < 0.0) | (w[l] < 0.0))
+            & ((u[l] > 0.0) | (v[l] > 0.0) | (w[l] > 0.0)));
     }
+    let mut out = Hits4 {
+        hit: [false; 4],
+        t: [0.0; 4],
+        u: [0.0; 4],
+        v: [0.0; 4],
+    };
     if zero {
-        return std::array::from_fn(|l| intersect_along::<KZ>(r, tri[l], tmin, tmax));
-    }
-    if outside == [true; 4] {
-        return [None; 4];
-    }
-    std::array::from_fn(|l| {
-        if outside[l] {
-            return None;
+        for (l, t) in tri.into_iter().enumerate() {
+            if let Some(h) = intersect_along::<KZ>(r, t, tmin, tmax) {
+                (out.hit[l], out.t[l], out.u[l], out.v[l]) = (true, h.t, h.u, h.v);
+            }
         }
-        let xy = [max3(ax[l], bx[l], cx[l]), max3(ay[l], by[l], cy[l])];
-        finish(
-            [u[l], v[l], w[l]],
-            [az[l], bz[l], cz[l]],
-            xy,
-            r.sz,
-            tmin,
-            tmax,
-        )
-    })
+        return out;
+    }
+    if inside == [false; 4] {
+        return out;
+    }
+    // `finish`, lane by lane, with its early returns as masks.
+    let mut near = [false; 4];
+    let mut max_z = [0f32; 4];
+    let mut inv = [0f32; 4];
+    for l in 0..4 {
+        let det = u[l] + v[l] + w[l];
+        let (zu, zv, zw) = (sz * az[l], sz * bz[l], sz * cz[l]);
+        let tt = u[l] * zu + v[l] * zv + w[l] * zw;
+        let negative = det < 0.0;
+        let tt = if negative { -tt } else { tt };
+        let adet = if negative { -det } else { det };
+        let t = tt / adet;
+        inv[l] = 1.0 / det;
+        max_z[l] = max3(zu, zv, zw);
+        near[l] = t < max_z[l] * (1.0 / 1024.0);
+        out.hit[l] = inside[l]
+            & (det != 0.0)
+            & !det.is_nan()
+            & (tt >= tmin * adet)
+            & (tt <= tmax * adet)
+            & (t >= tmin)
+            & (t <= tmax);
+        out.t[l] = t;
+        out.u[l] = v[l] * inv[l];
+        out.v[l] = w[l] * inv[l];
+    }
+    for l in 0..4 {
+        if out.hit[l] && near[l] {
+            let xy = [max3(ax[l], bx[l], cx[l]), max3(ay[l], by[l], cy[l])];
+            out.hit[l] = out.t[l] > t_error([u[l], v[l], w[l]], max_z[l], xy, inv[l]);
+        }
+    }
+    out
 }
 
 #[cfg(test)]
@@ -348,9 +402,9 @@ mod tests {
                 1 => intersect4_along::<1>(&r, group, 0.0, tmax),
                 _ => intersect4_along::<2>(&r, group, 0.0, tmax),
             };
-            for l in 0..4 {
-                let one = intersect(&r, &tris[l], 0.0, tmax);
-                assert_eq!(bits(four[l]), bits(one), "group {i}, lane {l}");
+            for (l, tri) in tris.iter().enumerate() {
+                let one = intersect(&r, tri, 0.0, tmax);
+                assert_eq!(bits(four.lane(l)), bits(one), "group {i}, lane {l}");
                 hits += one.is_some() as u32;
                 if let Some(h) = one {
                     on_edges += (h.u == 0.0 || h.v == 0.0 || h.u + h.v == 1.0) as u32;
@@ -430,7 +484,7 @@ mod tests {
                 refused += 1;
             }
             let group = intersect4_along_any(&r, [&floor; 4]);
-            assert!(group.iter().all(Option::is_none), "four-wide, origin {o}");
+            assert_eq!(group.hit, [false; 4], "four-wide, origin {o}");
         }
         assert_eq!(refused, 200);
         // A real hit far beyond the rounding bound is kept.
@@ -439,7 +493,7 @@ mod tests {
         assert!((h.t - 1.0 / -dir.y).abs() < 1e-5, "{}", h.t);
     }
 
-    fn intersect4_along_any(r: &RayPre, tri: [&[[f32; 3]; 3]; 4]) -> [Option<RawHit>; 4] {
+    fn intersect4_along_any(r: &RayPre, tri: [&[[f32; 3]; 3]; 4]) -> Hits4 {
         match r.kz {
             0 => intersect4_along::<0>(r, tri, f32::MIN_POSITIVE, f32::INFINITY),
             1 => intersect4_along::<1>(r, tri, f32::MIN_POSITIVE, f32::INFINITY),
