@@ -17,6 +17,9 @@ pub struct RayCounts {
     /// Hits that shadow rays passed through: surfaces that cast no shadow that way and
     /// cut-out holes.
     pub shadow_pass_through: u64,
+    /// Shadow rays taken as blocked where they passed into a closed piece of an object:
+    /// the face they would leave it by casts (see `render::solid`).
+    pub shadow_solid: u64,
     /// Camera and reflection rays continued past a blended (Transparent/Fade) surface for
     /// the light behind it: each a query from the hit onwards.
     pub blend_continuation: u64,
@@ -40,6 +43,7 @@ impl RayCounts {
         self.reflection += o.reflection;
         self.pass_through += o.pass_through;
         self.shadow_pass_through += o.shadow_pass_through;
+        self.shadow_solid += o.shadow_solid;
         self.blend_continuation += o.blend_continuation;
         self.shadow_blend += o.shadow_blend;
         self.texture_lookups += o.texture_lookups;
@@ -60,6 +64,7 @@ pub struct SharedCounts {
     reflection: AtomicU64,
     pass_through: AtomicU64,
     shadow_pass_through: AtomicU64,
+    shadow_solid: AtomicU64,
     blend_continuation: AtomicU64,
     shadow_blend: AtomicU64,
     texture_lookups: AtomicU64,
@@ -76,6 +81,7 @@ impl SharedCounts {
         self.pass_through.fetch_add(c.pass_through, Relaxed);
         self.shadow_pass_through
             .fetch_add(c.shadow_pass_through, Relaxed);
+        self.shadow_solid.fetch_add(c.shadow_solid, Relaxed);
         self.blend_continuation
             .fetch_add(c.blend_continuation, Relaxed);
         self.shadow_blend.fetch_add(c.shadow_blend, Relaxed);
@@ -91,6 +97,7 @@ impl SharedCounts {
             reflection: self.reflection.load(Relaxed),
             pass_through: self.pass_through.load(Relaxed),
             shadow_pass_through: self.shadow_pass_through.load(Relaxed),
+            shadow_solid: self.shadow_solid.load(Relaxed),
             blend_continuation: self.blend_continuation.load(Relaxed),
             shadow_blend: self.shadow_blend.load(Relaxed),
             texture_lookups: self.texture_lookups.load(Relaxed),

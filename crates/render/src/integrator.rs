@@ -32,6 +32,7 @@ use crate::offset::{
 };
 use crate::plan::{colour_mapped, Plan, ShadowMode};
 use crate::sampling::{disc_sample, Rng};
+use crate::solid::Solids;
 use crate::texture::{cone_footprint, Sampler};
 use crate::TextureFilter;
 use formats::{CastShadows, Cull, Hit, Light, LightKind, Soup, Tiling};
@@ -149,6 +150,8 @@ pub struct Integrator<'a> {
     samplers: Vec<Sampler>,
     /// One per material (empty when textures and alpha are off).
     surfacing: Vec<Surfacing>,
+    /// Closed pieces of objects, asked about by opaque shadow rays passing into them.
+    solids: Solids<'a>,
 }
 
 /// Replace NaN and ±Inf channels by 0; true when something was replaced.
@@ -205,6 +208,7 @@ impl<'a> Integrator<'a> {
         } else {
             (Vec::new(), Vec::new())
         };
+        let shadow_filter = plan.shadow_casting.enabled || alpha;
         Integrator {
             soup,
             accel,
@@ -219,11 +223,16 @@ impl<'a> Integrator<'a> {
             cutoff: plan.reflections.cutoff,
             soft_samples,
             culling: plan.culling.enabled,
-            shadow_filter: plan.shadow_casting.enabled || alpha,
+            shadow_filter,
             alpha,
             filter,
             samplers,
             surfacing,
+            solids: if shadow_filter && !alpha {
+                Solids::new(soup)
+            } else {
+                Solids::none(soup)
+            },
         }
     }
 
@@ -618,9 +627,15 @@ impl<'a> Integrator<'a> {
         }
         if !self.alpha {
             let blocked = self.accel.occluded_filtered(&ray, |hit| {
-                let casts = self.casts(hit.prim as usize, ray.dir);
-                counts.shadow_pass_through += !casts as u64;
-                casts
+                let prim = hit.prim as usize;
+                if self.casts(prim, ray.dir) {
+                    return true;
+                }
+                counts.shadow_pass_through += 1;
+                // Entering a closed piece: the face it leaves by casts (see `solid`).
+                let solid = self.solids.blocks(prim, &ray);
+                counts.shadow_solid += solid as u64;
+                solid
             });
             return if blocked { 0.0 } else { 1.0 };
         }

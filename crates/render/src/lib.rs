@@ -32,6 +32,7 @@ pub mod plan;
 pub mod preview;
 pub mod render;
 pub mod sampling;
+pub mod solid;
 pub mod texture;
 
 pub use aov::{Aov, AovSet};

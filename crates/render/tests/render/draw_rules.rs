@@ -243,3 +243,82 @@ fn a_light_leaves_objects_outside_its_culling_mask_unlit() {
         .reason
         .contains("lights layers 0xfffffeff only"));
 }
+
+/// A white floor lit by a sun travelling along `sun`, and a 1 m box over it at
+/// y ∈ [1, 2], x, z ∈ [−0.5, 0.5] whose material culls `cull`; `open_top` leaves out its
+/// two top triangles. The camera sees x, z ∈ [−2, 2] from above, 20 × 20 pixels.
+fn box_over_floor(cull: Cull, open_top: bool, sun: Vec3) -> render::Rendered {
+    let mut s = SceneBuilder::new();
+    let white = s.material(Material {
+        cull: Cull::Back,
+        ..diffuse(Vec3::ONE)
+    });
+    s.floor(0.0, 0.0, 0.0, 20.0, white);
+    let grey = s.material(Material {
+        cull,
+        ..diffuse(Vec3::splat(0.5))
+    });
+    let first = s.soup.triangles.len();
+    s.cube(
+        "box",
+        Vec3::new(-0.5, 1.0, -0.5),
+        Vec3::new(0.5, 2.0, 0.5),
+        grey,
+    );
+    if open_top {
+        // The builder writes bottom, top, −Z, +Z, −X, +X, two triangles each.
+        let top = first + 2..first + 4;
+        s.soup.triangles.drain(top.clone());
+        s.soup.uvs.drain(top.clone());
+        s.soup.normals.drain(top.clone());
+        s.soup.tri_material.drain(top.clone());
+        s.soup.tri_object.drain(top);
+    }
+    s.light(directional_light(sun, 1.0, Shadows::Hard));
+    s.camera(top_down_camera(Vec3::new(0.0, 10.0, 0.0), 2.0));
+    let (soup, kd) = s.build();
+    render(&soup, &kd, &opts(20, 20)).0
+}
+
+#[test]
+fn a_closed_back_culled_box_shadows_exactly_as_a_two_sided_one() {
+    // Shadow rays from the floor enter the box by a face the shadow pass culls and leave
+    // by one that casts: the closed box is taken as blocking where they enter, and the
+    // image is the two-sided box's to the bit.
+    let sun = Vec3::new(-1.0, -1.0, 0.0);
+    let culled = box_over_floor(Cull::Back, false, sun);
+    let two_sided = box_over_floor(Cull::None, false, sun);
+    assert!(culled.counts.shadow_solid > 0, "{:?}", culled.counts);
+    assert_eq!(two_sided.counts.shadow_solid, 0);
+    for y in 0..20 {
+        for x in 0..20 {
+            let (a, b) = (culled.frame.pixel(x, y), two_sided.frame.pixel(x, y));
+            let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+            assert_eq!(bits(a), bits(b), "pixel ({x}, {y})");
+        }
+    }
+    // (−0.9, 0, −0.1) lies in the box's shadow, (−0.9, 0, −1.9) beside it (n·l = 1/√2).
+    assert_eq!(culled.frame.pixel(14, 10), Vec3::ZERO);
+    assert_close(
+        culled.frame.pixel(14, 19),
+        Vec3::splat(LIT),
+        1e-5,
+        "lit floor",
+    );
+}
+
+#[test]
+fn a_box_open_at_the_top_lets_the_light_through_its_culled_bottom() {
+    // Under a sun straight above, the floor's shadow ray enters by the culled bottom and
+    // leaves through the missing top: nothing casts, and the camera sees the lit floor
+    // through the open top and the culled bottom.
+    let out = box_over_floor(Cull::Back, true, Vec3::new(0.0, -1.0, 0.0));
+    assert_eq!(out.counts.shadow_solid, 0, "{:?}", out.counts);
+    assert!(out.counts.shadow_pass_through > 0);
+    assert_close(
+        out.frame.pixel(10, 10),
+        Vec3::ONE,
+        1e-5,
+        "floor under the open box",
+    );
+}
