@@ -82,7 +82,8 @@ impl<'a> Solids<'a> {
 
     /// Whether `ray`, which met triangle `prim` on a face its shadow pass culls, is sure
     /// to meet a face of the same piece that casts before `ray.tmax`: the piece is solid
-    /// (see [`closed_pieces`]) and the ray starts and ends outside its box.
+    /// (closed and casting as Unity's default shadow pass does) and the ray starts and ends
+    /// outside its box.
     pub fn blocks(&self, prim: usize, ray: &Ray) -> bool {
         let Some(&o) = self.soup.tri_object.get(prim) else {
             return false;
