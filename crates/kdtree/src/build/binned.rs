@@ -202,7 +202,8 @@ pub(super) fn find_split(ctx: &Ctx, refs: &[Ref], cell: &Aabb) -> Search {
     } else {
         histogram(refs, &slabs)
     };
-    let axes: [Option<AxisCost>; 3] = std::array::from_fn(|a| AxisCost::new(cell, a, ctx.bonus));
+    let axes: [Option<AxisCost>; 3] =
+        std::array::from_fn(|a| AxisCost::new(cell, a, ctx.bonus, refs.len()));
     let pos = events::unordered;
 
     // Upper bounds from each slab's end positions, and the lower bound of each slab.
@@ -301,6 +302,7 @@ pub(super) fn find_split(ctx: &Ctx, refs: &[Ref], cell: &Aabb) -> Search {
             ended += e + p;
         }
         found[axis] = best.at.map(|(pos, planar_below)| Split {
+            rank: best.rank,
             cost: AxisCost::cost(best.rank, ctx.kt, ctx.ki, area),
             axis,
             pos,

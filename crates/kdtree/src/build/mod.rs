@@ -76,6 +76,8 @@ struct Work {
 
 #[derive(Clone, Copy, Debug)]
 struct Split {
+    /// The plane's rank on its axis ([`sah::AxisCost::at`]) and its SAH cost.
+    rank: f64,
     cost: f64,
     axis: usize,
     pos: f32,
@@ -315,16 +317,24 @@ fn build_rec(ctx: &Ctx, w: Work, depth: u32, out: &mut Subtree) {
     out.nodes[at] = KdNode::interior(split.axis as u32, split.pos, above_at);
 }
 
+/// The cheapest split of the cell that beats a leaf (None when no plane does).
 fn find_split(ctx: &Ctx, w: &Work, parallel: bool) -> Option<Split> {
     let area = w.cell.area();
     if !(area > 0.0) || !area.is_finite() {
         return None;
     }
-    let sweep = |axis: usize| {
-        let ax = AxisCost::new(&w.cell, axis, ctx.bonus)?;
-        let mut best = Best::NONE;
-        sah::sweep(&ax, &w.events[axis], 0.0, w.tris.len() as f64, &mut best);
+    let n = w.tris.len();
+    // Planes ranked at or above this cost at least a leaf: no sweep needs to look at them.
+    let leaf = leaf_rank(ctx, n, area);
+    let sweep = |axis: usize, beat: f64| {
+        let ax = AxisCost::new(&w.cell, axis, ctx.bonus, n)?;
+        let mut best = Best {
+            rank: beat,
+            at: None,
+        };
+        sah::sweep(&ax, &w.events[axis], 0.0, n as f64, &mut best);
         best.at.map(|(pos, planar_below)| Split {
+            rank: best.rank,
             cost: AxisCost::cost(best.rank, ctx.kt, ctx.ki, area),
             axis,
             pos,
@@ -332,14 +342,48 @@ fn find_split(ctx: &Ctx, w: &Work, parallel: bool) -> Option<Split> {
         })
     };
     let best = if parallel {
-        let (a, (b, c)) = rayon::join(|| sweep(0), || rayon::join(|| sweep(1), || sweep(2)));
+        let (a, (b, c)) = rayon::join(
+            || sweep(0, leaf),
+            || rayon::join(|| sweep(1, leaf), || sweep(2, leaf)),
+        );
         [a, b, c]
     } else {
-        [sweep(0), sweep(1), sweep(2)]
+        // Each axis only has to beat the ranks found on the axes before it: a plane ranked
+        // no lower than an earlier axis's best costs no less, and equal costs go to the
+        // earlier axis anyway.
+        let a = sweep(0, leaf);
+        let b = sweep(1, a.map_or(leaf, |s| s.rank));
+        let c = sweep(
+            2,
+            [&a, &b]
+                .into_iter()
+                .flatten()
+                .fold(leaf, |r, s| r.min(s.rank)),
+        );
+        [a, b, c]
     };
     best.into_iter()
         .flatten()
         .min_by(|a, b| a.cost.total_cmp(&b.cost))
+}
+
+/// A rank at and above which a plane's SAH cost is no less than the leaf's, `ki · n`: the
+/// threshold solved for, then raised until the cost formula itself, monotone in the rank,
+/// confirms it.
+fn leaf_rank(ctx: &Ctx, n: usize, area: f64) -> f64 {
+    let leaf = ctx.ki * n as f64;
+    let mut rank = ((leaf - ctx.kt) * area / (2.0 * ctx.ki)).max(0.0);
+    for _ in 0..64 {
+        if !rank.is_finite() {
+            break;
+        }
+        if AxisCost::cost(rank, ctx.kt, ctx.ki, area) >= leaf {
+            return rank;
+        }
+        // A few ulps usually do; steps grow so that a cost dominated by `kt` gets there too.
+        rank = (rank * (1.0 + 4.0 * f64::EPSILON)).max(rank.next_up());
+    }
+    f64::INFINITY
 }
 
 // A triangle's place in a split: its side in the low 2 bits and, for triangles that stay
