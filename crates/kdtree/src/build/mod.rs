@@ -386,8 +386,9 @@ fn leaf_rank(ctx: &Ctx, n: usize, area: f64) -> f64 {
     f64::INFINITY
 }
 
-// A triangle's place in a split: its side in the low 2 bits and, for triangles that stay
-// on one side, its local index in that child above them.
+// A triangle's side of a split; then its place: in the low 2 bits the child that keeps it
+// (BELOW or ABOVE; 0 for a straddler, whose events no child keeps) and above them its local
+// index in that child.
 const BELOW: u32 = 1;
 const ABOVE: u32 = 2;
 const BOTH: u32 = 3;
@@ -439,7 +440,8 @@ fn split_work(ctx: &Ctx, w: Work, s: &Split, parallel: bool) -> (Work, Work) {
         tris_a[na] = t;
         straddlers[ns] = i;
         let index = if side == BELOW { nb } else { na };
-        *p = side | (index as u32) << 2;
+        let kept = if side == BOTH { 0 } else { side };
+        *p = kept | (index as u32) << 2;
         nb += (side == BELOW) as usize;
         na += (side == ABOVE) as usize;
         ns += (side == BOTH) as usize;
@@ -474,31 +476,20 @@ fn split_work(ctx: &Ctx, w: Work, s: &Split, parallel: bool) -> (Work, Work) {
         }
     }
     let child_events = |axis: usize, ev: &Vec<Event>| -> (Vec<Event>, Vec<Event>) {
-        // Branch-free partition: every event is written to both lists and kept where its
-        // side says (sides are random along the other axes, a branch would mispredict).
-        // Each list has room for its final length plus the one slot written past the end.
-        let mut eb = vec![Event::default(); 2 * tris_b.len() + 1];
-        let mut ea = vec![Event::default(); 2 * tris_a.len() + 1];
-        let (mut nb, mut na) = (0, 0);
-        for &e in ev {
-            let p = place[e.tri() as usize];
-            let moved = e.with_tri(p >> 2);
-            eb[nb] = moved;
-            ea[na] = moved;
-            nb += (p & 3 == BELOW) as usize;
-            na += (p & 3 == ABOVE) as usize;
-        }
-        eb.truncate(nb);
-        ea.truncate(na);
-        let mut fresh = Vec::with_capacity(2 * new_b.len().max(new_a.len()));
-        for (list, out) in [(&new_b, &mut eb), (&new_a, &mut ea)] {
-            fresh.clear();
+        let fresh = [&new_b, &new_a].map(|list| {
+            let mut fresh = Vec::with_capacity(2 * list.len());
             for (t, b) in list {
                 events::push_events(&mut fresh, b, axis, *t);
             }
             events::sort(&mut fresh, false);
-            events::merge_into(out, &fresh);
-        }
+            fresh
+        });
+        let [eb, ea] = partition(
+            ev,
+            &place,
+            [&fresh[0], &fresh[1]],
+            [tris_b.len(), tris_a.len()],
+        );
         (eb, ea)
     };
     let Work { events: ev, .. } = w;
@@ -526,4 +517,67 @@ fn split_work(ctx: &Ctx, w: Work, s: &Split, parallel: bool) -> (Work, Work) {
             cell: cell_a,
         },
     )
+}
+
+/// One axis's events of both children, in one pass over the parent's: the events of the
+/// triangles each child keeps (`place`), in order and renumbered, with the child's `fresh`
+/// events (sorted) merged in. `tris` is each child's triangle count: two events each at most.
+fn partition(
+    ev: &[Event],
+    place: &[u32],
+    fresh: [&[Event]; 2],
+    tris: [usize; 2],
+) -> [Vec<Event>; 2] {
+    // Each list has room for its final length plus the one slot written past the end.
+    let mut out = [2 * tris[0] + 1, 2 * tris[1] + 1].map(Vec::with_capacity);
+    let [eb, ea] = &mut out;
+    let (sb, sa) = (eb.spare_capacity_mut(), ea.spare_capacity_mut());
+    let (mut nb, mut na) = (0, 0);
+    // A fresh event goes after every parent event of a lower or equal position and kind (it
+    // follows the kept ones at equal position and kind, whose indices are lower). One
+    // comparison per event against the nearer of the two children's next fresh events.
+    let [fb, fa] = fresh;
+    let (mut jb, mut ja) = (0, 0);
+    let key = |f: &[Event], j: usize| f.get(j).map_or(u64::MAX, |f| f.pos_kind());
+    let (mut kb, mut ka) = (key(fb, 0), key(fa, 0));
+    let mut next = kb.min(ka);
+    for &e in ev {
+        if e.pos_kind() > next {
+            while kb < e.pos_kind() {
+                sb[nb].write(fb[jb]);
+                (nb, jb) = (nb + 1, jb + 1);
+                kb = key(fb, jb);
+            }
+            while ka < e.pos_kind() {
+                sa[na].write(fa[ja]);
+                (na, ja) = (na + 1, ja + 1);
+                ka = key(fa, ja);
+            }
+            next = kb.min(ka);
+        }
+        let p = place[e.tri() as usize];
+        let moved = e.with_tri(p >> 2);
+        // Branch-free: every event is written to both lists and kept where its side says
+        // (sides are random along the other axes, a branch would mispredict).
+        sb[nb].write(moved);
+        sa[na].write(moved);
+        nb += (p & BELOW) as usize;
+        na += (p >> 1 & 1) as usize;
+    }
+    for &f in &fb[jb..] {
+        sb[nb].write(f);
+        nb += 1;
+    }
+    for &f in &fa[ja..] {
+        sa[na].write(f);
+        na += 1;
+    }
+    // SAFETY: `nb` and `na` only ever grow by one right after a write to the slot they
+    // index, so the first `nb` (`na`) slots of `eb` (`ea`) are initialised, and the
+    // indexing above checked that they lie within the capacity.
+    unsafe {
+        eb.set_len(nb);
+        ea.set_len(na);
+    }
+    out
 }
