@@ -484,12 +484,7 @@ fn split_work(ctx: &Ctx, w: Work, s: &Split, parallel: bool) -> (Work, Work) {
             events::sort(&mut fresh, false);
             fresh
         });
-        let [eb, ea] = partition(
-            ev,
-            &place,
-            [&fresh[0], &fresh[1]],
-            [tris_b.len(), tris_a.len()],
-        );
+        let [eb, ea] = partition(ev, &place, [&fresh[0], &fresh[1]]);
         (eb, ea)
     };
     let Work { events: ev, .. } = w;
@@ -521,27 +516,23 @@ fn split_work(ctx: &Ctx, w: Work, s: &Split, parallel: bool) -> (Work, Work) {
 
 /// One axis's events of both children, in one pass over the parent's: the events of the
 /// triangles each child keeps (`place`), in order and renumbered, with the child's `fresh`
-/// events (sorted) merged in. `tris` is each child's triangle count: two events each at most.
-fn partition(
-    ev: &[Event],
-    place: &[u32],
-    fresh: [&[Event]; 2],
-    tris: [usize; 2],
-) -> [Vec<Event>; 2] {
-    // Each list has room for its final length plus the one slot written past the end.
-    let mut out = [2 * tris[0] + 1, 2 * tris[1] + 1].map(Vec::with_capacity);
+/// events (sorted) merged in.
+fn partition(ev: &[Event], place: &[u32], fresh: [&[Event]; 2]) -> [Vec<Event>; 2] {
+    let [fb, fa] = fresh;
+    // Room for every event and every fresh event: each step below writes at most one of
+    // either, so the counts stay below the capacities without a check per write.
+    let mut out = [ev.len() + fb.len() + 1, ev.len() + fa.len() + 1].map(Vec::with_capacity);
     let [eb, ea] = &mut out;
     let (sb, sa) = (eb.spare_capacity_mut(), ea.spare_capacity_mut());
     let (mut nb, mut na) = (0, 0);
     // A fresh event goes after every parent event of a lower or equal position and kind (it
     // follows the kept ones at equal position and kind, whose indices are lower). One
     // comparison per event against the nearer of the two children's next fresh events.
-    let [fb, fa] = fresh;
     let (mut jb, mut ja) = (0, 0);
     let key = |f: &[Event], j: usize| f.get(j).map_or(u64::MAX, |f| f.pos_kind());
     let (mut kb, mut ka) = (key(fb, 0), key(fa, 0));
     let mut next = kb.min(ka);
-    for &e in ev {
+    for (i, &e) in ev.iter().enumerate() {
         if e.pos_kind() > next {
             while kb < e.pos_kind() {
                 sb[nb].write(fb[jb]);
@@ -559,8 +550,14 @@ fn partition(
         let moved = e.with_tri(p >> 2);
         // Branch-free: every event is written to both lists and kept where its side says
         // (sides are random along the other axes, a branch would mispredict).
-        sb[nb].write(moved);
-        sa[na].write(moved);
+        debug_assert!(nb <= i + jb && na <= i + ja);
+        // SAFETY: `nb` grows by at most one per parent event before this one (`i` of
+        // them) and by one per fresh event written (`jb ≤ fb.len()`), so
+        // `nb ≤ i + jb < ev.len() + fb.len() + 1`, the capacity `sb` spans; likewise `na`.
+        unsafe {
+            sb.get_unchecked_mut(nb).write(moved);
+            sa.get_unchecked_mut(na).write(moved);
+        }
         nb += (p & BELOW) as usize;
         na += (p >> 1 & 1) as usize;
     }
@@ -573,8 +570,7 @@ fn partition(
         na += 1;
     }
     // SAFETY: `nb` and `na` only ever grow by one right after a write to the slot they
-    // index, so the first `nb` (`na`) slots of `eb` (`ea`) are initialised, and the
-    // indexing above checked that they lie within the capacity.
+    // index, so the first `nb` (`na`) slots of `eb` (`ea`) are initialised.
     unsafe {
         eb.set_len(nb);
         ea.set_len(na);
