@@ -267,7 +267,7 @@ fn build_events(ctx: &Ctx, w: Work, depth: u32) -> Part {
     let n = w.tris.len();
     if n < JOIN_MIN {
         let mut out = Subtree::default();
-        build_rec(ctx, w, depth, &mut out);
+        build_rec(ctx, w, depth, &mut out, &mut Scratch::default());
         return Part::Flat(out);
     }
     if n <= ctx.leaf_size || depth >= ctx.max_depth {
@@ -278,7 +278,7 @@ fn build_events(ctx: &Ctx, w: Work, depth: u32) -> Part {
         Some(s) if s.cost < ctx.ki * n as f64 => s,
         _ => return Part::leaf(w.tris),
     };
-    let (below, above) = split_work(ctx, w, &split, parallel);
+    let (below, above) = split_work(ctx, w, &split, parallel, &mut Scratch::default());
     let (b, a) = rayon::join(
         || build_events(ctx, below, depth + 1),
         || build_events(ctx, above, depth + 1),
@@ -299,7 +299,7 @@ fn make_leaf(w: Work, out: &mut Subtree) {
 }
 
 /// The serial build below `JOIN_MIN` triangles, straight into one flat subtree.
-fn build_rec(ctx: &Ctx, w: Work, depth: u32, out: &mut Subtree) {
+fn build_rec(ctx: &Ctx, w: Work, depth: u32, out: &mut Subtree, scratch: &mut Scratch) {
     let n = w.tris.len();
     if n <= ctx.leaf_size || depth >= ctx.max_depth {
         return make_leaf(w, out);
@@ -308,12 +308,12 @@ fn build_rec(ctx: &Ctx, w: Work, depth: u32, out: &mut Subtree) {
         Some(s) if s.cost < ctx.ki * n as f64 => s,
         _ => return make_leaf(w, out),
     };
-    let (below, above) = split_work(ctx, w, &split, false);
+    let (below, above) = split_work(ctx, w, &split, false, scratch);
     let at = out.nodes.len();
     out.nodes.push(KdNode::leaf(0, 0)); // placeholder, set once `above` has an index
-    build_rec(ctx, below, depth + 1, out);
+    build_rec(ctx, below, depth + 1, out, scratch);
     let above_at = out.nodes.len() as u32;
-    build_rec(ctx, above, depth + 1, out);
+    build_rec(ctx, above, depth + 1, out, scratch);
     out.nodes[at] = KdNode::interior(split.axis as u32, split.pos, above_at);
 }
 
@@ -393,11 +393,35 @@ const BELOW: u32 = 1;
 const ABOVE: u32 = 2;
 const BOTH: u32 = 3;
 
+/// The working lists of a split that do not outlive it, kept from one split to the next of
+/// a serial build instead of allocated and freed at every node.
+#[derive(Default)]
+struct Scratch {
+    place: Vec<u32>,
+    straddlers: Vec<usize>,
+    clipped: Vec<(Option<Aabb>, Option<Aabb>)>,
+    /// Per child: the straddlers that reach into it (local index in the child, clipped box).
+    new: [Vec<(u32, Aabb)>; 2],
+}
+
 /// Classify the triangles against the split and build both children's work, keeping each
 /// axis's events sorted.
-fn split_work(ctx: &Ctx, w: Work, s: &Split, parallel: bool) -> (Work, Work) {
+fn split_work(
+    ctx: &Ctx,
+    w: Work,
+    s: &Split,
+    parallel: bool,
+    scratch: &mut Scratch,
+) -> (Work, Work) {
     let n = w.tris.len();
-    let mut place = vec![BOTH; n];
+    let Scratch {
+        place,
+        straddlers,
+        clipped,
+        new: [new_b, new_a],
+    } = scratch;
+    place.clear();
+    place.resize(n, BOTH);
     // The split axis's events are sorted, so the ones before, at and after the plane are
     // three runs; before and after are classified without branching on the kind.
     let ev = &w.events[s.axis];
@@ -432,7 +456,8 @@ fn split_work(ctx: &Ctx, w: Work, s: &Split, parallel: bool) -> (Work, Work) {
     let kept_a = n - kept_b - n_both;
     let mut tris_b = vec![0; kept_b + n_both + 1];
     let mut tris_a = vec![0; kept_a + n_both + 1];
-    let mut straddlers = vec![0usize; n_both + 1];
+    straddlers.clear();
+    straddlers.resize(n_both + 1, 0);
     let (mut nb, mut na, mut ns) = (0, 0, 0);
     for (i, (p, &t)) in place.iter_mut().zip(&w.tris).enumerate() {
         let side = *p;
@@ -458,14 +483,15 @@ fn split_work(ctx: &Ctx, w: Work, s: &Split, parallel: bool) -> (Work, Work) {
             clip::clipped_bounds(tri, &cell_a),
         )
     };
-    let clipped: Vec<(Option<Aabb>, Option<Aabb>)> = if straddlers.len() > 4096 {
-        straddlers.par_iter().map(clip).collect()
+    clipped.clear();
+    if straddlers.len() > 4096 {
+        straddlers.par_iter().map(clip).collect_into_vec(clipped);
     } else {
-        straddlers.iter().map(clip).collect()
-    };
-    let mut new_b = Vec::with_capacity(straddlers.len()); // (local index in child, clipped box)
-    let mut new_a = Vec::with_capacity(straddlers.len());
-    for (&i, (cb, ca)) in straddlers.iter().zip(&clipped) {
+        clipped.extend(straddlers.iter().map(clip));
+    }
+    new_b.clear();
+    new_a.clear();
+    for (&i, (cb, ca)) in straddlers.iter().zip(clipped.iter()) {
         if let Some(b) = cb {
             new_b.push((tris_b.len() as u32, *b));
             tris_b.push(w.tris[i]);
@@ -475,8 +501,9 @@ fn split_work(ctx: &Ctx, w: Work, s: &Split, parallel: bool) -> (Work, Work) {
             tris_a.push(w.tris[i]);
         }
     }
+    let (new_b, new_a, place) = (&*new_b, &*new_a, &*place);
     let child_events = |axis: usize, ev: &Vec<Event>| -> (Vec<Event>, Vec<Event>) {
-        let fresh = [&new_b, &new_a].map(|list| {
+        let fresh = [new_b, new_a].map(|list| {
             let mut fresh = Vec::with_capacity(2 * list.len());
             for (t, b) in list {
                 events::push_events(&mut fresh, b, axis, *t);
@@ -484,7 +511,7 @@ fn split_work(ctx: &Ctx, w: Work, s: &Split, parallel: bool) -> (Work, Work) {
             events::sort(&mut fresh, false);
             fresh
         });
-        let [eb, ea] = partition(ev, &place, [&fresh[0], &fresh[1]]);
+        let [eb, ea] = partition(ev, place, [&fresh[0], &fresh[1]]);
         (eb, ea)
     };
     let Work { events: ev, .. } = w;
