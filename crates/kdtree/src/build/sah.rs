@@ -80,6 +80,20 @@ impl AxisCost {
     #[inline]
     pub fn at(&self, p: f32, nl: f64, nr: f64, pp: f64) -> (f64, bool) {
         let w = self.weights(p, p);
+        if nl > 0.0 && nr > 0.0 {
+            // Inside the cell's run of triangles both sides hold some, wherever the planar
+            // ones go: the same sums as `weigh`, without its empty-side test.
+            let c_below = w.0 * (nl + pp) + w.1 * nr;
+            if pp == 0.0 {
+                return (c_below, true);
+            }
+            let c_above = w.0 * nl + w.1 * (nr + pp);
+            return if c_below <= c_above {
+                (c_below, true)
+            } else {
+                (c_above, false)
+            };
+        }
         let c_below = self.weigh(w, nl + pp, nr);
         if pp == 0.0 {
             // Nothing lies in the plane: both sides price the same, and below wins ties.
@@ -176,7 +190,9 @@ pub fn sweep(ax: &AxisCost, ev: &[Event], mut nl: f64, mut nr: f64, best: &mut B
 impl AxisCost {
     /// Offer the plane at `key` with its events' counts, move the counts past it, and say
     /// whether a later plane can still beat `best`.
-    #[inline]
+    // Always inlined: at every position of every sweep, and the compiler's own weighing
+    // of the grown `at` left it a call.
+    #[inline(always)]
     fn price(
         &self,
         key: u32,
