@@ -548,59 +548,58 @@ fn partition(ev: &[Event], place: &[u32], fresh: [&[Event]; 2]) -> [Vec<Event>; 
     let [fb, fa] = fresh;
     // Room for every event and every fresh event: each step below writes at most one of
     // either, so the counts stay below the capacities without a check per write.
-    let mut out = [ev.len() + fb.len() + 1, ev.len() + fa.len() + 1].map(Vec::with_capacity);
-    let [eb, ea] = &mut out;
-    let (sb, sa) = (eb.spare_capacity_mut(), ea.spare_capacity_mut());
-    let (mut nb, mut na) = (0, 0);
-    // A fresh event goes after every parent event of a lower or equal position and kind (it
-    // follows the kept ones at equal position and kind, whose indices are lower). One
-    // comparison per event against the nearer of the two children's next fresh events.
-    let (mut jb, mut ja) = (0, 0);
+    let mut eb: Vec<Event> = Vec::with_capacity(ev.len() + fb.len() + 1);
+    let mut ea: Vec<Event> = Vec::with_capacity(ev.len() + fa.len() + 1);
+    let (pb, pa) = (eb.as_mut_ptr(), ea.as_mut_ptr());
+    let (mut nb, mut na, mut jb, mut ja, mut i) = (0, 0, 0, 0, 0);
     let key = |f: &[Event], j: usize| f.get(j).map_or(u64::MAX, |f| f.pos_kind());
-    let (mut kb, mut ka) = (key(fb, 0), key(fa, 0));
-    let mut next = kb.min(ka);
-    for (i, &e) in ev.iter().enumerate() {
-        if e.pos_kind() > next {
-            while kb < e.pos_kind() {
-                sb[nb].write(fb[jb]);
-                (nb, jb) = (nb + 1, jb + 1);
-                kb = key(fb, jb);
+    loop {
+        // A fresh event goes after every parent event of a lower or equal position and
+        // kind (it follows the kept ones at equal position and kind, whose indices are
+        // lower). The parent's events run in a tight loop up to where the nearer of the
+        // two children's next fresh events goes in.
+        let next = key(fb, jb).min(key(fa, ja));
+        while let Some(&e) = ev.get(i) {
+            if e.pos_kind() > next {
+                break;
             }
-            while ka < e.pos_kind() {
-                sa[na].write(fa[ja]);
-                (na, ja) = (na + 1, ja + 1);
-                ka = key(fa, ja);
+            let p = place[e.tri() as usize];
+            let moved = e.with_tri(p >> 2);
+            // Branch-free: every event is written to both lists and kept where its side
+            // says (sides are random along the other axes, a branch would mispredict).
+            debug_assert!(nb <= i + jb && na <= i + ja);
+            // SAFETY: `nb` grows by at most one per parent event before this one (`i` of
+            // them) and by one per fresh event written (`jb ≤ fb.len()`), so
+            // `nb ≤ i + jb < ev.len() + fb.len() + 1`, within the capacity `pb` points at,
+            // and `eb` is not touched until the end; likewise `na`.
+            unsafe {
+                pb.add(nb).write(moved);
+                pa.add(na).write(moved);
             }
-            next = kb.min(ka);
+            nb += (p & BELOW) as usize;
+            na += (p >> 1 & 1) as usize;
+            i += 1;
         }
-        let p = place[e.tri() as usize];
-        let moved = e.with_tri(p >> 2);
-        // Branch-free: every event is written to both lists and kept where its side says
-        // (sides are random along the other axes, a branch would mispredict).
-        debug_assert!(nb <= i + jb && na <= i + ja);
-        // SAFETY: `nb` grows by at most one per parent event before this one (`i` of
-        // them) and by one per fresh event written (`jb ≤ fb.len()`), so
-        // `nb ≤ i + jb < ev.len() + fb.len() + 1`, the capacity `sb` spans; likewise `na`.
-        unsafe {
-            sb.get_unchecked_mut(nb).write(moved);
-            sa.get_unchecked_mut(na).write(moved);
+        // The fresh events that go before the parent's next event (at the end, all left).
+        let limit = ev.get(i).map_or(u64::MAX, |e| e.pos_kind());
+        while key(fb, jb) < limit {
+            // SAFETY: as above, with `jb < fb.len()` and `i ≤ ev.len()`.
+            unsafe { pb.add(nb).write(fb[jb]) };
+            (nb, jb) = (nb + 1, jb + 1);
         }
-        nb += (p & BELOW) as usize;
-        na += (p >> 1 & 1) as usize;
+        while key(fa, ja) < limit {
+            // SAFETY: as above.
+            unsafe { pa.add(na).write(fa[ja]) };
+            (na, ja) = (na + 1, ja + 1);
+        }
+        if i == ev.len() {
+            break;
+        }
     }
-    for &f in &fb[jb..] {
-        sb[nb].write(f);
-        nb += 1;
-    }
-    for &f in &fa[ja..] {
-        sa[na].write(f);
-        na += 1;
-    }
-    // SAFETY: `nb` and `na` only ever grow by one right after a write to the slot they
-    // index, so the first `nb` (`na`) slots of `eb` (`ea`) are initialised.
+    // SAFETY: the first `nb` (`na`) elements were written above, within the capacity.
     unsafe {
         eb.set_len(nb);
         ea.set_len(na);
     }
-    out
+    [eb, ea]
 }
