@@ -503,15 +503,19 @@ fn split_work(
     }
     let (new_b, new_a, place) = (&*new_b, &*new_a, &*place);
     let child_events = |axis: usize, ev: &Vec<Event>| -> (Vec<Event>, Vec<Event>) {
-        let fresh = [new_b, new_a].map(|list| {
-            let mut fresh = Vec::with_capacity(2 * list.len());
-            for (t, b) in list {
-                events::push_events(&mut fresh, b, axis, *t);
-            }
-            events::sort(&mut fresh, false);
-            fresh
-        });
-        let [eb, ea] = partition(ev, place, [&fresh[0], &fresh[1]]);
+        // Both children's fresh events in one list: the below child's, then the above's.
+        let mut fresh = Vec::with_capacity(2 * (new_b.len() + new_a.len()));
+        for (t, b) in new_b {
+            events::push_events(&mut fresh, b, axis, *t);
+        }
+        let mid = fresh.len();
+        for (t, b) in new_a {
+            events::push_events(&mut fresh, b, axis, *t);
+        }
+        let (fb, fa) = fresh.split_at_mut(mid);
+        events::sort(fb, false);
+        events::sort(fa, false);
+        let [eb, ea] = partition(ev, place, [fb, fa]);
         (eb, ea)
     };
     let Work { events: ev, .. } = w;
