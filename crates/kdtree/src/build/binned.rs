@@ -121,11 +121,20 @@ impl Slabs {
         }
     }
 
-    /// `as usize` saturates (and takes NaN, from 0·∞ at the low face of a very thin
-    /// cell, to 0), so every position lands in a slab.
+    /// Every position lands in a slab: below the cell and NaN (from 0·∞ at the low face of
+    /// a very thin cell) in the first, beyond it in the last. Clamped before it is
+    /// truncated, so the conversion is one instruction, not a saturating sequence.
     #[inline]
     fn of(&self, axis: usize, pos: f32) -> usize {
-        (((pos - self.lo[axis]) * self.scale[axis]) as usize).min(BINS - 1)
+        let x = (pos - self.lo[axis]) * self.scale[axis];
+        let x = if x > 0.0 {
+            x.min((BINS - 1) as f32)
+        } else {
+            0.0
+        };
+        // SAFETY: NaN fails `x > 0.0`, so `x` is a number in [0, BINS − 1]: its truncation
+        // fits a u32.
+        unsafe { x.to_int_unchecked::<u32>() as usize }
     }
 }
 
@@ -202,7 +211,8 @@ pub(super) fn find_split(ctx: &Ctx, refs: &[Ref], cell: &Aabb) -> Search {
     } else {
         histogram(refs, &slabs)
     };
-    let axes: [Option<AxisCost>; 3] = std::array::from_fn(|a| AxisCost::new(cell, a, ctx.bonus));
+    let axes: [Option<AxisCost>; 3] =
+        std::array::from_fn(|a| AxisCost::new(cell, a, ctx.bonus, refs.len()));
     let pos = events::unordered;
 
     // Upper bounds from each slab's end positions, and the lower bound of each slab.
@@ -301,6 +311,7 @@ pub(super) fn find_split(ctx: &Ctx, refs: &[Ref], cell: &Aabb) -> Search {
             ended += e + p;
         }
         found[axis] = best.at.map(|(pos, planar_below)| Split {
+            rank: best.rank,
             cost: AxisCost::cost(best.rank, ctx.kt, ctx.ki, area),
             axis,
             pos,

@@ -58,7 +58,9 @@ pub fn clipped_bounds(tri: &[Vec3; 3], cell: &Aabb) -> Option<Aabb> {
             let mut m = 0;
             for i in 0..n {
                 let a = poly[i];
-                let b = poly[(i + 1) % n];
+                // The edge to the next vertex, the last closing on the first (no division
+                // by a variable `n`).
+                let b = poly[if i + 1 == n { 0 } else { i + 1 }];
                 let (ia, ib) = (inside(&a), inside(&b));
                 if ia {
                     next[m] = a;
@@ -82,10 +84,13 @@ pub fn clipped_bounds(tri: &[Vec3; 3], cell: &Aabb) -> Option<Aabb> {
     }
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
+    // Plain comparisons: every coordinate is a number (f64::min and max would also sort
+    // out NaN), and which zero wins a tie of −0 and +0 changes no event (positions map
+    // both to one key).
     for p in &poly[..n] {
         for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
+            lo[k] = if p[k] < lo[k] { p[k] } else { lo[k] };
+            hi[k] = if p[k] > hi[k] { p[k] } else { hi[k] };
         }
     }
     let mut b = Aabb::EMPTY;

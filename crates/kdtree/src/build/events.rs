@@ -56,6 +56,11 @@ impl Event {
     pub fn pos(self) -> f32 {
         unordered(self.pos_key())
     }
+    /// Position and kind: the order of events of different triangles at equal keys.
+    #[inline]
+    pub fn pos_kind(self) -> u64 {
+        self.0 >> 30
+    }
     #[inline]
     pub fn tri(self) -> u32 {
         self.0 as u32 & (MAX_TRIANGLES as u32 - 1)
@@ -90,24 +95,6 @@ pub fn sort(events: &mut [Event], parallel: bool) {
     }
 }
 
-/// Merge the sorted `fresh` into the sorted `v`, in place: `v` grows by `fresh.len()`
-/// and is filled from the back, so no third list is allocated.
-pub fn merge_into(v: &mut Vec<Event>, fresh: &[Event]) {
-    let (mut i, mut j) = (v.len(), fresh.len());
-    v.extend_from_slice(fresh);
-    let mut k = v.len();
-    while j > 0 {
-        k -= 1;
-        if i > 0 && v[i - 1] > fresh[j - 1] {
-            v[k] = v[i - 1];
-            i -= 1;
-        } else {
-            v[k] = fresh[j - 1];
-            j -= 1;
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -125,15 +112,6 @@ mod tests {
         sort(&mut v, false);
         let tris: Vec<u32> = v.iter().map(|e| e.tri()).collect();
         assert_eq!(tris, vec![5, 4, 3, 2, 1, 0]);
-        let mut merged = vec![v[0], v[2], v[4]];
-        merge_into(&mut merged, &[v[1], v[3], v[5]]);
-        assert_eq!(merged, v);
-        let mut all_fresh = vec![];
-        merge_into(&mut all_fresh, &v);
-        assert_eq!(all_fresh, v);
-        let mut none_fresh = v.clone();
-        merge_into(&mut none_fresh, &[]);
-        assert_eq!(none_fresh, v);
     }
 
     #[test]

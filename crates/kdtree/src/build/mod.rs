@@ -76,6 +76,8 @@ struct Work {
 
 #[derive(Clone, Copy, Debug)]
 struct Split {
+    /// The plane's rank on its axis ([`sah::AxisCost::at`]) and its SAH cost.
+    rank: f64,
     cost: f64,
     axis: usize,
     pos: f32,
@@ -265,7 +267,7 @@ fn build_events(ctx: &Ctx, w: Work, depth: u32) -> Part {
     let n = w.tris.len();
     if n < JOIN_MIN {
         let mut out = Subtree::default();
-        build_rec(ctx, w, depth, &mut out);
+        build_rec(ctx, w, depth, &mut out, &mut Scratch::default());
         return Part::Flat(out);
     }
     if n <= ctx.leaf_size || depth >= ctx.max_depth {
@@ -276,7 +278,7 @@ fn build_events(ctx: &Ctx, w: Work, depth: u32) -> Part {
         Some(s) if s.cost < ctx.ki * n as f64 => s,
         _ => return Part::leaf(w.tris),
     };
-    let (below, above) = split_work(ctx, w, &split, parallel);
+    let (below, above) = split_work(ctx, w, &split, parallel, &mut Scratch::default());
     let (b, a) = rayon::join(
         || build_events(ctx, below, depth + 1),
         || build_events(ctx, above, depth + 1),
@@ -297,7 +299,7 @@ fn make_leaf(w: Work, out: &mut Subtree) {
 }
 
 /// The serial build below `JOIN_MIN` triangles, straight into one flat subtree.
-fn build_rec(ctx: &Ctx, w: Work, depth: u32, out: &mut Subtree) {
+fn build_rec(ctx: &Ctx, w: Work, depth: u32, out: &mut Subtree, scratch: &mut Scratch) {
     let n = w.tris.len();
     if n <= ctx.leaf_size || depth >= ctx.max_depth {
         return make_leaf(w, out);
@@ -306,25 +308,33 @@ fn build_rec(ctx: &Ctx, w: Work, depth: u32, out: &mut Subtree) {
         Some(s) if s.cost < ctx.ki * n as f64 => s,
         _ => return make_leaf(w, out),
     };
-    let (below, above) = split_work(ctx, w, &split, false);
+    let (below, above) = split_work(ctx, w, &split, false, scratch);
     let at = out.nodes.len();
     out.nodes.push(KdNode::leaf(0, 0)); // placeholder, set once `above` has an index
-    build_rec(ctx, below, depth + 1, out);
+    build_rec(ctx, below, depth + 1, out, scratch);
     let above_at = out.nodes.len() as u32;
-    build_rec(ctx, above, depth + 1, out);
+    build_rec(ctx, above, depth + 1, out, scratch);
     out.nodes[at] = KdNode::interior(split.axis as u32, split.pos, above_at);
 }
 
+/// The cheapest split of the cell that beats a leaf (None when no plane does).
 fn find_split(ctx: &Ctx, w: &Work, parallel: bool) -> Option<Split> {
     let area = w.cell.area();
     if !(area > 0.0) || !area.is_finite() {
         return None;
     }
-    let sweep = |axis: usize| {
-        let ax = AxisCost::new(&w.cell, axis, ctx.bonus)?;
-        let mut best = Best::NONE;
-        sah::sweep(&ax, &w.events[axis], 0.0, w.tris.len() as f64, &mut best);
+    let n = w.tris.len();
+    // Planes ranked at or above this cost at least a leaf: no sweep needs to look at them.
+    let leaf = leaf_rank(ctx, n, area);
+    let sweep = |axis: usize, beat: f64| {
+        let ax = AxisCost::new(&w.cell, axis, ctx.bonus, n)?;
+        let mut best = Best {
+            rank: beat,
+            at: None,
+        };
+        sah::sweep(&ax, &w.events[axis], 0.0, n as f64, &mut best);
         best.at.map(|(pos, planar_below)| Split {
+            rank: best.rank,
             cost: AxisCost::cost(best.rank, ctx.kt, ctx.ki, area),
             axis,
             pos,
@@ -332,27 +342,86 @@ fn find_split(ctx: &Ctx, w: &Work, parallel: bool) -> Option<Split> {
         })
     };
     let best = if parallel {
-        let (a, (b, c)) = rayon::join(|| sweep(0), || rayon::join(|| sweep(1), || sweep(2)));
+        let (a, (b, c)) = rayon::join(
+            || sweep(0, leaf),
+            || rayon::join(|| sweep(1, leaf), || sweep(2, leaf)),
+        );
         [a, b, c]
     } else {
-        [sweep(0), sweep(1), sweep(2)]
+        // Each axis only has to beat the ranks found on the axes before it: a plane ranked
+        // no lower than an earlier axis's best costs no less, and equal costs go to the
+        // earlier axis anyway.
+        let a = sweep(0, leaf);
+        let b = sweep(1, a.map_or(leaf, |s| s.rank));
+        let c = sweep(
+            2,
+            [&a, &b]
+                .into_iter()
+                .flatten()
+                .fold(leaf, |r, s| r.min(s.rank)),
+        );
+        [a, b, c]
     };
     best.into_iter()
         .flatten()
         .min_by(|a, b| a.cost.total_cmp(&b.cost))
 }
 
-// A triangle's place in a split: its side in the low 2 bits and, for triangles that stay
-// on one side, its local index in that child above them.
+/// A rank at and above which a plane's SAH cost is no less than the leaf's, `ki · n`: the
+/// threshold solved for, then raised until the cost formula itself, monotone in the rank,
+/// confirms it.
+fn leaf_rank(ctx: &Ctx, n: usize, area: f64) -> f64 {
+    let leaf = ctx.ki * n as f64;
+    let mut rank = ((leaf - ctx.kt) * area / (2.0 * ctx.ki)).max(0.0);
+    for _ in 0..64 {
+        if !rank.is_finite() {
+            break;
+        }
+        if AxisCost::cost(rank, ctx.kt, ctx.ki, area) >= leaf {
+            return rank;
+        }
+        // A few ulps usually do; steps grow so that a cost dominated by `kt` gets there too.
+        rank = (rank * (1.0 + 4.0 * f64::EPSILON)).max(rank.next_up());
+    }
+    f64::INFINITY
+}
+
+// A triangle's side of a split; then its place: in the low 2 bits the child that keeps it
+// (BELOW or ABOVE; 0 for a straddler, whose events no child keeps) and above them its local
+// index in that child.
 const BELOW: u32 = 1;
 const ABOVE: u32 = 2;
 const BOTH: u32 = 3;
 
+/// The working lists of a split that do not outlive it, kept from one split to the next of
+/// a serial build instead of allocated and freed at every node.
+#[derive(Default)]
+struct Scratch {
+    place: Vec<u32>,
+    straddlers: Vec<usize>,
+    clipped: Vec<(Option<Aabb>, Option<Aabb>)>,
+    /// Per child: the straddlers that reach into it (local index in the child, clipped box).
+    new: [Vec<(u32, Aabb)>; 2],
+}
+
 /// Classify the triangles against the split and build both children's work, keeping each
 /// axis's events sorted.
-fn split_work(ctx: &Ctx, w: Work, s: &Split, parallel: bool) -> (Work, Work) {
+fn split_work(
+    ctx: &Ctx,
+    w: Work,
+    s: &Split,
+    parallel: bool,
+    scratch: &mut Scratch,
+) -> (Work, Work) {
     let n = w.tris.len();
-    let mut place = vec![BOTH; n];
+    let Scratch {
+        place,
+        straddlers,
+        clipped,
+        new: [new_b, new_a],
+    } = scratch;
+    place.clear();
+    place.resize(n, BOTH);
     // The split axis's events are sorted, so the ones before, at and after the plane are
     // three runs; before and after are classified without branching on the kind.
     let ev = &w.events[s.axis];
@@ -387,7 +456,8 @@ fn split_work(ctx: &Ctx, w: Work, s: &Split, parallel: bool) -> (Work, Work) {
     let kept_a = n - kept_b - n_both;
     let mut tris_b = vec![0; kept_b + n_both + 1];
     let mut tris_a = vec![0; kept_a + n_both + 1];
-    let mut straddlers = vec![0usize; n_both + 1];
+    straddlers.clear();
+    straddlers.resize(n_both + 1, 0);
     let (mut nb, mut na, mut ns) = (0, 0, 0);
     for (i, (p, &t)) in place.iter_mut().zip(&w.tris).enumerate() {
         let side = *p;
@@ -395,7 +465,8 @@ fn split_work(ctx: &Ctx, w: Work, s: &Split, parallel: bool) -> (Work, Work) {
         tris_a[na] = t;
         straddlers[ns] = i;
         let index = if side == BELOW { nb } else { na };
-        *p = side | (index as u32) << 2;
+        let kept = if side == BOTH { 0 } else { side };
+        *p = kept | (index as u32) << 2;
         nb += (side == BELOW) as usize;
         na += (side == ABOVE) as usize;
         ns += (side == BOTH) as usize;
@@ -412,14 +483,15 @@ fn split_work(ctx: &Ctx, w: Work, s: &Split, parallel: bool) -> (Work, Work) {
             clip::clipped_bounds(tri, &cell_a),
         )
     };
-    let clipped: Vec<(Option<Aabb>, Option<Aabb>)> = if straddlers.len() > 4096 {
-        straddlers.par_iter().map(clip).collect()
+    clipped.clear();
+    if straddlers.len() > 4096 {
+        straddlers.par_iter().map(clip).collect_into_vec(clipped);
     } else {
-        straddlers.iter().map(clip).collect()
-    };
-    let mut new_b = Vec::with_capacity(straddlers.len()); // (local index in child, clipped box)
-    let mut new_a = Vec::with_capacity(straddlers.len());
-    for (&i, (cb, ca)) in straddlers.iter().zip(&clipped) {
+        clipped.extend(straddlers.iter().map(clip));
+    }
+    new_b.clear();
+    new_a.clear();
+    for (&i, (cb, ca)) in straddlers.iter().zip(clipped.iter()) {
         if let Some(b) = cb {
             new_b.push((tris_b.len() as u32, *b));
             tris_b.push(w.tris[i]);
@@ -429,32 +501,21 @@ fn split_work(ctx: &Ctx, w: Work, s: &Split, parallel: bool) -> (Work, Work) {
             tris_a.push(w.tris[i]);
         }
     }
+    let (new_b, new_a, place) = (&*new_b, &*new_a, &*place);
     let child_events = |axis: usize, ev: &Vec<Event>| -> (Vec<Event>, Vec<Event>) {
-        // Branch-free partition: every event is written to both lists and kept where its
-        // side says (sides are random along the other axes, a branch would mispredict).
-        // Each list has room for its final length plus the one slot written past the end.
-        let mut eb = vec![Event::default(); 2 * tris_b.len() + 1];
-        let mut ea = vec![Event::default(); 2 * tris_a.len() + 1];
-        let (mut nb, mut na) = (0, 0);
-        for &e in ev {
-            let p = place[e.tri() as usize];
-            let moved = e.with_tri(p >> 2);
-            eb[nb] = moved;
-            ea[na] = moved;
-            nb += (p & 3 == BELOW) as usize;
-            na += (p & 3 == ABOVE) as usize;
+        // Both children's fresh events in one list: the below child's, then the above's.
+        let mut fresh = Vec::with_capacity(2 * (new_b.len() + new_a.len()));
+        for (t, b) in new_b {
+            events::push_events(&mut fresh, b, axis, *t);
         }
-        eb.truncate(nb);
-        ea.truncate(na);
-        let mut fresh = Vec::with_capacity(2 * new_b.len().max(new_a.len()));
-        for (list, out) in [(&new_b, &mut eb), (&new_a, &mut ea)] {
-            fresh.clear();
-            for (t, b) in list {
-                events::push_events(&mut fresh, b, axis, *t);
-            }
-            events::sort(&mut fresh, false);
-            events::merge_into(out, &fresh);
+        let mid = fresh.len();
+        for (t, b) in new_a {
+            events::push_events(&mut fresh, b, axis, *t);
         }
+        let (fb, fa) = fresh.split_at_mut(mid);
+        events::sort(fb, false);
+        events::sort(fa, false);
+        let [eb, ea] = partition(ev, place, [fb, fa]);
         (eb, ea)
     };
     let Work { events: ev, .. } = w;
@@ -482,4 +543,67 @@ fn split_work(ctx: &Ctx, w: Work, s: &Split, parallel: bool) -> (Work, Work) {
             cell: cell_a,
         },
     )
+}
+
+/// One axis's events of both children, in one pass over the parent's: the events of the
+/// triangles each child keeps (`place`), in order and renumbered, with the child's `fresh`
+/// events (sorted) merged in.
+fn partition(ev: &[Event], place: &[u32], fresh: [&[Event]; 2]) -> [Vec<Event>; 2] {
+    let [fb, fa] = fresh;
+    // Room for every event and every fresh event: each step below writes at most one of
+    // either, so the counts stay below the capacities without a check per write.
+    let mut eb: Vec<Event> = Vec::with_capacity(ev.len() + fb.len() + 1);
+    let mut ea: Vec<Event> = Vec::with_capacity(ev.len() + fa.len() + 1);
+    let (pb, pa) = (eb.as_mut_ptr(), ea.as_mut_ptr());
+    let (mut nb, mut na, mut jb, mut ja, mut i) = (0, 0, 0, 0, 0);
+    let key = |f: &[Event], j: usize| f.get(j).map_or(u64::MAX, |f| f.pos_kind());
+    loop {
+        // A fresh event goes after every parent event of a lower or equal position and
+        // kind (it follows the kept ones at equal position and kind, whose indices are
+        // lower). The parent's events run in a tight loop up to where the nearer of the
+        // two children's next fresh events goes in.
+        let next = key(fb, jb).min(key(fa, ja));
+        while let Some(&e) = ev.get(i) {
+            if e.pos_kind() > next {
+                break;
+            }
+            let p = place[e.tri() as usize];
+            let moved = e.with_tri(p >> 2);
+            // Branch-free: every event is written to both lists and kept where its side
+            // says (sides are random along the other axes, a branch would mispredict).
+            debug_assert!(nb <= i + jb && na <= i + ja);
+            // SAFETY: `nb` grows by at most one per parent event before this one (`i` of
+            // them) and by one per fresh event written (`jb ≤ fb.len()`), so
+            // `nb ≤ i + jb < ev.len() + fb.len() + 1`, within the capacity `pb` points at,
+            // and `eb` is not touched until the end; likewise `na`.
+            unsafe {
+                pb.add(nb).write(moved);
+                pa.add(na).write(moved);
+            }
+            nb += (p & BELOW) as usize;
+            na += (p >> 1 & 1) as usize;
+            i += 1;
+        }
+        // The fresh events that go before the parent's next event (at the end, all left).
+        let limit = ev.get(i).map_or(u64::MAX, |e| e.pos_kind());
+        while key(fb, jb) < limit {
+            // SAFETY: as above, with `jb < fb.len()` and `i ≤ ev.len()`.
+            unsafe { pb.add(nb).write(fb[jb]) };
+            (nb, jb) = (nb + 1, jb + 1);
+        }
+        while key(fa, ja) < limit {
+            // SAFETY: as above.
+            unsafe { pa.add(na).write(fa[ja]) };
+            (na, ja) = (na + 1, ja + 1);
+        }
+        if i == ev.len() {
+            break;
+        }
+    }
+    // SAFETY: the first `nb` (`na`) elements were written above, within the capacity.
+    unsafe {
+        eb.set_len(nb);
+        ea.set_len(na);
+    }
+    [eb, ea]
 }

@@ -2,7 +2,7 @@
 //! events that ranks them. The event builder and the binned search both rank planes here,
 //! with the same arithmetic, so that both pick bit-for-bit the same split.
 
-use super::events::{self, Event};
+use super::events::{self, Event, END, PLANAR, START};
 use crate::aabb::Aabb;
 
 /// One axis of one cell, ready to price planes.
@@ -12,13 +12,16 @@ pub struct AxisCost {
     cap: f64,
     ring: f64,
     keep: f64,
+    /// The cell's triangle count: every plane has at least this many on its two sides.
+    n: f64,
     lo_key: u32,
     hi_key: u32,
 }
 
 impl AxisCost {
-    /// None when the cell is flat along `axis` (no plane strictly inside it).
-    pub fn new(cell: &Aabb, axis: usize, bonus: f64) -> Option<AxisCost> {
+    /// None when the cell is flat along `axis` (no plane strictly inside it). `n` is the
+    /// number of triangles in the cell.
+    pub fn new(cell: &Aabb, axis: usize, bonus: f64, n: usize) -> Option<AxisCost> {
         let lo = cell.lo[axis];
         let hi = cell.hi[axis];
         if !(lo < hi) {
@@ -36,6 +39,7 @@ impl AxisCost {
             cap: e[o1] * e[o2],
             ring: e[o1] + e[o2],
             keep: 1.0 - bonus,
+            n: n as f64,
             lo_key: events::ordered(lo),
             hi_key: events::ordered(hi),
         })
@@ -76,6 +80,20 @@ impl AxisCost {
     #[inline]
     pub fn at(&self, p: f32, nl: f64, nr: f64, pp: f64) -> (f64, bool) {
         let w = self.weights(p, p);
+        if nl > 0.0 && nr > 0.0 {
+            // Inside the cell's run of triangles both sides hold some, wherever the planar
+            // ones go: the same sums as `weigh`, without its empty-side test.
+            let c_below = w.0 * (nl + pp) + w.1 * nr;
+            if pp == 0.0 {
+                return (c_below, true);
+            }
+            let c_above = w.0 * nl + w.1 * (nr + pp);
+            return if c_below <= c_above {
+                (c_below, true)
+            } else {
+                (c_above, false)
+            };
+        }
         let c_below = self.weigh(w, nl + pp, nr);
         if pp == 0.0 {
             // Nothing lies in the plane: both sides price the same, and below wins ties.
@@ -95,6 +113,19 @@ impl AxisCost {
     #[inline]
     pub fn bound(&self, p_low: f32, p_high: f32, l: f64, r: f64) -> f64 {
         self.weigh(self.weights(p_low, p_high), l, r)
+    }
+
+    /// A lower bound on the rank of every plane above `p` (or of every plane, with `p` at
+    /// the cell's low face) when `nl` triangles start or lie at or below `p`: such a plane
+    /// has at least `nl` triangles below, a larger area below, and every triangle on at
+    /// least one side, each side weighing at least `cap`. So a plane with `l` below and
+    /// `r` above ranks at least `wl·nl + cap·(n − nl)` (or, with a side empty, `keep` times
+    /// `wl·n` or `cap·n`, no less than `keep` times that bound). The inequality holds for
+    /// exact numbers; rounding moves either side by far less than the factor below.
+    #[inline]
+    fn floor(&self, p: f32, nl: f64) -> f64 {
+        let (wl, _) = self.weights(p, p);
+        self.keep * (wl * nl + self.cap * (self.n - nl)) * (1.0 - 1e-12)
     }
 
     /// The SAH cost of a ranked plane.
@@ -127,23 +158,59 @@ impl Best {
 }
 
 /// Sweep sorted events in position order, starting from the counts the positions before
-/// them leave: `nl` triangles started (or planar) below, `nr` not yet ended.
+/// them leave: `nl` triangles started (or planar) below, `nr` not yet ended. `best` may
+/// come in with a rank to beat and no plane (a bound from elsewhere): only planes ranked
+/// strictly below it are taken.
 pub fn sweep(ax: &AxisCost, ev: &[Event], mut nl: f64, mut nr: f64, best: &mut Best) {
-    let mut i = 0;
-    while i < ev.len() {
-        // One position at a time: count its end, planar and start events.
-        let key = ev[i].pos_key();
-        let mut count = [0u32; 3];
-        while i < ev.len() && ev[i].pos_key() == key {
-            count[ev[i].kind() as usize] += 1;
-            i += 1;
+    // One position at a time: count its end, planar and start events, then price the
+    // plane there. The counters are plain locals (an array indexed by kind would keep them
+    // in memory, one store-to-load chain per event).
+    let Some(first) = ev.first() else { return };
+    if ax.floor(ax.lo, nl) >= best.rank {
+        return;
+    }
+    let mut key = first.pos_key();
+    let (mut pe, mut pp, mut ps) = (0u32, 0u32, 0u32);
+    for e in ev {
+        if e.pos_key() != key {
+            if !ax.price(key, [pe, pp, ps], &mut nl, &mut nr, best) {
+                return;
+            }
+            key = e.pos_key();
+            (pe, pp, ps) = (0, 0, 0);
         }
+        let kind = e.kind();
+        pe += (kind == END) as u32;
+        pp += (kind == PLANAR) as u32;
+        ps += (kind == START) as u32;
+    }
+    ax.price(key, [pe, pp, ps], &mut nl, &mut nr, best);
+}
+
+impl AxisCost {
+    /// Offer the plane at `key` with its events' counts, move the counts past it, and say
+    /// whether a later plane can still beat `best`.
+    // Always inlined: at every position of every sweep, and the compiler's own weighing
+    // of the grown `at` left it a call.
+    #[inline(always)]
+    fn price(
+        &self,
+        key: u32,
+        count: [u32; 3],
+        nl: &mut f64,
+        nr: &mut f64,
+        best: &mut Best,
+    ) -> bool {
         let [pe, pp, ps] = count.map(f64::from);
-        nr -= pp + pe;
-        if ax.inside(key) {
-            let p = ev[i - 1].pos();
-            best.offer(ax.at(p, nl, nr, pp), p);
+        *nr -= pp + pe;
+        if !self.inside(key) {
+            *nl += ps + pp;
+            return true;
         }
-        nl += ps + pp;
+        let p = events::unordered(key);
+        best.offer(self.at(p, *nl, *nr, pp), p);
+        *nl += ps + pp;
+        // Ties go to the earlier plane: stop once no later one can rank strictly lower.
+        self.floor(p, *nl) < best.rank
     }
 }
