@@ -18,7 +18,10 @@ pub struct RayCounts {
     /// cut-out holes.
     pub shadow_pass_through: u64,
     /// Shadow rays taken as blocked where they passed into a closed piece of an object:
-    /// the face they would leave it by casts (see `render::solid`).
+    /// the face they would leave it by casts (see `render::solid`). With this and
+    /// `shadow_pass_through`, how the work splits varies a little from run to run (an
+    /// object's pieces are found once enough rays, from any thread, have entered it); the
+    /// pixels do not.
     pub shadow_solid: u64,
     /// Camera and reflection rays continued past a blended (Transparent/Fade) surface for
     /// the light behind it: each a query from the hit onwards.
