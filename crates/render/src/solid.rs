@@ -18,7 +18,7 @@ use glam::Vec3;
 use kdtree::Ray;
 use std::collections::HashMap;
 use std::ops::Range;
-use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
+use std::sync::atomic::{AtomicBool, AtomicU32, Ordering::Relaxed};
 use std::sync::OnceLock;
 
 /// The closed pieces of each object, worked out once enough shadow rays have passed into
@@ -31,6 +31,8 @@ pub struct Solids<'a> {
     pieces: Vec<OnceLock<Pieces>>,
     /// Shadow rays that passed into each object so far.
     entered: Vec<AtomicU32>,
+    /// Whether a thread has taken on finding each object's pieces.
+    claimed: Vec<AtomicBool>,
 }
 
 /// One object's pieces: per triangle of its run, the number of its solid piece or
@@ -67,6 +69,7 @@ impl<'a> Solids<'a> {
             runs,
             pieces: (0..n).map(|_| OnceLock::new()).collect(),
             entered: (0..n).map(|_| AtomicU32::new(0)).collect(),
+            claimed: (0..n).map(|_| AtomicBool::new(false)).collect(),
         }
     }
 
@@ -77,6 +80,7 @@ impl<'a> Solids<'a> {
             runs: Vec::new(),
             pieces: Vec::new(),
             entered: Vec::new(),
+            claimed: Vec::new(),
         }
     }
 
@@ -100,7 +104,8 @@ impl<'a> Solids<'a> {
             Some(p) => p,
             None => {
                 let entered = self.entered[o].fetch_add(1, Relaxed) as usize + 1;
-                if entered < run.len() / 4 {
+                // One thread finds them; the others walk on meanwhile rather than wait.
+                if entered < run.len() / 4 || self.claimed[o].swap(true, Relaxed) {
                     return false;
                 }
                 cell.get_or_init(|| closed_pieces(self.soup, o, run.clone()))
