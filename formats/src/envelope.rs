@@ -34,8 +34,8 @@ fn config() -> bincode::config::Configuration<bincode::config::LittleEndian, bin
 /// Payloads are bincode (little-endian, fixed-width integers), but their bulk — per-triangle
 /// arrays, tree nodes — goes through [`PayloadWriter::array`] and [`PayloadReader::array`],
 /// which write and read the very bytes bincode would (a u64 count, then the elements
-/// little-endian) as one block instead of one call per number. A two-million-triangle soup is 168 MB; serialising it
-/// float by float was the largest part of writing it.
+/// little-endian) as one block instead of one call per number. A two-million-triangle soup
+/// is 168 MB; serialising it float by float was the largest part of writing it.
 pub trait Artifact: Sized {
     const MAGIC: &'static [u8; 8];
     const VERSION: u32;

@@ -49,20 +49,14 @@ impl<'a> Solids<'a> {
     pub fn new(soup: &'a Soup) -> Solids<'a> {
         let n = soup.objects.len();
         let mut runs = vec![0..0; n];
-        let mut seen = vec![false; n];
         let mut start = 0;
-        let ids = &soup.tri_object;
-        for i in 0..=ids.len() {
-            if i == ids.len() || ids[i] != ids[start] {
-                if let Some(&o) = ids.get(start) {
-                    let Some(s) = seen.get_mut(o as usize).filter(|s| !**s) else {
-                        return Self::none(soup);
-                    };
-                    *s = true;
-                    runs[o as usize] = start..i;
-                }
-                start = i;
+        for run in soup.tri_object.chunk_by(|a, b| a == b) {
+            // An object met a second time is not one run.
+            match runs.get_mut(run[0] as usize) {
+                Some(r) if r.start == r.end => *r = start..start + run.len(),
+                _ => return Self::none(soup),
             }
+            start += run.len();
         }
         Solids {
             soup,
