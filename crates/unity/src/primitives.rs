@@ -154,8 +154,7 @@ fn quad() -> Mesh {
     b.quad(a, c, d, e);
     // Unity's Quad maps the texture upright seen from its front (from −Z, +X to the
     // right): (0, 0) at Unity's (−0.5, −0.5), which is this right-handed (+0.5, −0.5).
-    // The layouts of Sphere, Capsule and Cylinder are not established, so they have no
-    // UVs yet; Cube and Plane get theirs in Unity space (see `mesh`).
+    // Cube and Plane get theirs in Unity space (see `mesh`).
     b.uv =
         b.p.iter()
             .map(|p| Vec2::new(0.5 - p.x, p.y + 0.5))
@@ -228,25 +227,31 @@ fn capsule(seg: u32, half_rings: u32) -> Mesh {
         }
     });
     // The equator row sits at y = 0 from the closure above; rebuild it as two rows so
-    // the side spans y ∈ [−0.5, 0.5]. Unity's Capsule layout is not known here: no UVs.
-    b.uv.clear();
+    // the side spans y ∈ [−0.5, 0.5].
     let m = b.done();
     fix_capsule_equator(m, seg)
 }
 
 /// The equator ring of the capsule generator is at y = 0: split the bands touching it so
 /// that the upper band ends at y = +0.5 and the lower starts at y = −0.5, joined by a side
-/// band.
+/// band. UVs keep the sphere's longitude as u and take v from the height, 0 at the bottom
+/// pole and 1 at the top (Unity's own Capsule layout could not be confirmed; this is the
+/// Sphere's convention stretched over the capsule).
 fn fix_capsule_equator(m: Mesh, seg: u32) -> Mesh {
     let mut b = Builder::default();
     let mut remap_up = vec![u32::MAX; m.positions.len()];
     let mut remap_down = vec![u32::MAX; m.positions.len()];
+    let mut vertex = |b: &mut Builder, p: Vec3, n: Vec3, u: f32| {
+        b.uv.push(Vec2::new(u, (p.y + 1.0) * 0.5));
+        b.v(p, n)
+    };
     for (i, (&p, &n)) in m.positions.iter().zip(&m.normals).enumerate() {
+        let u = m.uvs[i].x;
         if p.y == 0.0 {
-            remap_up[i] = b.v(Vec3::new(p.x, 0.5, p.z), n);
-            remap_down[i] = b.v(Vec3::new(p.x, -0.5, p.z), n);
+            remap_up[i] = vertex(&mut b, Vec3::new(p.x, 0.5, p.z), n, u);
+            remap_down[i] = vertex(&mut b, Vec3::new(p.x, -0.5, p.z), n, u);
         } else {
-            remap_up[i] = b.v(p, n);
+            remap_up[i] = vertex(&mut b, p, n, u);
             remap_down[i] = remap_up[i];
         }
     }
@@ -267,7 +272,11 @@ fn fix_capsule_equator(m: Mesh, seg: u32) -> Mesh {
     b.done()
 }
 
-/// Diameter 1, height 2 (y ∈ [−1, 1]), `seg` sides, capped.
+/// Diameter 1, height 2 (y ∈ [−1, 1]), `seg` sides, capped. Unity's own Cylinder layout
+/// could not be confirmed, so the UVs follow the Sphere's convention: the side spans the
+/// texture once around (u as the Sphere's longitude) and once from bottom (v = 0) to top;
+/// each cap shows the disc inscribed in the texture, upright seen from outside with
+/// Unity's +Z up (from above) or down (from below), Unity's +X to the right.
 fn cylinder(seg: u32) -> Mesh {
     let mut b = Builder::default();
     let ring = |b: &mut Builder, y: f32, side: bool| -> Vec<u32> {
@@ -275,11 +284,12 @@ fn cylinder(seg: u32) -> Mesh {
             .map(|si| {
                 let phi = TAU * si as f32 / seg as f32;
                 let d = Vec3::new(phi.cos(), 0.0, -phi.sin());
-                let n = if side {
-                    d
+                let (n, uv) = if side {
+                    (d, Vec2::new(si as f32 / seg as f32, (y + 1.0) * 0.5))
                 } else {
-                    Vec3::new(0.0, y.signum(), 0.0)
+                    (Vec3::new(0.0, y.signum(), 0.0), cap_uv(d * 0.5, y))
                 };
+                b.uv.push(uv);
                 b.v(d * 0.5 + Vec3::Y * y, n)
             })
             .collect()
@@ -291,6 +301,7 @@ fn cylinder(seg: u32) -> Mesh {
     }
     for (y, up) in [(1.0f32, true), (-1.0, false)] {
         let r = ring(&mut b, y, false);
+        b.uv.push(cap_uv(Vec3::ZERO, y));
         let c = b.v(Vec3::Y * y, Vec3::Y * y.signum());
         for i in 0..seg as usize {
             // φ increases counter-clockwise seen from +Y (x = cos φ, z = −sin φ).
@@ -302,6 +313,13 @@ fn cylinder(seg: u32) -> Mesh {
         }
     }
     b.done()
+}
+
+/// A cylinder cap's UV at offset `d` from its centre (this builder's right-handed space,
+/// whose +X is Unity's −X) on the cap at height `y`: see [`cylinder`].
+fn cap_uv(d: Vec3, y: f32) -> Vec2 {
+    let v = if y > 0.0 { d.z } else { -d.z };
+    Vec2::new(0.5 - d.x, 0.5 + v)
 }
 
 #[cfg(test)]
@@ -390,9 +408,6 @@ mod tests {
             assert_eq!(*uv, Vec2::new(p.x + 0.5, p.y + 0.5), "{p}");
         }
         assert!(q.uvs.contains(&Vec2::ZERO) && q.uvs.contains(&Vec2::ONE));
-        for id in [10206, 10208] {
-            assert!(mesh(id).unwrap().uvs.is_empty(), "{id}");
-        }
     }
 
     #[test]
@@ -473,5 +488,81 @@ mod tests {
             uv_at(&p, Vec3::new(0.0, 0.0, 0.0), Vec3::Y),
             Vec2::splat(0.5)
         );
+    }
+
+    /// The UVs of the vertices within 1e-6 of the Unity-space point `p` whose normal leans
+    /// towards `n`, sorted by u (a point on a seam has two).
+    fn uvs_near(m: &Mesh, p: Vec3, n: Vec3) -> Vec<Vec2> {
+        let mut found: Vec<Vec2> = (0..m.positions.len())
+            .filter(|&i| (m.positions[i] - p).length() < 1e-6 && m.normals[i].dot(n) > 0.7)
+            .map(|i| m.uvs[i])
+            .collect();
+        assert!(!found.is_empty(), "no vertex at {p} facing {n}");
+        found.sort_by(|a, b| a.x.total_cmp(&b.x));
+        found
+    }
+
+    fn close(got: &[Vec2], want: &[Vec2]) -> bool {
+        got.len() == want.len() && got.iter().zip(want).all(|(g, w)| (*g - *w).length() < 1e-6)
+    }
+
+    #[test]
+    fn cylinder_uvs_wrap_the_side_and_inscribe_the_caps() {
+        let m = mesh(10206).unwrap();
+        assert_eq!(m.uvs.len(), m.positions.len());
+        let v2 = Vec2::new;
+        let cases = [
+            // Side: u as the Sphere's longitude (seam on −X), v from 0 at the bottom.
+            (
+                Vec3::new(-0.5, 1.0, 0.0),
+                Vec3::NEG_X,
+                vec![v2(0.0, 1.0), v2(1.0, 1.0)],
+            ),
+            (Vec3::new(0.0, -1.0, -0.5), Vec3::NEG_Z, vec![v2(0.25, 0.0)]),
+            (Vec3::new(0.5, 1.0, 0.0), Vec3::X, vec![v2(0.5, 1.0)]),
+            (Vec3::new(0.0, -1.0, 0.5), Vec3::Z, vec![v2(0.75, 0.0)]),
+            // Top, from above: +X right, +Z up; bottom, from below: +X right, +Z down.
+            (Vec3::new(0.0, 1.0, 0.0), Vec3::Y, vec![v2(0.5, 0.5)]),
+            (Vec3::new(0.5, 1.0, 0.0), Vec3::Y, vec![v2(1.0, 0.5)]),
+            (Vec3::new(0.0, 1.0, 0.5), Vec3::Y, vec![v2(0.5, 1.0)]),
+            (Vec3::new(0.5, -1.0, 0.0), Vec3::NEG_Y, vec![v2(1.0, 0.5)]),
+            (Vec3::new(0.0, -1.0, 0.5), Vec3::NEG_Y, vec![v2(0.5, 0.0)]),
+        ];
+        for (p, n, want) in cases {
+            let got = uvs_near(&m, p, n);
+            assert!(
+                close(&got, &want),
+                "at {p} facing {n}: {got:?}, want {want:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn capsule_uvs_run_from_pole_to_pole_by_height() {
+        let m = mesh(10208).unwrap();
+        assert_eq!(m.uvs.len(), m.positions.len());
+        let v2 = Vec2::new;
+        let cases = [
+            (
+                Vec3::new(-0.5, 0.5, 0.0),
+                Vec3::NEG_X,
+                vec![v2(0.0, 0.75), v2(1.0, 0.75)],
+            ),
+            (Vec3::new(0.0, 0.5, -0.5), Vec3::NEG_Z, vec![v2(0.25, 0.75)]),
+            (Vec3::new(0.5, -0.5, 0.0), Vec3::X, vec![v2(0.5, 0.25)]),
+            (Vec3::new(0.0, -0.5, 0.5), Vec3::Z, vec![v2(0.75, 0.25)]),
+        ];
+        for (p, n, want) in cases {
+            let got = uvs_near(&m, p, n);
+            assert!(
+                close(&got, &want),
+                "at {p} facing {n}: {got:?}, want {want:?}"
+            );
+        }
+        // The poles: v = 1 at the top, 0 at the bottom, whatever the longitude.
+        assert!(uvs_near(&m, Vec3::Y, Vec3::Y).iter().all(|uv| uv.y == 1.0));
+        assert!(uvs_near(&m, Vec3::NEG_Y, Vec3::NEG_Y)
+            .iter()
+            .all(|uv| uv.y == 0.0));
     }
 }
