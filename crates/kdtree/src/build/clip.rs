@@ -30,64 +30,94 @@ fn up(x: f64) -> f32 {
     }
 }
 
+/// A convex polygon in f64, cut down one plane at a time.
+struct Poly {
+    v: [[f64; 3]; MAX_POLY],
+    n: usize,
+}
+
+impl Poly {
+    /// Keep the part on one side of the plane `AXIS = plane` (at or above it when `ABOVE`):
+    /// false when no vertex is on that side. The axis and side are constants so that each
+    /// of the six calls compiles to its own straight comparisons.
+    #[inline(always)]
+    fn cut<const AXIS: usize, const ABOVE: bool>(&mut self, plane: f64) -> bool {
+        let inside = |p: &[f64; 3]| {
+            if ABOVE {
+                p[AXIS] >= plane
+            } else {
+                p[AXIS] <= plane
+            }
+        };
+        let n = self.n;
+        let v = &self.v;
+        // One bit per vertex; most planes cut nothing and are skipped (the polygon is
+        // unchanged, same bits).
+        let mut mask = 0u32;
+        for (i, p) in v[..n].iter().enumerate() {
+            mask |= (inside(p) as u32) << i;
+        }
+        if mask == (1 << n) - 1 {
+            return true;
+        }
+        if mask == 0 {
+            return false;
+        }
+        let mut out = [[0f64; 3]; MAX_POLY];
+        let mut m = 0;
+        for i in 0..n {
+            let a = v[i];
+            // The edge to the next vertex, the last closing on the first.
+            let j = if i + 1 == n { 0 } else { i + 1 };
+            let b = v[j];
+            let (ia, ib) = (mask >> i & 1 != 0, mask >> j & 1 != 0);
+            if ia {
+                out[m] = a;
+                m += 1;
+            }
+            if ia != ib && m < MAX_POLY {
+                let s = (plane - a[AXIS]) / (b[AXIS] - a[AXIS]);
+                let mut p = [0f64; 3];
+                for k in 0..3 {
+                    p[k] = a[k] + s * (b[k] - a[k]);
+                }
+                // The crossing point lies on the plane by construction.
+                p[AXIS] = plane;
+                out[m] = p;
+                m += 1;
+            }
+        }
+        self.v = out;
+        self.n = m;
+        true
+    }
+}
+
 /// Bounds of `tri ∩ cell`, or None when the triangle does not reach into the cell.
 pub fn clipped_bounds(tri: &[Vec3; 3], cell: &Aabb) -> Option<Aabb> {
-    let mut poly = [[0f64; 3]; MAX_POLY];
-    let mut n = 3;
+    let mut poly = Poly {
+        v: [[0f64; 3]; MAX_POLY],
+        n: 3,
+    };
     for (i, v) in tri.iter().enumerate() {
-        poly[i] = [v.x as f64, v.y as f64, v.z as f64];
+        poly.v[i] = [v.x as f64, v.y as f64, v.z as f64];
     }
-    let mut next = [[0f64; 3]; MAX_POLY];
-    for axis in 0..3 {
-        for (plane, keep_above) in [(cell.lo[axis] as f64, true), (cell.hi[axis] as f64, false)] {
-            let inside = |p: &[f64; 3]| {
-                if keep_above {
-                    p[axis] >= plane
-                } else {
-                    p[axis] <= plane
-                }
-            };
-            // Most planes cut nothing: skip them (the polygon is unchanged, same bits).
-            let n_inside = poly[..n].iter().filter(|p| inside(p)).count();
-            if n_inside == n {
-                continue;
-            }
-            if n_inside == 0 {
-                return None;
-            }
-            let mut m = 0;
-            for i in 0..n {
-                let a = poly[i];
-                // The edge to the next vertex, the last closing on the first (no division
-                // by a variable `n`).
-                let b = poly[if i + 1 == n { 0 } else { i + 1 }];
-                let (ia, ib) = (inside(&a), inside(&b));
-                if ia {
-                    next[m] = a;
-                    m += 1;
-                }
-                if ia != ib && m < MAX_POLY {
-                    let s = (plane - a[axis]) / (b[axis] - a[axis]);
-                    let mut p = [0f64; 3];
-                    for k in 0..3 {
-                        p[k] = a[k] + s * (b[k] - a[k]);
-                    }
-                    // The crossing point lies on the plane by construction.
-                    p[axis] = plane;
-                    next[m] = p;
-                    m += 1;
-                }
-            }
-            n = m;
-            poly[..n].copy_from_slice(&next[..n]);
-        }
+    let (lo, hi) = (cell.lo.map(f64::from), cell.hi.map(f64::from));
+    let inside = poly.cut::<0, true>(lo[0])
+        && poly.cut::<0, false>(hi[0])
+        && poly.cut::<1, true>(lo[1])
+        && poly.cut::<1, false>(hi[1])
+        && poly.cut::<2, true>(lo[2])
+        && poly.cut::<2, false>(hi[2]);
+    if !inside {
+        return None;
     }
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     // Plain comparisons: every coordinate is a number (f64::min and max would also sort
     // out NaN), and which zero wins a tie of −0 and +0 changes no event (positions map
     // both to one key).
-    for p in &poly[..n] {
+    for p in &poly.v[..poly.n] {
         for k in 0..3 {
             lo[k] = if p[k] < lo[k] { p[k] } else { lo[k] };
             hi[k] = if p[k] > hi[k] { p[k] } else { hi[k] };
@@ -107,6 +137,7 @@ pub fn clipped_bounds(tri: &[Vec3; 3], cell: &Aabb) -> Option<Aabb> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::testkit::Rng;
 
     fn cell(lo: [f32; 3], hi: [f32; 3]) -> Aabb {
         Aabb { lo, hi }
@@ -159,5 +190,115 @@ mod tests {
         let exact_y = 3.0 - 0.1f32 as f64;
         assert!(b.hi[1] as f64 >= exact_y);
         assert!((b.hi[1] as f64 - exact_y) < 1e-6);
+    }
+
+    /// The clipper as first written, one plane after another over a vertex list: the
+    /// structure of [`clipped_bounds`] may change, its bits may not.
+    fn reference(tri: &[Vec3; 3], cell: &Aabb) -> Option<Aabb> {
+        let mut poly = [[0f64; 3]; MAX_POLY];
+        let mut n = 3;
+        for (i, v) in tri.iter().enumerate() {
+            poly[i] = [v.x as f64, v.y as f64, v.z as f64];
+        }
+        let mut next = [[0f64; 3]; MAX_POLY];
+        for axis in 0..3 {
+            for (plane, keep_above) in [(cell.lo[axis] as f64, true), (cell.hi[axis] as f64, false)]
+            {
+                let inside = |p: &[f64; 3]| {
+                    if keep_above {
+                        p[axis] >= plane
+                    } else {
+                        p[axis] <= plane
+                    }
+                };
+                // Most planes cut nothing: skip them (the polygon is unchanged, same bits).
+                let n_inside = poly[..n].iter().filter(|p| inside(p)).count();
+                if n_inside == n {
+                    continue;
+                }
+                if n_inside == 0 {
+                    return None;
+                }
+                let mut m = 0;
+                for i in 0..n {
+                    let a = poly[i];
+                    // The edge to the next vertex, the last closing on the first (no division
+                    // by a variable `n`).
+                    let b = poly[if i + 1 == n { 0 } else { i + 1 }];
+                    let (ia, ib) = (inside(&a), inside(&b));
+                    if ia {
+                        next[m] = a;
+                        m += 1;
+                    }
+                    if ia != ib && m < MAX_POLY {
+                        let s = (plane - a[axis]) / (b[axis] - a[axis]);
+                        let mut p = [0f64; 3];
+                        for k in 0..3 {
+                            p[k] = a[k] + s * (b[k] - a[k]);
+                        }
+                        // The crossing point lies on the plane by construction.
+                        p[axis] = plane;
+                        next[m] = p;
+                        m += 1;
+                    }
+                }
+                n = m;
+                poly[..n].copy_from_slice(&next[..n]);
+            }
+        }
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        // Plain comparisons: every coordinate is a number (f64::min and max would also sort
+        // out NaN), and which zero wins a tie of −0 and +0 changes no event (positions map
+        // both to one key).
+        for p in &poly[..n] {
+            for k in 0..3 {
+                lo[k] = if p[k] < lo[k] { p[k] } else { lo[k] };
+                hi[k] = if p[k] > hi[k] { p[k] } else { hi[k] };
+            }
+        }
+        let mut b = Aabb::EMPTY;
+        for k in 0..3 {
+            b.lo[k] = down(lo[k]).max(cell.lo[k]);
+            b.hi[k] = up(hi[k]).min(cell.hi[k]);
+            if b.lo[k] > b.hi[k] {
+                return None;
+            }
+        }
+        Some(b)
+    }
+
+    #[test]
+    fn same_bounds_as_the_reference_clipper() {
+        let mut rng = Rng(5);
+        // Lattice coordinates put vertices on cell planes and make flat cells and
+        // triangles; the scales cover rounding far from 1.
+        let coord = |rng: &mut Rng, scale: f32| {
+            if rng.unit() < 0.3 {
+                (rng.range(-4.0, 4.0).round() * 0.5) * scale
+            } else {
+                rng.range(-2.0, 2.0) * scale
+            }
+        };
+        for case in 0..200_000 {
+            let scale = [1.0, 1e-3, 7.3e4, 3e-30][case % 4];
+            let t: [Vec3; 3] = std::array::from_fn(|_| {
+                Vec3::new(
+                    coord(&mut rng, scale),
+                    coord(&mut rng, scale),
+                    coord(&mut rng, scale),
+                )
+            });
+            let (mut lo, mut hi) = ([0f32; 3], [0f32; 3]);
+            for k in 0..3 {
+                let (a, b) = (coord(&mut rng, scale), coord(&mut rng, scale));
+                (lo[k], hi[k]) = (a.min(b), a.max(b));
+            }
+            let c = cell(lo, hi);
+            let (got, want) = (clipped_bounds(&t, &c), reference(&t, &c));
+            let bits =
+                |b: Option<Aabb>| b.map(|b| (b.lo.map(f32::to_bits), b.hi.map(f32::to_bits)));
+            assert_eq!(bits(got), bits(want), "triangle {t:?}, cell {c:?}");
+        }
     }
 }

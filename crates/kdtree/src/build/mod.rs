@@ -290,23 +290,24 @@ fn build_events(ctx: &Ctx, w: Work, depth: u32) -> Part {
     }
 }
 
-fn make_leaf(w: Work, out: &mut Subtree) {
+fn make_leaf(w: Work, out: &mut Subtree, scratch: &mut Scratch) {
     out.nodes.push(KdNode::leaf(
         w.tris.len() as u32,
         out.leaf_tris.len() as u32,
     ));
     out.leaf_tris.extend_from_slice(&w.tris);
+    scratch.recycle(w);
 }
 
 /// The serial build below `JOIN_MIN` triangles, straight into one flat subtree.
 fn build_rec(ctx: &Ctx, w: Work, depth: u32, out: &mut Subtree, scratch: &mut Scratch) {
     let n = w.tris.len();
     if n <= ctx.leaf_size || depth >= ctx.max_depth {
-        return make_leaf(w, out);
+        return make_leaf(w, out, scratch);
     }
     let split = match find_split(ctx, &w, false) {
         Some(s) if s.cost < ctx.ki * n as f64 => s,
-        _ => return make_leaf(w, out),
+        _ => return make_leaf(w, out, scratch),
     };
     let (below, above) = split_work(ctx, w, &split, false, scratch);
     let at = out.nodes.len();
@@ -402,6 +403,32 @@ struct Scratch {
     clipped: Vec<(Option<Aabb>, Option<Aabb>)>,
     /// Per child: the straddlers that reach into it (local index in the child, clipped box).
     new: [Vec<(u32, Aabb)>; 2],
+    /// Both children's fresh events of one axis.
+    fresh: Vec<Event>,
+    /// The lists of cells already split or made leaves, handed out again for children's
+    /// lists: a serial build then allocates only while its lists grow deeper.
+    spare_tris: Vec<Vec<u32>>,
+    spare_events: Vec<Vec<Event>>,
+}
+
+impl Scratch {
+    fn recycle(&mut self, w: Work) {
+        self.spare_tris.push(w.tris);
+        self.spare_events.extend(w.events);
+    }
+
+    /// An empty list from the spares (the last given back: the largest, most often).
+    fn events(&mut self) -> Vec<Event> {
+        let mut v = self.spare_events.pop().unwrap_or_default();
+        v.clear();
+        v
+    }
+
+    fn tris(&mut self) -> Vec<u32> {
+        let mut v = self.spare_tris.pop().unwrap_or_default();
+        v.clear();
+        v
+    }
 }
 
 /// Classify the triangles against the split and build both children's work, keeping each
@@ -414,11 +441,22 @@ fn split_work(
     scratch: &mut Scratch,
 ) -> (Work, Work) {
     let n = w.tris.len();
+    // Lists for the children, from the spares (empty ones in a parallel split: the three
+    // axes' partitions then allocate their own).
+    let (mut tris_b, mut tris_a) = (scratch.tris(), scratch.tris());
+    let mut lists: [[Vec<Event>; 2]; 3] = Default::default();
+    if !parallel {
+        for l in lists.iter_mut().flatten() {
+            *l = scratch.events();
+        }
+    }
     let Scratch {
         place,
         straddlers,
         clipped,
         new: [new_b, new_a],
+        fresh,
+        ..
     } = scratch;
     place.clear();
     place.resize(n, BOTH);
@@ -454,8 +492,8 @@ fn split_work(
     let kept_b = place.iter().filter(|&&p| p == BELOW).count();
     let n_both = place.iter().filter(|&&p| p == BOTH).count();
     let kept_a = n - kept_b - n_both;
-    let mut tris_b = vec![0; kept_b + n_both + 1];
-    let mut tris_a = vec![0; kept_a + n_both + 1];
+    tris_b.resize(kept_b + n_both + 1, 0);
+    tris_a.resize(kept_a + n_both + 1, 0);
     straddlers.clear();
     straddlers.resize(n_both + 1, 0);
     let (mut nb, mut na, mut ns) = (0, 0, 0);
@@ -502,35 +540,48 @@ fn split_work(
         }
     }
     let (new_b, new_a, place) = (&*new_b, &*new_a, &*place);
-    let child_events = |axis: usize, ev: &Vec<Event>| -> (Vec<Event>, Vec<Event>) {
+    let child_events = |axis: usize,
+                        ev: &[Event],
+                        fresh: &mut Vec<Event>,
+                        [mut eb, mut ea]: [Vec<Event>; 2]|
+     -> (Vec<Event>, Vec<Event>) {
         // Both children's fresh events in one list: the below child's, then the above's.
-        let mut fresh = Vec::with_capacity(2 * (new_b.len() + new_a.len()));
+        fresh.clear();
         for (t, b) in new_b {
-            events::push_events(&mut fresh, b, axis, *t);
+            events::push_events(fresh, b, axis, *t);
         }
         let mid = fresh.len();
         for (t, b) in new_a {
-            events::push_events(&mut fresh, b, axis, *t);
+            events::push_events(fresh, b, axis, *t);
         }
         let (fb, fa) = fresh.split_at_mut(mid);
         events::sort(fb, false);
         events::sort(fa, false);
-        let [eb, ea] = partition(ev, place, [fb, fa]);
+        partition(ev, place, [fb, fa], [&mut eb, &mut ea]);
         (eb, ea)
     };
-    let Work { events: ev, .. } = w;
-    let [ex, ey, ez] = ev;
+    let [ex, ey, ez] = &w.events;
+    let [lx, ly, lz] = lists;
     let ((bx, ax), ((by, ay), (bz, az))) = if parallel {
         rayon::join(
-            || child_events(0, &ex),
-            || rayon::join(|| child_events(1, &ey), || child_events(2, &ez)),
+            || child_events(0, ex, &mut Vec::new(), lx),
+            || {
+                rayon::join(
+                    || child_events(1, ey, &mut Vec::new(), ly),
+                    || child_events(2, ez, &mut Vec::new(), lz),
+                )
+            },
         )
     } else {
         (
-            child_events(0, &ex),
-            (child_events(1, &ey), child_events(2, &ez)),
+            child_events(0, ex, fresh, lx),
+            (
+                child_events(1, ey, fresh, ly),
+                child_events(2, ez, fresh, lz),
+            ),
         )
     };
+    scratch.recycle(w);
     (
         Work {
             tris: tris_b,
@@ -547,13 +598,15 @@ fn split_work(
 
 /// One axis's events of both children, in one pass over the parent's: the events of the
 /// triangles each child keeps (`place`), in order and renumbered, with the child's `fresh`
-/// events (sorted) merged in.
-fn partition(ev: &[Event], place: &[u32], fresh: [&[Event]; 2]) -> [Vec<Event>; 2] {
+/// events (sorted) merged in. `out` are the children's lists, empty.
+fn partition(ev: &[Event], place: &[u32], fresh: [&[Event]; 2], out: [&mut Vec<Event>; 2]) {
     let [fb, fa] = fresh;
+    let [eb, ea] = out;
     // Room for every event and every fresh event: each step below writes at most one of
     // either, so the counts stay below the capacities without a check per write.
-    let mut eb: Vec<Event> = Vec::with_capacity(ev.len() + fb.len() + 1);
-    let mut ea: Vec<Event> = Vec::with_capacity(ev.len() + fa.len() + 1);
+    debug_assert!(eb.is_empty() && ea.is_empty());
+    eb.reserve(ev.len() + fb.len() + 1);
+    ea.reserve(ev.len() + fa.len() + 1);
     let (pb, pa) = (eb.as_mut_ptr(), ea.as_mut_ptr());
     let (mut nb, mut na, mut jb, mut ja, mut i) = (0, 0, 0, 0, 0);
     let key = |f: &[Event], j: usize| f.get(j).map_or(u64::MAX, |f| f.pos_kind());
@@ -605,5 +658,4 @@ fn partition(ev: &[Event], place: &[u32], fresh: [&[Event]; 2]) -> [Vec<Event>; 
         eb.set_len(nb);
         ea.set_len(na);
     }
-    [eb, ea]
 }

@@ -157,60 +157,65 @@ impl Best {
     }
 }
 
+/// A table indexed by an event's kind (two bits: the fourth entry is never read, and
+/// makes the index need no bounds check).
+const fn per_kind(end: f64, planar: f64, start: f64) -> [f64; 4] {
+    let mut t = [0.0; 4];
+    t[END as usize] = end;
+    t[PLANAR as usize] = planar;
+    t[START as usize] = start;
+    t
+}
+
 /// Sweep sorted events in position order, starting from the counts the positions before
 /// them leave: `nl` triangles started (or planar) below, `nr` not yet ended. `best` may
 /// come in with a rank to beat and no plane (a bound from elsewhere): only planes ranked
 /// strictly below it are taken.
 pub fn sweep(ax: &AxisCost, ev: &[Event], mut nl: f64, mut nr: f64, best: &mut Best) {
-    // One position at a time: count its end, planar and start events, then price the
-    // plane there. The counters are plain locals (an array indexed by kind would keep them
-    // in memory, one store-to-load chain per event).
+    // What one event of each kind (END, PLANAR, START) does to the counts of the planes
+    // from its own on: it takes one from those not yet ended at its position, adds one to
+    // those lying in it, and one to those below every later plane. The counts stay whole
+    // numbers in f64, so adding one event at a time gives the very sums of adding a
+    // position's counts at once, without converting counts at every position.
+    const ENDED: [f64; 4] = per_kind(1.0, 1.0, 0.0);
+    const IN_PLANE: [f64; 4] = per_kind(0.0, 1.0, 0.0);
+    const BELOW_NEXT: [f64; 4] = per_kind(0.0, 1.0, 1.0);
     let Some(first) = ev.first() else { return };
     if ax.floor(ax.lo, nl) >= best.rank {
         return;
     }
     let mut key = first.pos_key();
-    let (mut pe, mut pp, mut ps) = (0u32, 0u32, 0u32);
+    // `nl` for the planes after the current position, and those lying in it.
+    let (mut next_nl, mut pp) = (nl, 0.0);
     for e in ev {
         if e.pos_key() != key {
-            if !ax.price(key, [pe, pp, ps], &mut nl, &mut nr, best) {
+            if !ax.price(key, nl, nr, pp, next_nl, best) {
                 return;
             }
             key = e.pos_key();
-            (pe, pp, ps) = (0, 0, 0);
+            (nl, pp) = (next_nl, 0.0);
         }
-        let kind = e.kind();
-        pe += (kind == END) as u32;
-        pp += (kind == PLANAR) as u32;
-        ps += (kind == START) as u32;
+        let kind = e.kind() as usize;
+        nr -= ENDED[kind];
+        pp += IN_PLANE[kind];
+        next_nl += BELOW_NEXT[kind];
     }
-    ax.price(key, [pe, pp, ps], &mut nl, &mut nr, best);
+    ax.price(key, nl, nr, pp, next_nl, best);
 }
 
 impl AxisCost {
-    /// Offer the plane at `key` with its events' counts, move the counts past it, and say
-    /// whether a later plane can still beat `best`.
+    /// Offer the plane at `key` with its counts, and say whether a later plane (with
+    /// `next_nl` triangles below) can still beat `best`.
     // Always inlined: at every position of every sweep, and the compiler's own weighing
     // of the grown `at` left it a call.
     #[inline(always)]
-    fn price(
-        &self,
-        key: u32,
-        count: [u32; 3],
-        nl: &mut f64,
-        nr: &mut f64,
-        best: &mut Best,
-    ) -> bool {
-        let [pe, pp, ps] = count.map(f64::from);
-        *nr -= pp + pe;
+    fn price(&self, key: u32, nl: f64, nr: f64, pp: f64, next_nl: f64, best: &mut Best) -> bool {
         if !self.inside(key) {
-            *nl += ps + pp;
             return true;
         }
         let p = events::unordered(key);
-        best.offer(self.at(p, *nl, *nr, pp), p);
-        *nl += ps + pp;
+        best.offer(self.at(p, nl, nr, pp), p);
         // Ties go to the earlier plane: stop once no later one can rank strictly lower.
-        self.floor(p, *nl) < best.rank
+        self.floor(p, next_nl) < best.rank
     }
 }
