@@ -96,14 +96,12 @@ pub enum Cull {
 }
 
 impl Cull {
-    /// Whether a ray travelling along `dir` skips a face with (unnormalised) winding
-    /// normal `n`: it sees the front when `dir·n < 0`. Edge-on hits are kept.
-    pub fn skips(self, n: Vec3, dir: Vec3) -> bool {
-        let d = n.dot(dir);
+    /// Whether a viewer who sees the face's front (`front`) or its back skips it.
+    pub fn skips(self, front: bool) -> bool {
         match self {
             Cull::None => false,
-            Cull::Back => d > 0.0,
-            Cull::Front => d < 0.0,
+            Cull::Back => !front,
+            Cull::Front => front,
         }
     }
 }

@@ -233,7 +233,13 @@ fn moller(origin: Vec3, dir: Vec3, tri: &[[f32; 3]; 3], tmin: f32, tmax: f32) ->
         return None;
     }
     let t = e2.dot(q) * inv;
-    (t >= tmin && t <= tmax).then_some(RawHit { t, u, v })
+    // det = e1 · (d × e2) = −d · n: positive when the ray meets the front.
+    (t >= tmin && t <= tmax).then_some(RawHit {
+        t,
+        u,
+        v,
+        front: det > 0.0,
+    })
 }
 
 /// [`moller`] on four triangles, lane by lane, as the product's four-wide test is.
@@ -279,7 +285,12 @@ fn moller4(
         }
         let t = Vec3::from([e2[0][l], e2[1][l], e2[2][l]]).dot(q) * inv[l];
         if t >= tmin && t <= tmax {
-            out[l] = Some(RawHit { t, u: u[l], v });
+            out[l] = Some(RawHit {
+                t,
+                u: u[l],
+                v,
+                front: inv[l] > 0.0,
+            });
         }
     }
     out

@@ -154,37 +154,43 @@ impl Accel {
     /// Closest hit with t in [tmin, tmax], or None. Ties in t go to the lower triangle
     /// index. NaN/infinite rays, zero directions and tmin > tmax are misses.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        self.tree().closest(ray, |_| true, &mut ())
+        self.tree().closest(ray, |_, _| true, &mut ())
     }
 
     /// Whether anything blocks the ray in [tmin, tmax]; stops at the first blocker.
     pub fn occluded(&self, ray: &Ray) -> bool {
-        self.tree().any(ray, |_| true, &mut ())
+        self.tree().any(ray, |_, _| true, &mut ())
     }
 
     /// The closest hit that `accept` takes (it is asked about each hit that would be the
-    /// closest so far, soup index and barycentrics filled in): what surfaces that are not
-    /// drawn from every side or at every texel need, without restarting the traversal for
-    /// each refused hit. Ties go to the lower index among accepted hits.
-    pub fn intersect_filtered(&self, ray: &Ray, accept: impl FnMut(&Hit) -> bool) -> Option<Hit> {
+    /// closest so far, soup index and barycentrics filled in, and whether the ray meets the
+    /// triangle's front, its vertices counter-clockwise as the ray sees them): what surfaces
+    /// that are not drawn from every side or at every texel need, without restarting the
+    /// traversal for each refused hit. Ties go to the lower index among accepted hits.
+    pub fn intersect_filtered(
+        &self,
+        ray: &Ray,
+        accept: impl FnMut(&Hit, bool) -> bool,
+    ) -> Option<Hit> {
         self.tree().closest(ray, accept, &mut ())
     }
 
     /// Whether a hit that `blocks` takes lies in [tmin, tmax]; stops at the first one.
-    /// Hits reach `blocks` in traversal order, not sorted by t.
-    pub fn occluded_filtered(&self, ray: &Ray, blocks: impl FnMut(&Hit) -> bool) -> bool {
+    /// Hits reach `blocks` in traversal order, not sorted by t, with the side as for
+    /// [`Accel::intersect_filtered`].
+    pub fn occluded_filtered(&self, ray: &Ray, blocks: impl FnMut(&Hit, bool) -> bool) -> bool {
         self.tree().any(ray, blocks, &mut ())
     }
 
     /// [`Accel::intersect`] that also adds what the traversal did to `counts` (benchmarks;
     /// the plain query is a separate instantiation and counts nothing).
     pub fn intersect_counted(&self, ray: &Ray, counts: &mut Counts) -> Option<Hit> {
-        self.tree().closest(ray, |_| true, counts)
+        self.tree().closest(ray, |_, _| true, counts)
     }
 
     /// [`Accel::occluded`] that also adds what the traversal did to `counts`.
     pub fn occluded_counted(&self, ray: &Ray, counts: &mut Counts) -> bool {
-        self.tree().any(ray, |_| true, counts)
+        self.tree().any(ray, |_, _| true, counts)
     }
 
     /// Bytes held for queries: nodes, leaf lists and triangle data.

@@ -352,7 +352,7 @@ impl Tree<'_> {
     /// and may refuse it (a culled face, a cut-out texel); refused hits are passed through
     /// inside the same traversal, with no restart from the root.
     #[inline(always)]
-    pub fn closest<F: FnMut(&Hit) -> bool, C: Counter>(
+    pub fn closest<F: FnMut(&Hit, bool) -> bool, C: Counter>(
         &self,
         ray: &Ray,
         mut accept: F,
@@ -369,7 +369,7 @@ impl Tree<'_> {
     }
 
     #[inline(always)]
-    fn closest_along<const KZ: usize, F: FnMut(&Hit) -> bool, C: Counter>(
+    fn closest_along<const KZ: usize, F: FnMut(&Hit, bool) -> bool, C: Counter>(
         &self,
         ray: &Ray,
         s: &Setup,
@@ -394,10 +394,9 @@ impl Tree<'_> {
                 for group in leaf.chunks(4) {
                     let bound = triangle::widen(best_t);
                     let (lanes, hits) = self.test4::<KZ>(s, ray, group, bound);
-                    for (l, p) in lanes.into_iter().enumerate() {
-                        if let Some(h) = hits.lane(l) {
-                            keep_closer(&mut best, &mut best_t, self.soup_index(p), h, accept);
-                        }
+                    for l in hits.hit_lanes() {
+                        let p = self.soup_index(lanes[l]);
+                        keep_closer(&mut best, &mut best_t, p, hits.raw(l), accept);
                     }
                 }
             } else {
@@ -428,7 +427,7 @@ impl Tree<'_> {
     /// Whether any triangle that `blocks` (soup index, t, u, v) is hit in [tmin, tmax];
     /// stops at the first one found, in whatever order the cells give them.
     #[inline(always)]
-    pub fn any<F: FnMut(&Hit) -> bool, C: Counter>(
+    pub fn any<F: FnMut(&Hit, bool) -> bool, C: Counter>(
         &self,
         ray: &Ray,
         mut blocks: F,
@@ -445,7 +444,7 @@ impl Tree<'_> {
     }
 
     #[inline(always)]
-    fn any_along<const KZ: usize, F: FnMut(&Hit) -> bool, C: Counter>(
+    fn any_along<const KZ: usize, F: FnMut(&Hit, bool) -> bool, C: Counter>(
         &self,
         ray: &Ray,
         s: &Setup,
@@ -476,18 +475,17 @@ impl Tree<'_> {
             if leaf.len() >= 2 {
                 for group in leaf.chunks(4) {
                     let (lanes, hits) = self.test4::<KZ>(s, ray, group, ray.tmax);
-                    for (l, p) in lanes.into_iter().enumerate() {
-                        if let Some(h) = hits.lane(l) {
-                            if blocks(&candidate(self.soup_index(p), h)) {
-                                return true;
-                            }
+                    for l in hits.hit_lanes() {
+                        let h = hits.raw(l);
+                        if blocks(&candidate(self.soup_index(lanes[l]), h), h.front) {
+                            return true;
                         }
                     }
                 }
             } else {
                 for &p in leaf {
                     if let Some(h) = test::<KZ>(s, ray, self.tri(p), ray.tmax) {
-                        if blocks(&candidate(self.soup_index(p), h)) {
+                        if blocks(&candidate(self.soup_index(p), h), h.front) {
                             return true;
                         }
                     }
@@ -508,7 +506,7 @@ impl Tree<'_> {
 /// the exact test.
 /// `accept` is asked only about a hit that would be kept.
 #[inline(always)]
-pub(crate) fn keep_closer<F: FnMut(&Hit) -> bool>(
+pub(crate) fn keep_closer<F: FnMut(&Hit, bool) -> bool>(
     best: &mut Hit,
     best_t: &mut f32,
     prim: u32,
@@ -517,7 +515,7 @@ pub(crate) fn keep_closer<F: FnMut(&Hit) -> bool>(
 ) {
     if h.t <= *best_t && (h.t < *best_t || prim < best.prim) {
         let c = candidate(prim, h);
-        if accept(&c) {
+        if accept(&c, h.front) {
             *best_t = h.t;
             *best = c;
         }

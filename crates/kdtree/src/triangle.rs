@@ -62,6 +62,10 @@ pub struct RawHit {
     pub t: f32,
     pub u: f32,
     pub v: f32,
+    /// The ray meets the triangle's front: its vertices run counter-clockwise as the ray
+    /// sees them. Taken from the determinant's sign, so it is the side the hit itself was
+    /// found on, never a separate (and differently rounded) normal test.
+    pub front: bool,
 }
 
 /// The bound to test candidates against when the best t so far is `t`: a few ulps more,
@@ -131,6 +135,15 @@ pub fn intersect_along<const KZ: usize>(
     finish([u, v, w], [a[2], b[2], c[2]], xy, r.sz, tmin, tmax)
 }
 
+/// Whether a hit with determinant `det` is on the triangle's front. The determinant is minus
+/// the sheared triangle's signed area in the plane of the other two axes: negative when
+/// the vertices run counter-clockwise seen from the dominant axis's positive side, which is
+/// the side a ray travelling down that axis (`sz` < 0) comes from.
+#[inline(always)]
+fn faces_front(det: f32, sz: f32) -> bool {
+    (det < 0.0) == (sz < 0.0)
+}
+
 /// The largest magnitude of three values.
 #[inline(always)]
 fn max3(a: f32, b: f32, c: f32) -> f32 {
@@ -188,6 +201,7 @@ fn finish(
         t,
         u: v * inv,
         v: w * inv,
+        front: faces_front(det, sz),
     })
 }
 
@@ -199,17 +213,40 @@ pub struct Hits4 {
     pub t: [f32; 4],
     pub u: [f32; 4],
     pub v: [f32; 4],
+    pub front: [bool; 4],
 }
 
 impl Hits4 {
+    /// The lanes that hit, in lane order. The loop runs once per hit (most groups have
+    /// none): asking each of four lanes was four branches a predictor cannot guess.
+    #[inline(always)]
+    pub fn hit_lanes(&self) -> impl Iterator<Item = usize> {
+        // One byte per lane, so lane l is bit 8·l of the little-endian word.
+        let mut mask = u32::from_le_bytes(self.hit.map(u8::from));
+        std::iter::from_fn(move || {
+            (mask != 0).then(|| {
+                let l = mask.trailing_zeros() as usize / 8;
+                mask &= mask - 1;
+                l
+            })
+        })
+    }
+
     /// Lane `l`'s answer as the scalar test gives it.
     #[inline(always)]
     pub fn lane(&self, l: usize) -> Option<RawHit> {
-        self.hit[l].then_some(RawHit {
+        self.hit[l].then(|| self.raw(l))
+    }
+
+    /// Lane `l`'s hit, for a lane that hit.
+    #[inline(always)]
+    pub fn raw(&self, l: usize) -> RawHit {
+        RawHit {
             t: self.t[l],
             u: self.u[l],
             v: self.v[l],
-        })
+            front: self.front[l],
+        }
     }
 }
 
@@ -278,11 +315,13 @@ pub fn intersect4_along<const KZ: usize>(
         t: [0.0; 4],
         u: [0.0; 4],
         v: [0.0; 4],
+        front: [false; 4],
     };
     if zero {
         for (l, t) in tri.into_iter().enumerate() {
             if let Some(h) = intersect_along::<KZ>(r, t, tmin, tmax) {
                 (out.hit[l], out.t[l], out.u[l], out.v[l]) = (true, h.t, h.u, h.v);
+                out.front[l] = h.front;
             }
         }
         return out;
@@ -315,6 +354,7 @@ pub fn intersect4_along<const KZ: usize>(
         out.t[l] = t;
         out.u[l] = v[l] * inv[l];
         out.v[l] = w[l] * inv[l];
+        out.front[l] = faces_front(det, sz);
     }
     for l in 0..4 {
         if out.hit[l] && near[l] {
@@ -344,7 +384,43 @@ mod tests {
                 (h.u - 0.25).abs() < 1e-6 && (h.v - 0.5).abs() < 1e-6,
                 "{h:?}"
             );
+            assert_eq!(h.front, dz < 0.0, "the front faces +z");
         }
+    }
+
+    /// `front` is the normal's side for every dominant axis, both directions along it,
+    /// oblique rays and both windings: the determinant's sign folded with the axis's sign.
+    #[test]
+    fn front_is_the_side_the_winding_normal_faces() {
+        let tri = [[0.3f32, -0.2, 0.1], [1.1, 0.4, -0.3], [-0.2, 0.9, 0.6]];
+        let flipped = [tri[0], tri[2], tri[1]];
+        let centre = Vec3::new(0.4, 0.366, 0.133);
+        let mut checked = 0;
+        for t in [tri, flipped] {
+            let [a, b, c] = t.map(Vec3::from);
+            let n = (b - a).cross(c - a);
+            for dir in [
+                Vec3::new(1.0, 0.2, -0.1),
+                Vec3::new(-1.0, 0.3, 0.2),
+                Vec3::new(0.1, 1.0, 0.3),
+                Vec3::new(-0.2, -1.0, 0.1),
+                Vec3::new(0.3, -0.1, 1.0),
+                Vec3::new(0.2, 0.3, -1.0),
+            ] {
+                let r = RayPre::new(centre - 3.0 * dir, dir).unwrap();
+                let h = intersect(&r, &t, 0.0, f32::INFINITY).expect("through the middle");
+                assert_eq!(h.front, n.dot(dir) < 0.0, "dir {dir}, normal {n}");
+                let lanes = [&t, &t, &t, &t];
+                let four = match r.kz {
+                    0 => intersect4_along::<0>(&r, lanes, 0.0, f32::INFINITY),
+                    1 => intersect4_along::<1>(&r, lanes, 0.0, f32::INFINITY),
+                    _ => intersect4_along::<2>(&r, lanes, 0.0, f32::INFINITY),
+                };
+                assert_eq!(four.front, [h.front; 4]);
+                checked += 1;
+            }
+        }
+        assert_eq!(checked, 12);
     }
 
     #[test]
@@ -372,7 +448,8 @@ mod tests {
         // Uniform in [-1, 1): 2·unit − 1 is exact on unit's 2⁻²⁴ grid.
         let mut rng = crate::testkit::Rng(7);
         let mut unit = move || 2.0 * rng.unit() - 1.0;
-        let bits = |h: Option<RawHit>| h.map(|h| (h.t.to_bits(), h.u.to_bits(), h.v.to_bits()));
+        let bits =
+            |h: Option<RawHit>| h.map(|h| (h.t.to_bits(), h.u.to_bits(), h.v.to_bits(), h.front));
         let (mut hits, mut on_edges) = (0, 0);
         for i in 0..30_000 {
             let snap = i % 3 == 0;
@@ -402,6 +479,8 @@ mod tests {
                 1 => intersect4_along::<1>(&r, group, 0.0, tmax),
                 _ => intersect4_along::<2>(&r, group, 0.0, tmax),
             };
+            let lanes: Vec<usize> = four.hit_lanes().collect();
+            assert_eq!(lanes, (0..4).filter(|&l| four.hit[l]).collect::<Vec<_>>());
             for (l, tri) in tris.iter().enumerate() {
                 let one = intersect(&r, tri, 0.0, tmax);
                 assert_eq!(bits(four.lane(l)), bits(one), "group {i}, lane {l}");

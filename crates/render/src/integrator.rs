@@ -35,7 +35,7 @@ use crate::sampling::{disc_sample, Rng};
 use crate::solid::Solids;
 use crate::texture::{cone_footprint, Sampler};
 use crate::TextureFilter;
-use formats::{CastShadows, Cull, Hit, Light, LightKind, Soup, Tiling};
+use formats::{CastShadows, Hit, Light, LightKind, Soup, Tiling};
 use glam::{Vec2, Vec3, Vec4};
 use kdtree::{Accel, Ray};
 
@@ -534,8 +534,12 @@ impl<'a> Integrator<'a> {
                 // Most rays meet a drawn face first, and most culled faces a filter would
                 // be asked about lie behind that face anyway: so the plain query, and the
                 // filtered one only from a refused hit on (same answer, ties included).
-                let first = self.accel.intersect(ray)?;
-                if !self.culled(first.prim as usize, ray.dir) {
+                let mut front = true;
+                let first = self.accel.intersect_filtered(ray, |_, f| {
+                    front = f;
+                    true
+                })?;
+                if !self.culled(first.prim as usize, front) {
                     return Some(first);
                 }
                 counts.pass_through += 1;
@@ -543,11 +547,11 @@ impl<'a> Integrator<'a> {
                     tmin: first.t,
                     ..*ray
                 };
-                self.accel.intersect_filtered(&rest, |hit| {
+                self.accel.intersect_filtered(&rest, |hit, front| {
                     if hit.prim == first.prim {
                         return false;
                     }
-                    let through = self.culled(hit.prim as usize, ray.dir);
+                    let through = self.culled(hit.prim as usize, front);
                     counts.pass_through += through as u64;
                     !through
                 })
@@ -561,10 +565,10 @@ impl<'a> Integrator<'a> {
     #[inline(never)]
     fn first_visible_alpha(&self, ray: &Ray, cone: RayCone, counts: &mut RayCounts) -> Option<Hit> {
         let culling = self.culling;
-        self.accel.intersect_filtered(ray, |hit| {
+        self.accel.intersect_filtered(ray, |hit, front| {
             let prim = hit.prim as usize;
             let s = &self.surfacing[self.soup.tri_material[prim] as usize];
-            let through = (culling && self.culled(prim, ray.dir))
+            let through = (culling && self.culled(prim, front))
                 || matches!(s.alpha, AlphaUse::Cutout { cutoff }
                     if self.alpha_at(s, prim, hit, ray.dir, cone.at(hit.t), counts) < cutoff);
             counts.pass_through += through as u64;
@@ -572,26 +576,29 @@ impl<'a> Integrator<'a> {
         })
     }
 
-    /// Whether camera and reflection rays along `dir` pass through triangle `prim`: a
-    /// shadows-only object, or a face its material culls.
+    /// Whether camera and reflection rays pass through triangle `prim`, met on its front
+    /// (`front`) or back: a shadows-only object, or a face its material culls.
     #[inline(always)]
-    fn culled(&self, prim: usize, dir: Vec3) -> bool {
+    fn culled(&self, prim: usize, front: bool) -> bool {
         let obj = &self.soup.objects[self.soup.tri_object[prim] as usize];
-        let cull = self.soup.materials[self.soup.tri_material[prim] as usize].cull;
-        !obj.visible() || (cull != Cull::None && cull.skips(winding(self.soup, prim), dir))
+        !obj.visible()
+            || self.soup.materials[self.soup.tri_material[prim] as usize]
+                .cull
+                .skips(front)
     }
 
-    /// Whether the hit triangle `prim` blocks a shadow ray travelling along `dir` (towards
-    /// the light): the shadow pass sees it from the light, looking along −`dir`.
-    fn casts(&self, prim: usize, dir: Vec3) -> bool {
+    /// Whether the hit triangle `prim` blocks a shadow ray (travelling towards the light)
+    /// that meets its front (`front`) or back: the shadow pass sees it from the light, so
+    /// from the other side.
+    fn casts(&self, prim: usize, front: bool) -> bool {
         let obj = &self.soup.objects[self.soup.tri_object[prim] as usize];
         match obj.cast_shadows {
             CastShadows::Off => false,
             CastShadows::TwoSided => true,
-            CastShadows::On | CastShadows::ShadowsOnly => {
-                let cull = self.soup.materials[self.soup.tri_material[prim] as usize].cull;
-                cull == Cull::None || !cull.skips(winding(self.soup, prim), -dir)
-            }
+            CastShadows::On | CastShadows::ShadowsOnly => !self.soup.materials
+                [self.soup.tri_material[prim] as usize]
+                .cull
+                .skips(!front),
         }
     }
 
@@ -626,9 +633,9 @@ impl<'a> Integrator<'a> {
             return if self.accel.occluded(&ray) { 0.0 } else { 1.0 };
         }
         if !self.alpha {
-            let blocked = self.accel.occluded_filtered(&ray, |hit| {
+            let blocked = self.accel.occluded_filtered(&ray, |hit, front| {
                 let prim = hit.prim as usize;
-                if self.casts(prim, ray.dir) {
+                if self.casts(prim, front) {
                     return true;
                 }
                 counts.shadow_pass_through += 1;
@@ -648,9 +655,9 @@ impl<'a> Integrator<'a> {
     fn transmittance_alpha(&self, ray: &Ray, counts: &mut RayCounts) -> f32 {
         let mut share = 1.0f32;
         let mut seen = Seen::new();
-        let blocked = self.accel.occluded_filtered(ray, |hit| {
+        let blocked = self.accel.occluded_filtered(ray, |hit, front| {
             let prim = hit.prim as usize;
-            if !self.casts(prim, ray.dir) {
+            if !self.casts(prim, front) {
                 counts.shadow_pass_through += 1;
                 return false;
             }
@@ -729,10 +736,4 @@ impl<'a> Integrator<'a> {
         }
         visible / n as f32
     }
-}
-
-/// Triangle `prim`'s winding normal (unnormalised): it points out of the front face.
-fn winding(soup: &Soup, prim: usize) -> Vec3 {
-    let t = &soup.triangles[prim];
-    (t[1] - t[0]).cross(t[2] - t[0])
 }

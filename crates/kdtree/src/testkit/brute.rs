@@ -16,14 +16,14 @@ use glam::{DVec3, Vec3};
 /// Closest hit in [tmin, tmax] with the tree's watertight test; ties in t go to the lower
 /// triangle index, as in the tree.
 pub fn intersect(triangles: &[[Vec3; 3]], ray: &Ray) -> Option<Hit> {
-    intersect_filtered(triangles, ray, |_| true)
+    intersect_filtered(triangles, ray, |_, _| true)
 }
 
 /// [`intersect`] over the hits `accept` takes, asked as the tree asks it.
 pub fn intersect_filtered(
     triangles: &[[Vec3; 3]],
     ray: &Ray,
-    mut accept: impl FnMut(&Hit) -> bool,
+    mut accept: impl FnMut(&Hit, bool) -> bool,
 ) -> Option<Hit> {
     if !(ray.tmin <= ray.tmax) || ray.tmax == f32::NEG_INFINITY || ray.tmin == f32::INFINITY {
         return None;
