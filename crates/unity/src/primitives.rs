@@ -241,7 +241,7 @@ fn fix_capsule_equator(m: Mesh, seg: u32) -> Mesh {
     let mut b = Builder::default();
     let mut remap_up = vec![u32::MAX; m.positions.len()];
     let mut remap_down = vec![u32::MAX; m.positions.len()];
-    let mut vertex = |b: &mut Builder, p: Vec3, n: Vec3, u: f32| {
+    let vertex = |b: &mut Builder, p: Vec3, n: Vec3, u: f32| {
         b.uv.push(Vec2::new(u, (p.y + 1.0) * 0.5));
         b.v(p, n)
     };
