@@ -532,8 +532,9 @@ impl<'a> Integrator<'a> {
             (false, false) => self.accel.intersect(ray),
             (true, false) => {
                 // Most rays meet a drawn face first, and most culled faces a filter would
-                // be asked about lie behind that face anyway: so the plain query, and the
-                // filtered one only from a refused hit on (same answer, ties included).
+                // be asked about lie behind that face anyway: so a query that takes every
+                // hit (keeping the side of the one it ends with), and the filtered one only
+                // from a refused hit on (same answer, ties included).
                 let mut front = true;
                 let first = self.accel.intersect_filtered(ray, |_, f| {
                     front = f;
