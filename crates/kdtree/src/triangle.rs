@@ -232,12 +232,6 @@ impl Hits4 {
         })
     }
 
-    /// Lane `l`'s answer as the scalar test gives it.
-    #[inline(always)]
-    pub fn lane(&self, l: usize) -> Option<RawHit> {
-        self.hit[l].then(|| self.raw(l))
-    }
-
     /// Lane `l`'s hit, for a lane that hit.
     #[inline(always)]
     pub fn raw(&self, l: usize) -> RawHit {
@@ -320,8 +314,8 @@ pub fn intersect4_along<const KZ: usize>(
     if zero {
         for (l, t) in tri.into_iter().enumerate() {
             if let Some(h) = intersect_along::<KZ>(r, t, tmin, tmax) {
-                (out.hit[l], out.t[l], out.u[l], out.v[l]) = (true, h.t, h.u, h.v);
-                out.front[l] = h.front;
+                (out.hit[l], out.t[l], out.u[l], out.v[l], out.front[l]) =
+                    (true, h.t, h.u, h.v, h.front);
             }
         }
         return out;
@@ -483,7 +477,8 @@ mod tests {
             assert_eq!(lanes, (0..4).filter(|&l| four.hit[l]).collect::<Vec<_>>());
             for (l, tri) in tris.iter().enumerate() {
                 let one = intersect(&r, tri, 0.0, tmax);
-                assert_eq!(bits(four.lane(l)), bits(one), "group {i}, lane {l}");
+                let lane = four.hit[l].then(|| four.raw(l));
+                assert_eq!(bits(lane), bits(one), "group {i}, lane {l}");
                 hits += one.is_some() as u32;
                 if let Some(h) = one {
                     on_edges += (h.u == 0.0 || h.v == 0.0 || h.u + h.v == 1.0) as u32;

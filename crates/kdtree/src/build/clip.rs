@@ -112,12 +112,18 @@ pub fn clipped_bounds(tri: &[Vec3; 3], cell: &Aabb) -> Option<Aabb> {
     if !inside {
         return None;
     }
+    bounds_in(&poly.v[..poly.n], cell)
+}
+
+/// The f32 box of the clipped polygon `poly`, rounded outward and held inside `cell`; None
+/// when rounding leaves it empty.
+fn bounds_in(poly: &[[f64; 3]], cell: &Aabb) -> Option<Aabb> {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     // Plain comparisons: every coordinate is a number (f64::min and max would also sort
     // out NaN), and which zero wins a tie of −0 and +0 changes no event (positions map
     // both to one key).
-    for p in &poly.v[..poly.n] {
+    for p in poly {
         for k in 0..3 {
             lo[k] = if p[k] < lo[k] { p[k] } else { lo[k] };
             hi[k] = if p[k] > hi[k] { p[k] } else { hi[k] };
@@ -192,8 +198,9 @@ mod tests {
         assert!((b.hi[1] as f64 - exact_y) < 1e-6);
     }
 
-    /// The clipper as first written, one plane after another over a vertex list: the
-    /// structure of [`clipped_bounds`] may change, its bits may not.
+    /// The clipper's cuts as first written, one plane after another over a vertex list: the
+    /// structure of [`clipped_bounds`] may change, its bits may not. (The box of the result
+    /// is the same [`bounds_in`].)
     fn reference(tri: &[Vec3; 3], cell: &Aabb) -> Option<Aabb> {
         let mut poly = [[0f64; 3]; MAX_POLY];
         let mut n = 3;
@@ -246,26 +253,7 @@ mod tests {
                 poly[..n].copy_from_slice(&next[..n]);
             }
         }
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        // Plain comparisons: every coordinate is a number (f64::min and max would also sort
-        // out NaN), and which zero wins a tie of −0 and +0 changes no event (positions map
-        // both to one key).
-        for p in &poly[..n] {
-            for k in 0..3 {
-                lo[k] = if p[k] < lo[k] { p[k] } else { lo[k] };
-                hi[k] = if p[k] > hi[k] { p[k] } else { hi[k] };
-            }
-        }
-        let mut b = Aabb::EMPTY;
-        for k in 0..3 {
-            b.lo[k] = down(lo[k]).max(cell.lo[k]);
-            b.hi[k] = up(hi[k]).min(cell.hi[k]);
-            if b.lo[k] > b.hi[k] {
-                return None;
-            }
-        }
-        Some(b)
+        bounds_in(&poly[..n], cell)
     }
 
     #[test]
