@@ -6,7 +6,7 @@
 //! slurmctld, slurmd, slurm-client and munge, so they are ignored by default:
 //!
 //! ```text
-//! cargo test --release --test end_to_end slurm -- --ignored
+//! cargo test --test end_to_end slurm -- --ignored
 //! ```
 //!
 //! Without `slurmctld` they pass after saying loudly that they were skipped. The merge
@@ -182,7 +182,7 @@ impl Drop for Remove {
 }
 
 #[test]
-#[ignore = "starts a local Slurm cluster: cargo test --release --test end_to_end slurm -- --ignored"]
+#[ignore = "starts a local Slurm cluster: cargo test --test end_to_end slurm -- --ignored"]
 fn just_slurm_renders_the_baseline_bit_identical_to_one_machine() {
     let Some(cluster) = Cluster::start() else {
         return;
@@ -248,7 +248,7 @@ fn just_slurm_renders_the_baseline_bit_identical_to_one_machine() {
 }
 
 #[test]
-#[ignore = "starts a local Slurm cluster: cargo test --release --test end_to_end slurm -- --ignored"]
+#[ignore = "starts a local Slurm cluster: cargo test --test end_to_end slurm -- --ignored"]
 fn a_failing_tile_is_resubmitted_once_then_named_with_its_log() {
     let Some(cluster) = Cluster::start() else {
         return;
