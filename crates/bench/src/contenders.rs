@@ -40,23 +40,33 @@ impl Found {
 pub(crate) trait Tracer: Sync {
     fn closest(&self, ray: &Ray) -> Found;
     fn occluded(&self, ray: &Ray) -> bool;
+    /// Four rays at once, through the contender's packet query where it has one.
+    fn closest4(&self, rays: &[Ray; 4]) -> [Found; 4] {
+        rays.each_ref().map(|r| self.closest(r))
+    }
+}
+
+fn found(hit: Option<(f32, u32, f32, f32)>) -> Found {
+    hit.map(|(t, prim, u, v)| Found { t, prim, u, v })
+        .unwrap_or_default()
+}
+
+fn found_kd(hit: Option<kdtree::Hit>) -> Found {
+    found(hit.map(|h| (h.t, h.prim, h.u, h.v)))
 }
 
 impl Tracer for Accel {
     #[inline]
     fn closest(&self, ray: &Ray) -> Found {
-        self.intersect(ray)
-            .map(|h| Found {
-                t: h.t,
-                prim: h.prim,
-                u: h.u,
-                v: h.v,
-            })
-            .unwrap_or_default()
+        found_kd(self.intersect(ray))
     }
     #[inline]
     fn occluded(&self, ray: &Ray) -> bool {
         Accel::occluded(self, ray)
+    }
+    #[inline]
+    fn closest4(&self, rays: &[Ray; 4]) -> [Found; 4] {
+        self.intersect4(rays).map(found_kd)
     }
 }
 
@@ -64,13 +74,15 @@ impl Tracer for Accel {
 impl Tracer for crate::embree::EmbreeScene {
     #[inline]
     fn closest(&self, ray: &Ray) -> Found {
-        self.intersect(ray)
-            .map(|(t, prim, u, v)| Found { t, prim, u, v })
-            .unwrap_or_default()
+        found(self.intersect(ray))
     }
     #[inline]
     fn occluded(&self, ray: &Ray) -> bool {
         crate::embree::EmbreeScene::occluded(self, ray)
+    }
+    #[inline]
+    fn closest4(&self, rays: &[Ray; 4]) -> [Found; 4] {
+        self.intersect4(rays).map(found)
     }
 }
 

@@ -24,6 +24,7 @@ const RTC_BUFFER_TYPE_INDEX: u32 = 0;
 const RTC_BUFFER_TYPE_VERTEX: u32 = 1;
 const RTC_FORMAT_UINT3: u32 = 0x5003;
 const RTC_FORMAT_FLOAT3: u32 = 0x9003;
+const RTC_INTERSECT_CONTEXT_FLAG_COHERENT: u32 = 1;
 const RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT: u32 = 0;
 const RTC_DEVICE_PROPERTY_VERSION: u32 = 0;
 
@@ -92,7 +93,32 @@ struct RtcRayHit {
     hit: RtcHit,
 }
 
+/// `struct RTCRayHit4`: `RTCRay4` then `RTCHit4`, lane-major arrays (320 bytes, 16-byte
+/// aligned; one instance level).
+#[repr(C, align(16))]
+struct RtcRayHit4 {
+    org: [[f32; 4]; 3],
+    tnear: [f32; 4],
+    dir: [[f32; 4]; 3],
+    time: [f32; 4],
+    tfar: [f32; 4],
+    mask: [u32; 4],
+    id: [u32; 4],
+    flags: [u32; 4],
+    ng: [[f32; 4]; 3],
+    u: [f32; 4],
+    v: [f32; 4],
+    prim_id: [u32; 4],
+    geom_id: [u32; 4],
+    inst_id: [u32; 4],
+}
+
+/// The `valid` mask of a packet call: −1 for an active lane, 16-byte aligned.
+#[repr(C, align(16))]
+struct Valid4([i32; 4]);
+
 const _: () = {
+    assert!(std::mem::size_of::<RtcRayHit4>() == 320);
     assert!(std::mem::size_of::<RtcIntersectContext>() == 24);
     assert!(std::mem::size_of::<RtcRay>() == 48);
     assert!(std::mem::align_of::<RtcRay>() == 16);
@@ -133,6 +159,12 @@ extern "C" {
     fn rtcCommitScene(scene: RtcScene);
     fn rtcIntersect1(scene: RtcScene, context: *mut RtcIntersectContext, rayhit: *mut RtcRayHit);
     fn rtcOccluded1(scene: RtcScene, context: *mut RtcIntersectContext, ray: *mut RtcRay);
+    fn rtcIntersect4(
+        valid: *const Valid4,
+        scene: RtcScene,
+        context: *mut RtcIntersectContext,
+        rayhit: *mut RtcRayHit4,
+    );
 }
 
 /// The header's inline `rtcInitIntersectContext`, for this build's configuration.
@@ -367,6 +399,48 @@ impl EmbreeScene {
         ))
     }
 
+    /// [`EmbreeScene::intersect`] on four rays with one `rtcIntersect4` call.
+    #[inline]
+    pub fn intersect4(&self, rays: &[Ray; 4]) -> [Option<(f32, u32, f32, f32)>; 4] {
+        let lane = |f: &dyn Fn(&Ray) -> f32| rays.each_ref().map(f);
+        let mut rh = RtcRayHit4 {
+            org: [
+                lane(&|r| r.origin.x),
+                lane(&|r| r.origin.y),
+                lane(&|r| r.origin.z),
+            ],
+            tnear: lane(&|r| r.tmin),
+            dir: [lane(&|r| r.dir.x), lane(&|r| r.dir.y), lane(&|r| r.dir.z)],
+            time: [0.0; 4],
+            tfar: lane(&|r| r.tmax),
+            mask: [u32::MAX; 4],
+            id: [0; 4],
+            flags: [0; 4],
+            ng: [[0.0; 4]; 3],
+            u: [0.0; 4],
+            v: [0.0; 4],
+            prim_id: [RTC_INVALID_GEOMETRY_ID; 4],
+            geom_id: [RTC_INVALID_GEOMETRY_ID; 4],
+            inst_id: [RTC_INVALID_GEOMETRY_ID; 4],
+        };
+        let valid = Valid4([-1; 4]);
+        // Neighbouring pixels' rays: Embree's hint for rays that travel together.
+        let mut ctx = RtcIntersectContext {
+            flags: RTC_INTERSECT_CONTEXT_FLAG_COHERENT,
+            ..init_context()
+        };
+        // SAFETY: committed scene; valid, ctx and rh are valid and 16-byte aligned.
+        unsafe { rtcIntersect4(&valid, self.scene, &mut ctx, &mut rh) };
+        std::array::from_fn(|l| {
+            (rh.geom_id[l] != RTC_INVALID_GEOMETRY_ID).then_some((
+                rh.tfar[l],
+                rh.prim_id[l],
+                rh.u[l],
+                rh.v[l],
+            ))
+        })
+    }
+
     /// Whether anything blocks the ray in [tmin, tmax] (Embree sets tfar to −inf).
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
@@ -435,5 +509,24 @@ mod tests {
         assert!(s.intersect(&r3).is_none());
         assert!(!s.occluded(&r3));
         assert!(s.memory_bytes() > 0);
+    }
+
+    #[test]
+    fn a_packet_of_four_gets_the_single_answers_lane_by_lane() {
+        let s = EmbreeScene::new(&quad()).unwrap();
+        let rays = [
+            Ray::new(Vec3::new(0.75, 0.25, 0.0), Vec3::Z, 0.0, f32::INFINITY),
+            Ray::new(Vec3::new(0.1, 0.1, 0.0), Vec3::Z, 3.0, 10.0),
+            Ray::new(Vec3::new(0.1, 0.1, 0.0), Vec3::Z, 0.0, 1.5),
+            Ray::new(Vec3::new(0.25, 0.75, 0.0), Vec3::Z, 0.0, f32::INFINITY),
+        ];
+        let got = s.intersect4(&rays);
+        assert_eq!(
+            got.map(|h| h.map(|h| h.1)),
+            [Some(0), Some(2), None, Some(1)]
+        );
+        for (r, g) in rays.iter().zip(got) {
+            assert_eq!(g, s.intersect(r));
+        }
     }
 }

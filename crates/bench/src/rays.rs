@@ -56,6 +56,30 @@ pub fn primary(view: &View, size: u32) -> Vec<Ray> {
     out
 }
 
+/// `primary`'s rays (a `size` × `size` image, row by row) reordered into 2×2 pixel blocks,
+/// the four rays of a block in a row: the packets a renderer would form. An odd last row
+/// or column stays in row order at the end.
+pub fn in_blocks(primary: &[Ray], size: u32) -> Vec<Ray> {
+    let n = size as usize;
+    let even = n & !1;
+    let mut out = Vec::with_capacity(primary.len());
+    for y in (0..even).step_by(2) {
+        for x in (0..even).step_by(2) {
+            for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                out.push(primary[(y + dy) * n + x + dx]);
+            }
+        }
+    }
+    for y in 0..n {
+        for x in 0..n {
+            if y >= even || x >= even {
+                out.push(primary[y * n + x]);
+            }
+        }
+    }
+    out
+}
+
 /// The light for shadow rays: above the centre of the bounds, one diagonal higher than
 /// the top, offset sideways so that shadows fall at an angle.
 pub fn light_above(bounds: [Vec3; 2]) -> Vec3 {
@@ -223,6 +247,19 @@ mod tests {
         // Top-left pixel points up and left of the view.
         let right = v.forward.cross(v.up);
         assert!(rays[0].dir.dot(v.up) > 0.0 && rays[0].dir.dot(right) < 0.0);
+    }
+
+    #[test]
+    fn blocks_hold_each_ray_once_in_2x2_order() {
+        let v = framing([Vec3::splat(-1.0), Vec3::splat(1.0)]);
+        let rays = primary(&v, 3);
+        let blocks = in_blocks(&rays, 3);
+        // Pixel index of each reordered ray: the 2×2 block, then the odd column and row.
+        let order: Vec<usize> = blocks
+            .iter()
+            .map(|b| rays.iter().position(|r| r.dir == b.dir).unwrap())
+            .collect();
+        assert_eq!(order, [0, 1, 3, 4, 2, 5, 6, 7, 8]);
     }
 
     #[test]

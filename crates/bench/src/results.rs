@@ -6,6 +6,8 @@ use crate::config::Config;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Kind {
     Primary,
+    /// The same camera rays in 2×2 pixel blocks, each block one packet query.
+    PrimaryPackets,
     Shadow,
     Random,
     /// From random surface points toward the light, closest hit.
@@ -19,8 +21,9 @@ pub enum Kind {
 }
 
 impl Kind {
-    pub const ALL: [Kind; 7] = [
+    pub const ALL: [Kind; 8] = [
         Kind::Primary,
+        Kind::PrimaryPackets,
         Kind::Shadow,
         Kind::Random,
         Kind::SurfaceLight,
@@ -31,6 +34,7 @@ impl Kind {
     pub fn name(self) -> &'static str {
         match self {
             Kind::Primary => "primary",
+            Kind::PrimaryPackets => "primary ×4",
             Kind::Shadow => "shadow",
             Kind::Random => "random",
             Kind::SurfaceLight => "surface→light",

@@ -42,6 +42,14 @@ impl Bench<'_> {
                     let start = Instant::now();
                     let a = if kind.any_hit() {
                         Answers::Occluded(trace(pool, rays, |r| tracer.occluded(r)))
+                    } else if kind == Kind::PrimaryPackets {
+                        let (packets, rest) = rays.as_chunks::<4>();
+                        let mut found: Vec<_> = trace(pool, packets, |p| tracer.closest4(p))
+                            .into_iter()
+                            .flatten()
+                            .collect();
+                        found.extend(rest.iter().map(|r| tracer.closest(r)));
+                        Answers::Closest(found)
                     } else {
                         Answers::Closest(trace(pool, rays, |r| tracer.closest(r)))
                     };
@@ -241,6 +249,7 @@ fn run_scene(
     let bounds = scenes::bounds(tris);
     let view: View = scene.view.unwrap_or_else(|| rays::framing(bounds));
     let primary = rays::primary(&view, cfg.image);
+    let primary_blocks = rays::in_blocks(&primary, cfg.image);
     let random = rays::random(bounds, cfg.random_rays, 0x5EED ^ n as u64);
     let brute = (n <= cfg.brute_max_triangles).then_some(Brute(tris));
     let light = rays::light_above(bounds);
@@ -255,6 +264,7 @@ fn run_scene(
     for kind in Kind::ALL {
         let set: &[Ray] = match kind {
             Kind::Primary => &primary,
+            Kind::PrimaryPackets => &primary_blocks,
             Kind::Shadow => &shadow,
             Kind::Random => &random,
             Kind::SurfaceLight | Kind::SurfaceLightAny => &surface_light,

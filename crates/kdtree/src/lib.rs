@@ -16,6 +16,7 @@
 
 pub mod aabb;
 pub mod build;
+mod packet;
 #[cfg(any(test, feature = "testkit"))]
 pub mod testkit;
 mod traverse;
@@ -29,6 +30,7 @@ pub use build::events::MAX_TRIANGLES;
 pub use build::median::build_median;
 pub use build::{build, depth_bound};
 pub use formats::Hit;
+pub use packet::LANES;
 pub use traverse::Counts;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -173,6 +175,22 @@ impl Accel {
         accept: impl FnMut(&Hit, bool) -> bool,
     ) -> Option<Hit> {
         self.tree().closest(ray, accept, &mut ())
+    }
+
+    /// [`Accel::intersect`] on four rays at once, the same answers bit for bit. Rays that
+    /// travel side by side (neighbouring pixels of a camera) share the walk down the tree;
+    /// rays whose directions differ in sign or dominant axis are traced one by one.
+    pub fn intersect4(&self, rays: &[Ray; LANES]) -> [Option<Hit>; LANES] {
+        self.tree().closest4(rays, |_, _, _| true)
+    }
+
+    /// [`Accel::intersect_filtered`] on four rays at once; `accept` is told the lane too.
+    pub fn intersect4_filtered(
+        &self,
+        rays: &[Ray; LANES],
+        accept: impl FnMut(usize, &Hit, bool) -> bool,
+    ) -> [Option<Hit>; LANES] {
+        self.tree().closest4(rays, accept)
     }
 
     /// Whether a hit that `blocks` takes lies in [tmin, tmax]; stops at the first one.

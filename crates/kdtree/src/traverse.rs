@@ -81,17 +81,18 @@ pub(crate) struct Tree<'a> {
 }
 
 /// Per-ray traversal constants.
-struct Setup {
-    pre: RayPre,
-    o: [f32; 3],
-    inv: [f32; 3],
-    t0: f32,
-    t1: f32,
+#[derive(Clone, Copy)]
+pub(crate) struct Setup {
+    pub pre: RayPre,
+    pub o: [f32; 3],
+    pub inv: [f32; 3],
+    pub t0: f32,
+    pub t1: f32,
 }
 
 /// None when the ray cannot hit anything (bad numbers, empty interval, misses the box).
 #[inline(always)]
-fn setup(ray: &Ray, b: &Aabb) -> Option<Setup> {
+pub(crate) fn setup(ray: &Ray, b: &Aabb) -> Option<Setup> {
     if !(ray.tmin <= ray.tmax) || ray.tmax == f32::NEG_INFINITY || ray.tmin == f32::INFINITY {
         return None;
     }
@@ -297,7 +298,7 @@ fn prefetch<T>(p: *const T) {
 
 impl Tree<'_> {
     #[inline(always)]
-    fn node(&self, i: u32) -> KdNode {
+    pub(crate) fn node(&self, i: u32) -> KdNode {
         debug_assert!((i as usize) < self.nodes.len());
         // SAFETY: `Accel::assemble` ran `KdFile::validate`, which proves every child index
         // (i + 1 and `above_child`) of an interior node is inside `nodes`; traversal only
@@ -306,7 +307,7 @@ impl Tree<'_> {
     }
 
     #[inline(always)]
-    fn leaf(&self, node: KdNode) -> &[u32] {
+    pub(crate) fn leaf(&self, node: KdNode) -> &[u32] {
         let off = node.offset() as usize;
         let end = off + node.count() as usize;
         debug_assert!(end <= self.leaf_tris.len());
@@ -390,22 +391,7 @@ impl Tree<'_> {
             }
             let leaf = self.leaf(node);
             count.leaf(leaf.len());
-            if leaf.len() >= 2 {
-                for group in leaf.chunks(4) {
-                    let bound = triangle::widen(best_t);
-                    let (lanes, hits) = self.test4::<KZ>(s, ray, group, bound);
-                    for l in hits.hit_lanes() {
-                        let p = self.soup_index(lanes[l]);
-                        keep_closer(&mut best, &mut best_t, p, hits.raw(l), accept);
-                    }
-                }
-            } else {
-                for &p in leaf {
-                    if let Some(h) = test::<KZ>(s, ray, self.tri(p), triangle::widen(best_t)) {
-                        keep_closer(&mut best, &mut best_t, self.soup_index(p), h, accept);
-                    }
-                }
-            }
+            self.leaf_closest::<KZ, F>(s, ray, leaf, &mut best, &mut best_t, accept);
             // Next cell: the first waiting one that starts before the best hit. The stack
             // is not always front to back, so a cell that starts beyond the hit is skipped,
             // not taken as the end: a ray lying in a split plane waits on the far child over
@@ -419,6 +405,35 @@ impl Tree<'_> {
                 (node_i, t0, t1) = pop(&stack, sp);
                 if best_t >= pad_down(t0) {
                     break;
+                }
+            }
+        }
+    }
+
+    /// A leaf's triangles for a closest-hit walk: keeps the closer hits `accept` takes.
+    #[inline(always)]
+    pub(crate) fn leaf_closest<const KZ: usize, F: FnMut(&Hit, bool) -> bool>(
+        &self,
+        s: &Setup,
+        ray: &Ray,
+        leaf: &[u32],
+        best: &mut Hit,
+        best_t: &mut f32,
+        accept: &mut F,
+    ) {
+        if leaf.len() >= 2 {
+            for group in leaf.chunks(4) {
+                let bound = triangle::widen(*best_t);
+                let (lanes, hits) = self.test4::<KZ>(s, ray, group, bound);
+                for l in hits.hit_lanes() {
+                    let p = self.soup_index(lanes[l]);
+                    keep_closer(best, best_t, p, hits.raw(l), accept);
+                }
+            }
+        } else {
+            for &p in leaf {
+                if let Some(h) = test::<KZ>(s, ray, self.tri(p), triangle::widen(*best_t)) {
+                    keep_closer(best, best_t, self.soup_index(p), h, accept);
                 }
             }
         }

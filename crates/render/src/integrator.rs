@@ -37,6 +37,7 @@ use crate::texture::{cone_footprint, Sampler};
 use crate::TextureFilter;
 use formats::{CastShadows, Hit, Light, LightKind, Soup, Tiling};
 use glam::{Vec2, Vec3, Vec4};
+use kdtree::LANES;
 use kdtree::{Accel, Ray};
 
 /// What the first hit of a camera ray tells the AOVs.
@@ -289,9 +290,48 @@ impl<'a> Integrator<'a> {
         rng: &mut Rng,
         counts: &mut RayCounts,
     ) -> (Vec3, Primary) {
+        let first = self.first_visible(ray, cone, counts);
+        self.camera_sample_from(ray, first, cone, rng, counts)
+    }
+
+    /// [`Integrator::camera_sample`] for the rays of four neighbouring pixels, their first
+    /// hits found together: the same four results and counts, bit for bit.
+    pub fn camera_sample4(
+        &self,
+        rays: &[Ray; LANES],
+        cone: RayCone,
+        rngs: &mut [Rng; LANES],
+        counts: &mut RayCounts,
+    ) -> [(Vec3, Primary); LANES] {
+        let first = self.first_visible4(rays, cone, counts);
+        let mut lanes = rngs.iter_mut().zip(rays).zip(first);
+        std::array::from_fn(|_| {
+            let ((rng, ray), first) = lanes.next().expect("four lanes");
+            self.camera_sample_from(ray, first, cone, rng, counts)
+        })
+    }
+
+    /// [`Integrator::camera_sample`] once the ray's first visible hit is known.
+    fn camera_sample_from(
+        &self,
+        ray: &Ray,
+        first: Option<Hit>,
+        cone: RayCone,
+        rng: &mut Rng,
+        counts: &mut RayCounts,
+    ) -> (Vec3, Primary) {
         counts.camera += 1;
         let mut primary = Primary::MISS;
-        let mut l = self.radiance(ray, cone, 0, Vec3::ONE, rng, counts, Some(&mut primary));
+        let mut l = self.radiance_from(
+            ray,
+            first,
+            cone,
+            0,
+            Vec3::ONE,
+            rng,
+            counts,
+            Some(&mut primary),
+        );
         if sanitize(&mut l) {
             counts.sanitized += 1;
         }
@@ -323,9 +363,26 @@ impl<'a> Integrator<'a> {
         counts: &mut RayCounts,
         primary: Option<&mut Primary>,
     ) -> Vec3 {
+        let first = self.first_visible(ray, cone, counts);
+        self.radiance_from(ray, first, cone, bounce, weight, rng, counts, primary)
+    }
+
+    /// [`Integrator::radiance`] once the ray's first visible hit, `first`, is known.
+    #[allow(clippy::too_many_arguments)]
+    fn radiance_from(
+        &self,
+        ray: &Ray,
+        first: Option<Hit>,
+        cone: RayCone,
+        bounce: u32,
+        weight: Vec3,
+        rng: &mut Rng,
+        counts: &mut RayCounts,
+        primary: Option<&mut Primary>,
+    ) -> Vec3 {
         let mut primary = primary;
         if !self.alpha {
-            let Some(hit) = self.first_visible(ray, cone, counts) else {
+            let Some(hit) = first else {
                 return environment::background(&self.soup.environment, ray.dir);
             };
             let p = &mut primary;
@@ -334,12 +391,13 @@ impl<'a> Integrator<'a> {
                 .0;
         }
         let mut r = *ray;
+        let mut next = first;
         // Light gathered from the blended layers so far, and the share of what lies behind
         // them that still reaches the eye.
         let mut acc = Vec3::ZERO;
         let mut through = 1.0f32;
         loop {
-            let Some(hit) = self.first_visible(&r, cone, counts) else {
+            let Some(hit) = next else {
                 let bg = environment::background(&self.soup.environment, r.dir);
                 return if through == 1.0 {
                     bg
@@ -371,6 +429,7 @@ impl<'a> Integrator<'a> {
             counts.blend_continuation += 1;
             // Past this surface point, and past the triangle sharing the edge it may lie on.
             r.tmin = (hit.t + hit.t * SAME_SURFACE).max(hit.t.next_up());
+            next = self.first_visible(&r, cone, counts);
         }
     }
 
@@ -540,25 +599,63 @@ impl<'a> Integrator<'a> {
                     front = f;
                     true
                 })?;
-                if !self.culled(first.prim as usize, front) {
-                    return Some(first);
-                }
-                counts.pass_through += 1;
-                let rest = Ray {
-                    tmin: first.t,
-                    ..*ray
-                };
-                self.accel.intersect_filtered(&rest, |hit, front| {
-                    if hit.prim == first.prim {
-                        return false;
-                    }
-                    let through = self.culled(hit.prim as usize, front);
-                    counts.pass_through += through as u64;
-                    !through
-                })
+                self.unless_culled(ray, first, front, counts)
             }
             (_, true) => self.first_visible_alpha(ray, cone, counts),
         }
+    }
+
+    /// [`Integrator::first_visible`] for four camera rays of neighbouring pixels (one
+    /// packet query where the scene has no cut-outs), lane by lane the same answers and
+    /// the same counts.
+    fn first_visible4(
+        &self,
+        rays: &[Ray; LANES],
+        cone: RayCone,
+        counts: &mut RayCounts,
+    ) -> [Option<Hit>; LANES] {
+        match (self.culling, self.alpha) {
+            (false, false) => self.accel.intersect4(rays),
+            (true, false) => {
+                let mut front = [true; LANES];
+                let first = self.accel.intersect4_filtered(rays, |l, _, f| {
+                    front[l] = f;
+                    true
+                });
+                std::array::from_fn(|l| self.unless_culled(&rays[l], first[l]?, front[l], counts))
+            }
+            (_, true) => rays
+                .each_ref()
+                .map(|r| self.first_visible_alpha(r, cone, counts)),
+        }
+    }
+
+    /// `first`, the ray's closest hit met on its front (`front`) or back, when its face is
+    /// drawn; else the closest drawn face behind it (each pass-through counted).
+    #[inline(always)]
+    fn unless_culled(
+        &self,
+        ray: &Ray,
+        first: Hit,
+        front: bool,
+        counts: &mut RayCounts,
+    ) -> Option<Hit> {
+        if !self.culled(first.prim as usize, front) {
+            return Some(first);
+        }
+        counts.pass_through += 1;
+        let rest = Ray {
+            tmin: first.t,
+            ..*ray
+        };
+        self.accel.intersect_filtered(&rest, |hit, front| {
+            if hit.prim == first.prim {
+                return false;
+            }
+            let through = self.culled(hit.prim as usize, front);
+            counts.pass_through += through as u64;
+            !through
+        })
     }
 
     /// [`Integrator::first_visible`] with cut-out holes, out of line so that scenes

@@ -106,13 +106,7 @@ fn render_tiles(
         .into_par_iter()
         .map(|tile| {
             let mut counts = RayCounts::default();
-            let mut pixels = Vec::with_capacity(tile.pixels() as usize);
-            for y in tile.y0..tile.y1 {
-                for x in tile.x0..tile.x1 {
-                    let c = &mut counts;
-                    pixels.push(render_pixel(camera, cone, integrator, opts, x, y, c));
-                }
-            }
+            let pixels = render_tile(camera, cone, integrator, opts, tile, &mut counts);
             shared.add(&counts);
             if let Some(report) = progress {
                 let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
@@ -135,6 +129,55 @@ fn render_tiles(
     (frame, shared.load())
 }
 
+/// A tile's pixels, row by row. At one sample per pixel the camera rays of each 2×2 block
+/// are traced together ([`Integrator::camera_sample4`]); an odd last row or column, and
+/// every pixel at more samples, goes through [`render_pixel`]. Either way each pixel gets
+/// the same value to the bit.
+fn render_tile(
+    camera: &CameraModel,
+    cone: RayCone,
+    integrator: &Integrator,
+    opts: &RenderOptions,
+    tile: Window,
+    counts: &mut RayCounts,
+) -> Vec<(Vec3, Primary)> {
+    let width = (tile.x1 - tile.x0) as usize;
+    let at = |x: u32, y: u32| (y - tile.y0) as usize * width + (x - tile.x0) as usize;
+    let mut pixels = vec![(Vec3::ZERO, Primary::MISS); tile.pixels() as usize];
+    let mut done = vec![false; pixels.len()];
+    if opts.spp <= 1 {
+        let (x_end, y_end) = (
+            tile.x1 - (tile.x1 - tile.x0) % 2,
+            tile.y1 - (tile.y1 - tile.y0) % 2,
+        );
+        for y in (tile.y0..y_end).step_by(2) {
+            for x in (tile.x0..x_end).step_by(2) {
+                let block = [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)];
+                let rays = block.map(|(x, y)| camera.ray(x as f32 + 0.5, y as f32 + 0.5));
+                let mut rngs = block.map(|(x, y)| Rng::for_pixel(opts.seed, x, y));
+                let samples = integrator.camera_sample4(&rays, cone, &mut rngs, counts);
+                for ((x, y), sample) in block.into_iter().zip(samples) {
+                    pixels[at(x, y)] = one_sample(sample);
+                    done[at(x, y)] = true;
+                }
+            }
+        }
+    }
+    for y in tile.y0..tile.y1 {
+        for x in tile.x0..tile.x1 {
+            if !done[at(x, y)] {
+                pixels[at(x, y)] = render_pixel(camera, cone, integrator, opts, x, y, counts);
+            }
+        }
+    }
+    pixels
+}
+
+/// A pixel of one sample: the mean [`render_pixel`] takes of many, which turns −0 into +0.
+fn one_sample((l, primary): (Vec3, Primary)) -> (Vec3, Primary) {
+    (Vec3::ZERO + l, primary)
+}
+
 /// One pixel: the box-filtered mean of its samples. Its generator is seeded from
 /// (seed, x, y) only, so its value is independent of tiles, threads and crops. The AOVs
 /// come from the sample nearest the pixel centre (averaging depths or object ids across
@@ -152,17 +195,14 @@ pub fn render_pixel(
     let mut rng = Rng::for_pixel(opts.seed, x, y);
     // The centre (`pixel_samples`' answer for one sample) needs no list: a heap list per
     // pixel was 3.6 % of a 1-spp render's instructions.
-    let (centre, many);
-    let samples: &[(f32, f32)] = if opts.spp <= 1 {
-        centre = [(0.5, 0.5)];
-        &centre
-    } else {
-        many = pixel_samples(opts.spp, &mut rng);
-        &many
-    };
+    if opts.spp <= 1 {
+        let ray = camera.ray(x as f32 + 0.5, y as f32 + 0.5);
+        return one_sample(integrator.camera_sample(&ray, cone, &mut rng, counts));
+    }
+    let samples = pixel_samples(opts.spp, &mut rng);
     let mut sum = Vec3::ZERO;
     let mut best = (f32::INFINITY, Primary::MISS);
-    for (sx, sy) in samples {
+    for &(sx, sy) in &samples {
         let ray = camera.ray(x as f32 + sx, y as f32 + sy);
         let (l, primary) = integrator.camera_sample(&ray, cone, &mut rng, counts);
         sum += l;

@@ -1,0 +1,141 @@
+//! Four rays traced together give each ray the answer it gets alone, bit for bit, and ask
+//! the filter the same questions in the same order.
+
+use formats::{BuildParams, Hit};
+use glam::Vec3;
+use kdtree::testkit::{grid, grid_box, sphere, Rng};
+use kdtree::{Accel, Ray, LANES};
+
+/// What the filter was asked, per lane: (triangle, t bits, side).
+type Asked = Vec<(u32, u32, bool)>;
+
+/// Lane by lane, `intersect4` against `intersect` and `intersect4_filtered` against
+/// `intersect_filtered` (refusing every third triangle and the back of every fifth), with
+/// the filter's questions recorded on both sides. Returns how many lanes hit.
+fn check(accel: &Accel, rays: &[Ray; LANES]) -> usize {
+    let got = accel.intersect4(rays);
+    let keep =
+        |h: &Hit, front: bool| !h.prim.is_multiple_of(3) && (front || !h.prim.is_multiple_of(5));
+    let mut asked4: [Asked; LANES] = Default::default();
+    let got_filtered = accel.intersect4_filtered(rays, |l, h, front| {
+        asked4[l].push((h.prim, h.t.to_bits(), front));
+        keep(h, front)
+    });
+    let mut hits = 0;
+    for (l, ray) in rays.iter().enumerate() {
+        let want = accel.intersect(ray);
+        assert_eq!(got[l], want, "lane {l} of {rays:?}");
+        hits += want.is_some() as usize;
+        let mut asked = Asked::new();
+        let want = accel.intersect_filtered(ray, |h, front| {
+            asked.push((h.prim, h.t.to_bits(), front));
+            keep(h, front)
+        });
+        assert_eq!(got_filtered[l], want, "filtered, lane {l} of {rays:?}");
+        assert_eq!(asked4[l], asked, "filter questions, lane {l} of {rays:?}");
+    }
+    hits
+}
+
+fn scene() -> Vec<[Vec3; 3]> {
+    let mut tris = sphere(Vec3::new(0.0, 1.0, 0.0), 1.0, 16, 32);
+    tris.extend(grid_box(Vec3::new(2.5, 0.5, -1.0), 0.5, 4));
+    tris.extend(
+        grid(16, 8.0, 0.0)
+            .iter()
+            .map(|t| t.map(|v| v - Vec3::new(4.0, 0.0, 4.0))),
+    );
+    let mut rng = Rng(11);
+    for _ in 0..300 {
+        let c = Vec3::new(
+            rng.range(-4.0, 4.0),
+            rng.range(0.0, 3.0),
+            rng.range(-4.0, 4.0),
+        );
+        tris.push([c, c + 0.3 * rng.dir(), c + 0.3 * rng.dir()]);
+    }
+    tris
+}
+
+/// Camera rays of 2×2 pixel blocks (the packets a renderer forms), from several viewpoints,
+/// some with the lanes' intervals cut differently.
+#[test]
+fn neighbouring_camera_rays_get_their_single_answers() {
+    let tris = scene();
+    let accel = Accel::build(&tris, &BuildParams::default());
+    let mut rng = Rng(3);
+    let (mut hits, mut lanes) = (0, 0);
+    for view in 0..12 {
+        let eye = Vec3::new(
+            rng.range(-6.0, 6.0),
+            rng.range(0.5, 5.0),
+            rng.range(-6.0, 6.0),
+        );
+        let forward = (Vec3::new(0.0, 0.8, 0.0) - eye).normalize();
+        let right = forward.cross(Vec3::Y).normalize();
+        let up = right.cross(forward);
+        let n = 48;
+        for py in (0..n).step_by(2) {
+            for px in (0..n).step_by(2) {
+                let rays: [Ray; LANES] = std::array::from_fn(|l| {
+                    let (x, y) = ((px + l % 2) as f32, (py + l / 2) as f32);
+                    let sx = (x + 0.5) / n as f32 * 2.0 - 1.0;
+                    let sy = 1.0 - (y + 0.5) / n as f32 * 2.0;
+                    let dir = forward + 0.7 * (sx * right + sy * up);
+                    let (tmin, tmax) = match (view + l) % 4 {
+                        0 => (0.0, f32::INFINITY),
+                        1 => (0.0, rng.range(2.0, 9.0)),
+                        2 => (rng.range(0.0, 4.0), f32::INFINITY),
+                        _ => (1e-4, 1e30),
+                    };
+                    Ray::new(eye, dir, tmin, tmax)
+                });
+                hits += check(&accel, &rays);
+                lanes += LANES;
+            }
+        }
+    }
+    assert!(
+        hits > lanes / 3 && hits < lanes,
+        "{hits} of {lanes} lanes hit"
+    );
+}
+
+/// Rays along the grid's lines and in its plane (split planes, zero direction components,
+/// rays in a plane visiting both children), lanes that cannot hit anything (zero or NaN
+/// directions, empty intervals, rays that miss the scene's box), and packets whose lanes
+/// point different ways (traced one by one).
+#[test]
+fn hard_lanes_and_mixed_packets_get_their_single_answers() {
+    let tris = scene();
+    let accel = Accel::build(&tris, &BuildParams::default());
+    let mut rng = Rng(5);
+    let mut hits = 0;
+    for i in 0..3000 {
+        let rays: [Ray; LANES] = std::array::from_fn(|l| {
+            let o = Vec3::new(
+                rng.range(-5.0, 5.0),
+                rng.range(-1.0, 4.0),
+                rng.range(-5.0, 5.0),
+            );
+            match (i + l) % 8 {
+                // On the grid's lattice, along an axis, in the plane y = 0.
+                0 => Ray::new(
+                    Vec3::new((o.x * 2.0).round() / 2.0, 0.0, (o.z * 2.0).round() / 2.0),
+                    Vec3::X,
+                    0.0,
+                    f32::INFINITY,
+                ),
+                1 => Ray::new(o, Vec3::new(0.3, -1.0, 0.0), 0.0, f32::INFINITY),
+                2 => Ray::new(o, Vec3::ZERO, 0.0, f32::INFINITY),
+                3 => Ray::new(o, Vec3::new(f32::NAN, 1.0, 0.0), 0.0, f32::INFINITY),
+                4 => Ray::new(o, Vec3::new(0.2, -1.0, 0.1), 5.0, 1.0),
+                5 => Ray::new(o + Vec3::splat(100.0), Vec3::new(0.2, -1.0, 0.1), 0.0, 1e3),
+                6 => Ray::new(o, rng.dir(), 0.0, f32::INFINITY),
+                _ => Ray::new(o, Vec3::new(0.25, -1.0, 0.15), 0.0, rng.range(0.5, 8.0)),
+            }
+        });
+        hits += check(&accel, &rays);
+    }
+    assert!(hits > 1000, "{hits} lanes hit");
+}
