@@ -144,28 +144,29 @@ fn render_tile(
     let width = (tile.x1 - tile.x0) as usize;
     let at = |x: u32, y: u32| (y - tile.y0) as usize * width + (x - tile.x0) as usize;
     let mut pixels = vec![(Vec3::ZERO, Primary::MISS); tile.pixels() as usize];
-    let mut done = vec![false; pixels.len()];
-    if opts.spp <= 1 {
-        let (x_end, y_end) = (
+    // The blocks cover [x0, x_end) × [y0, y_end); nothing at more than one sample.
+    let (x_end, y_end) = if opts.spp <= 1 {
+        (
             tile.x1 - (tile.x1 - tile.x0) % 2,
             tile.y1 - (tile.y1 - tile.y0) % 2,
-        );
-        for y in (tile.y0..y_end).step_by(2) {
-            for x in (tile.x0..x_end).step_by(2) {
-                let block = [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)];
-                let rays = block.map(|(x, y)| camera.ray(x as f32 + 0.5, y as f32 + 0.5));
-                let mut rngs = block.map(|(x, y)| Rng::for_pixel(opts.seed, x, y));
-                let samples = integrator.camera_sample4(&rays, cone, &mut rngs, counts);
-                for ((x, y), sample) in block.into_iter().zip(samples) {
-                    pixels[at(x, y)] = one_sample(sample);
-                    done[at(x, y)] = true;
-                }
+        )
+    } else {
+        (tile.x0, tile.y0)
+    };
+    for y in (tile.y0..y_end).step_by(2) {
+        for x in (tile.x0..x_end).step_by(2) {
+            let block = [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)];
+            let rays = block.map(|(x, y)| camera.ray(x as f32 + 0.5, y as f32 + 0.5));
+            let mut rngs = block.map(|(x, y)| Rng::for_pixel(opts.seed, x, y));
+            let samples = integrator.camera_sample4(&rays, cone, &mut rngs, counts);
+            for ((x, y), sample) in block.into_iter().zip(samples) {
+                pixels[at(x, y)] = one_sample(sample);
             }
         }
     }
     for y in tile.y0..tile.y1 {
         for x in tile.x0..tile.x1 {
-            if !done[at(x, y)] {
+            if x >= x_end || y >= y_end {
                 pixels[at(x, y)] = render_pixel(camera, cone, integrator, opts, x, y, counts);
             }
         }

@@ -62,7 +62,7 @@ fn quick_run_has_every_row_and_the_contenders_agree() {
     let mut all = contenders.clone();
     all.push(BRUTE);
     let kinds = Kind::ALL.len();
-    assert_eq!(kinds, 7);
+    assert_eq!(kinds, 8);
     assert_eq!(s.traces.len(), all.len() * 2 * kinds);
     let rays = |who: &str, kind: Kind| {
         s.traces
@@ -72,6 +72,7 @@ fn quick_run_has_every_row_and_the_contenders_agree() {
             .rays
     };
     assert_eq!(rays(KDTREE, Kind::Primary), 48 * 48);
+    assert_eq!(rays(KDTREE, Kind::PrimaryPackets), 48 * 48);
     assert_eq!(rays(KDTREE, Kind::Random), 2048);
     // Shadow rays start at primary hits: most of a framed view hits the scene.
     let shadow = rays(KDTREE, Kind::Shadow);
@@ -80,6 +81,7 @@ fn quick_run_has_every_row_and_the_contenders_agree() {
         "{shadow} shadow rays"
     );
     assert_eq!(rays(BRUTE, Kind::Primary), 512);
+    assert_eq!(rays(BRUTE, Kind::PrimaryPackets), 512);
     for k in [
         Kind::SurfaceLight,
         Kind::SurfaceLightAny,
@@ -118,7 +120,7 @@ fn quick_run_has_every_row_and_the_contenders_agree() {
     assert!(md.contains(&format!("| {name} | kdtree median | 1 |")));
     assert!(md.contains(&format!("| {name} | brute force | 1 |")));
     assert!(md.contains(&format!(
-        "| {name} | brute force | 0 / 512 | 0 / {} | 0 / 512 | 0 / 512 | 0 / 512 | 0 / 512 | 0 / 512 | 100.0000% | ok | – |",
+        "| {name} | brute force | 0 / 512 | 0 / 512 | 0 / {} | 0 / 512 | 0 / 512 | 0 / 512 | 0 / 512 | 0 / 512 | 100.0000% | ok | – |",
         shadow.min(512)
     )));
     assert_eq!(

@@ -44,8 +44,10 @@ pub fn intersect_filtered(
 /// [`intersect`], answer for answer, with most of the work skipped where it provably
 /// cannot change the answer. The triangles are cut into runs of consecutive indices
 /// (meshes are contiguous in a soup, so a run is a patch of a mesh) and each run sits in its
-/// bounding box grown by 10⁻⁴ of the scene's diagonal, thousands of times the rounding of
-/// any hit point. A ray that misses a run's box cannot hit a triangle in it, and a run
+/// bounding box, grown for each ray by 10⁻⁴ of the scene's diagonal plus the largest
+/// coordinate of the scene and of the ray's origin: the triangle test works on vertices
+/// less the origin in f32, so its hits are off the exact line by a few ulps of those, and the
+/// margin is hundreds of times that. A ray that misses a run's box cannot hit a triangle in it, and a run
 /// whose box the ray enters beyond the best hit so far cannot hold a closer one; since ties
 /// go to the lower index whatever the order of the tests, visiting the boxes nearest first
 /// and stopping there leaves the answer unchanged. The boxes are a flat list in f64, not
@@ -54,6 +56,8 @@ pub struct Runs<'a> {
     triangles: &'a [[Vec3; 3]],
     run: usize,
     boxes: Vec<[DVec3; 2]>,
+    /// The scene's diagonal plus its largest coordinate (see the margin above).
+    scale: f64,
 }
 
 impl<'a> Runs<'a> {
@@ -69,18 +73,13 @@ impl<'a> Runs<'a> {
             b
         };
         let [lo, hi] = bounds(triangles);
-        let margin = DVec3::splat(((hi - lo).length() * 1e-4).max(1e-30));
-        let boxes = triangles
-            .chunks(run)
-            .map(|run| {
-                let [lo, hi] = bounds(run);
-                [lo - margin, hi + margin]
-            })
-            .collect();
+        let scale = (hi - lo).length() + lo.abs().max(hi.abs()).max_element();
+        let boxes = triangles.chunks(run).map(bounds).collect();
         Runs {
             triangles,
             run,
             boxes,
+            scale: if scale.is_finite() { scale } else { 0.0 },
         }
     }
 
@@ -91,11 +90,16 @@ impl<'a> Runs<'a> {
         }
         let pre = RayPre::new(ray.origin, ray.dir)?;
         let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());
+        let margin = DVec3::splat((1e-4 * (self.scale + o.abs().max_element())).max(1e-30));
+        let (tmin, tmax) = (ray.tmin as f64, ray.tmax as f64);
         let mut entered: Vec<(f64, usize)> = self
             .boxes
             .iter()
             .enumerate()
-            .filter_map(|(k, b)| Some((entry(o, d, b, ray.tmin as f64, ray.tmax as f64)?, k)))
+            .filter_map(|(k, b)| {
+                let grown = [b[0] - margin, b[1] + margin];
+                Some((entry(o, d, &grown, tmin, tmax)?, k))
+            })
             .collect();
         entered.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
         let mut best = Hit::MISS;
@@ -207,37 +211,43 @@ mod tests {
     /// start inside the scene, coplanar duplicates (ties by index) and rays along a plane.
     #[test]
     fn runs_give_exactly_the_answers_of_testing_every_triangle() {
-        let mut tris = sphere(Vec3::new(0.3, 0.2, -0.1), 1.0, 12, 24);
-        tris.extend(grid_box(Vec3::new(2.5, 0.0, 0.0), 0.7, 6));
-        tris.extend(grid(10, 8.0, -1.2));
-        tris.extend(grid(10, 8.0, -1.2)); // exact duplicates: ties go to the lower index
-                                          // Runs of 8: many boxes for so few triangles, so the order and the early stop matter.
-        let runs = Runs::new(&tris, 8);
-        let mut rng = Rng(7);
-        let (mut hits, mut rays) = (0, 0);
-        for i in 0..4000 {
-            let mut origin = Vec3::new(
-                rng.range(-2.0, 7.0),
-                rng.range(-3.0, 2.0),
-                rng.range(-2.0, 7.0),
-            );
-            let mut dir = rng.dir();
-            if i % 10 == 0 {
-                // In the grid's plane, which is also a face of its runs' boxes.
-                (origin.y, dir.y) = (-1.2, 0.0);
+        // At the origin, and 10⁵ away, where coordinates keep about 3 fractional bits.
+        for offset in [Vec3::ZERO, Vec3::new(1e5, 0.0, -1e5)] {
+            let mut tris = sphere(Vec3::new(0.3, 0.2, -0.1), 1.0, 12, 24);
+            tris.extend(grid_box(Vec3::new(2.5, 0.0, 0.0), 0.7, 6));
+            // The grid twice, exactly: ties go to the lower index.
+            tris.extend(grid(10, 8.0, -1.2));
+            tris.extend(grid(10, 8.0, -1.2));
+            let tris: Vec<[Vec3; 3]> = tris.iter().map(|t| t.map(|v| v + offset)).collect();
+            // Runs of 8: many boxes for so few triangles, so the order and the early stop
+            // matter.
+            let runs = Runs::new(&tris, 8);
+            let mut rng = Rng(7);
+            let (mut hits, mut rays) = (0, 0);
+            for i in 0..4000 {
+                let mut origin = Vec3::new(
+                    rng.range(-2.0, 7.0),
+                    rng.range(-3.0, 2.0),
+                    rng.range(-2.0, 7.0),
+                );
+                let mut dir = rng.dir();
+                if i % 10 == 0 {
+                    // In the grid's plane, which is also a face of its runs' boxes.
+                    (origin.y, dir.y) = (-1.2, 0.0);
+                }
+                let (tmin, tmax) = match i % 3 {
+                    0 => (0.0, f32::INFINITY),
+                    1 => (rng.range(0.0, 2.0), rng.range(2.0, 6.0)),
+                    _ => (0.0, rng.range(0.0, 3.0)),
+                };
+                let r = Ray::new(origin + offset, dir, tmin, tmax);
+                let want = intersect(&tris, &r);
+                assert_eq!(runs.intersect(&r), want, "{r:?}");
+                hits += want.is_some() as usize;
+                rays += 1;
             }
-            let (tmin, tmax) = match i % 3 {
-                0 => (0.0, f32::INFINITY),
-                1 => (rng.range(0.0, 2.0), rng.range(2.0, 6.0)),
-                _ => (0.0, rng.range(0.0, 3.0)),
-            };
-            let r = Ray::new(origin, dir, tmin, tmax);
-            let want = intersect(&tris, &r);
-            assert_eq!(runs.intersect(&r), want, "{r:?}");
-            hits += want.is_some() as usize;
-            rays += 1;
+            assert!(hits > rays / 8 && hits < rays, "{hits} of {rays} rays hit");
         }
-        assert!(hits > rays / 8 && hits < rays, "{hits} of {rays} rays hit");
     }
 
     #[test]
