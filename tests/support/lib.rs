@@ -1,9 +1,13 @@
 //! Support for the end-to-end tests: building, locating and running the real binaries.
 //!
 //! The binaries live in other workspace packages, so cargo does not build them for this
-//! package's tests. The first test that needs one runs `cargo build --bins` once, with the
-//! same profile and target folder as the running test, so the suite always tests the
-//! binaries of the current source.
+//! package's tests. The first test that needs one runs `cargo test --workspace --no-run`
+//! once, with the same profile and target folder as the running test, so the suite always
+//! tests the binaries of the current source. That command resolves features as
+//! `cargo test --workspace` does (the packages' own integration tests need the same
+//! binaries), so after that command it has nothing left to build; a plain
+//! `cargo build --bins` would resolve them without the dev-dependencies' features and
+//! rebuild every binary.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -38,14 +42,14 @@ pub fn bin(name: &str) -> PathBuf {
         let target = dir.parent().expect("target dir");
         let mut cmd = Command::new(env!("CARGO"));
         cmd.current_dir(repo())
-            .args(["build", "--workspace", "--bins", "--quiet"])
+            .args(["test", "--workspace", "--no-run", "--quiet"])
             .env("CARGO_TARGET_DIR", target);
         // `debug` is the test profile's output folder; any other folder is a named profile.
         if profile != "debug" {
             cmd.args(["--profile", profile]);
         }
-        let status = cmd.status().expect("run cargo build --bins");
-        assert!(status.success(), "cargo build --bins failed");
+        let status = cmd.status().expect("run cargo test --no-run");
+        assert!(status.success(), "cargo test --workspace --no-run failed");
     });
     let p = profile_dir().join(format!("{name}{}", std::env::consts::EXE_SUFFIX));
     assert!(p.exists(), "binary {} was not built", p.display());
