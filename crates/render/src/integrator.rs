@@ -37,8 +37,7 @@ use crate::texture::{cone_footprint, Sampler};
 use crate::TextureFilter;
 use formats::{CastShadows, Hit, Light, LightKind, Soup, Tiling};
 use glam::{Vec2, Vec3, Vec4};
-use kdtree::LANES;
-use kdtree::{Accel, Ray};
+use kdtree::{Accel, Ray, LANES};
 
 /// What the first hit of a camera ray tells the AOVs.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -26,19 +26,39 @@ pub fn intersect_filtered(
     ray: &Ray,
     mut accept: impl FnMut(&Hit, bool) -> bool,
 ) -> Option<Hit> {
+    let pre = ray_pre(ray)?;
+    let mut best = Hit::MISS;
+    let mut best_t = ray.tmax;
+    test_run(&pre, ray, triangles, 0, &mut best, &mut best_t, &mut accept);
+    (!best.is_miss()).then_some(best)
+}
+
+/// The per-ray constants, or None for a ray that can hit nothing (an empty interval, bad
+/// numbers).
+fn ray_pre(ray: &Ray) -> Option<RayPre> {
     if !(ray.tmin <= ray.tmax) || ray.tmax == f32::NEG_INFINITY || ray.tmin == f32::INFINITY {
         return None;
     }
-    let pre = RayPre::new(ray.origin, ray.dir)?;
-    let mut best = Hit::MISS;
-    let mut best_t = ray.tmax;
-    for (i, t) in triangles.iter().enumerate() {
+    RayPre::new(ray.origin, ray.dir)
+}
+
+/// Tests `run`, whose first triangle has index `first`, keeping the closer hits `accept`
+/// takes, with the tree's test and tie rule.
+fn test_run(
+    pre: &RayPre,
+    ray: &Ray,
+    run: &[[Vec3; 3]],
+    first: usize,
+    best: &mut Hit,
+    best_t: &mut f32,
+    accept: &mut impl FnMut(&Hit, bool) -> bool,
+) {
+    for (i, t) in run.iter().enumerate() {
         let tri = [t[0].to_array(), t[1].to_array(), t[2].to_array()];
-        if let Some(h) = triangle::intersect(&pre, &tri, ray.tmin, triangle::widen(best_t)) {
-            keep_closer(&mut best, &mut best_t, i as u32, h, &mut accept);
+        if let Some(h) = triangle::intersect(pre, &tri, ray.tmin, triangle::widen(*best_t)) {
+            keep_closer(best, best_t, (first + i) as u32, h, accept);
         }
     }
-    (!best.is_miss()).then_some(best)
 }
 
 /// [`intersect`], answer for answer, with most of the work skipped where it provably
@@ -47,10 +67,10 @@ pub fn intersect_filtered(
 /// bounding box, grown for each ray by 10⁻⁴ of the scene's diagonal plus the largest
 /// coordinate of the scene and of the ray's origin: the triangle test works on vertices
 /// less the origin in f32, so its hits are off the exact line by a few ulps of those, and the
-/// margin is hundreds of times that. A ray that misses a run's box cannot hit a triangle in it, and a run
-/// whose box the ray enters beyond the best hit so far cannot hold a closer one; since ties
-/// go to the lower index whatever the order of the tests, visiting the boxes nearest first
-/// and stopping there leaves the answer unchanged. The boxes are a flat list in f64, not
+/// margin is hundreds of times that. A ray that misses a run's box cannot hit a triangle in
+/// it, and a run whose box the ray enters beyond the best hit so far cannot hold a closer
+/// one; since ties go to the lower index whatever the order of the tests, visiting the boxes
+/// nearest first and stopping there leaves the answer unchanged. The boxes are a flat list in f64, not
 /// a hierarchy, and share no code with the tree's build or traversal.
 pub struct Runs<'a> {
     triangles: &'a [[Vec3; 3]],
@@ -85,10 +105,7 @@ impl<'a> Runs<'a> {
 
     /// The same answer as [`intersect`] on all the triangles.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        if !(ray.tmin <= ray.tmax) || ray.tmax == f32::NEG_INFINITY || ray.tmin == f32::INFINITY {
-            return None;
-        }
-        let pre = RayPre::new(ray.origin, ray.dir)?;
+        let pre = ray_pre(ray)?;
         let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());
         let margin = DVec3::splat((1e-4 * (self.scale + o.abs().max_element())).max(1e-30));
         let (tmin, tmax) = (ray.tmin as f64, ray.tmax as f64);
@@ -109,19 +126,16 @@ impl<'a> Runs<'a> {
                 break;
             }
             let first = k * self.run;
-            for (i, t) in self.triangles[first..].iter().take(self.run).enumerate() {
-                let tri = [t[0].to_array(), t[1].to_array(), t[2].to_array()];
-                if let Some(h) = triangle::intersect(&pre, &tri, ray.tmin, triangle::widen(best_t))
-                {
-                    keep_closer(
-                        &mut best,
-                        &mut best_t,
-                        (first + i) as u32,
-                        h,
-                        &mut |_, _| true,
-                    );
-                }
-            }
+            let run = &self.triangles[first..(first + self.run).min(self.triangles.len())];
+            test_run(
+                &pre,
+                ray,
+                run,
+                first,
+                &mut best,
+                &mut best_t,
+                &mut |_, _| true,
+            );
         }
         (!best.is_miss()).then_some(best)
     }

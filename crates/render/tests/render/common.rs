@@ -294,6 +294,23 @@ pub fn render(soup: &Soup, kd: &KdFile, opts: &RenderOptions) -> (Rendered, Plan
     (out, plan)
 }
 
+/// `opts` rendered on one thread with tiles of 1 pixel (no 2×2 blocks), 5 (blocks, and a
+/// last row and column alone) and 32: asserts the same frame and counts, returns the first.
+pub fn render_alike_at_tiles(soup: &Soup, kd: &KdFile, opts: &RenderOptions) -> Rendered {
+    let mut o = opts.clone();
+    o.threads = Some(1);
+    let runs = [1, 5, 32].map(|tile| {
+        o.tile = tile;
+        render(soup, kd, &o).0
+    });
+    let [first, rest @ ..] = runs;
+    for r in &rest {
+        assert_eq!(r.frame, first.frame);
+        assert_eq!(r.counts, first.counts);
+    }
+    first
+}
+
 /// Relative difference, per channel, of `got` from `want` is within `tol`.
 pub fn assert_close(got: Vec3, want: Vec3, tol: f32, what: &str) {
     for c in 0..3 {

@@ -59,18 +59,9 @@ fn a_one_sided_quad_seen_from_behind_shows_the_wall_behind_it() {
 #[test]
 fn culled_faces_are_passed_alike_in_blocks_and_alone() {
     let (soup, kd) = quad_over_wall(Cull::Back, false).build();
-    let mut o = opts(21, 19);
-    o.threads = Some(1);
-    let runs = [1, 5, 32].map(|tile| {
-        o.tile = tile;
-        render(&soup, &kd, &o).0
-    });
-    for r in &runs[1..] {
-        assert_eq!(r.frame, runs[0].frame);
-        assert_eq!(r.counts, runs[0].counts);
-    }
-    assert!(runs[0].counts.pass_through > 50, "{:?}", runs[0].counts);
-    assert_eq!(runs[0].frame.pixel(10, 9), WALL);
+    let out = render_alike_at_tiles(&soup, &kd, &opts(21, 19));
+    assert!(out.counts.pass_through > 50, "{:?}", out.counts);
+    assert_eq!(out.frame.pixel(10, 9), WALL);
 }
 
 #[test]

@@ -284,15 +284,6 @@ fn pixels_do_not_depend_on_threads_or_tiles() {
 #[test]
 fn pixels_traced_in_blocks_equal_pixels_traced_alone() {
     let (soup, kd) = shadow_scene(Shadows::Hard, 0.5).build();
-    let mut o = opts(37, 29);
-    o.threads = Some(1);
-    let runs = [1, 5, 32].map(|tile| {
-        o.tile = tile;
-        render(&soup, &kd, &o).0
-    });
-    for r in &runs[1..] {
-        assert_eq!(r.frame, runs[0].frame);
-        assert_eq!(r.counts, runs[0].counts);
-    }
-    assert_eq!(runs[0].counts.camera, 37 * 29);
+    let out = render_alike_at_tiles(&soup, &kd, &opts(37, 29));
+    assert_eq!(out.counts.camera, 37 * 29);
 }
