@@ -81,7 +81,8 @@ impl Tree<'_> {
         accept: &mut F,
     ) -> [Option<Hit>; LANES] {
         let mut best = [Hit::MISS; LANES];
-        let mut best_t = Vec4::from_array(rays.each_ref().map(|r| r.tmax));
+        // An array, not a `Vec4`: a `Vec4` indexed by a variable lane is a jump table.
+        let mut best_t = rays.each_ref().map(|r| r.tmax);
         let mut stack = [MaybeUninit::<Waiting>::uninit(); STACK];
         let mut sp = 0;
         let (mut node_i, mut mask) = (0u32, live);
@@ -135,16 +136,14 @@ impl Tree<'_> {
             let leaf = self.leaf(node);
             for l in lanes_of(mask) {
                 let mut accept_l = |h: &Hit, front: bool| accept(l, h, front);
-                let mut bt = best_t[l];
                 self.leaf_closest::<KZ, _>(
                     &s[l],
                     &rays[l],
                     leaf,
                     &mut best[l],
-                    &mut bt,
+                    &mut best_t[l],
                     &mut accept_l,
                 );
-                best_t[l] = bt;
             }
             loop {
                 if sp == 0 {
@@ -154,7 +153,7 @@ impl Tree<'_> {
                 // SAFETY: entries below `sp` were written by the push that raised `sp`
                 // past them.
                 let w = unsafe { stack[sp].assume_init() };
-                let ahead = best_t.cmpge(down4(w.t0)).bitmask() as u8;
+                let ahead = Vec4::from_array(best_t).cmpge(down4(w.t0)).bitmask() as u8;
                 if w.lanes & ahead != 0 {
                     (node_i, mask, t0, t1) = (w.node, w.lanes & ahead, w.t0, w.t1);
                     break;

@@ -97,8 +97,13 @@ impl<'a> Solids<'a> {
         let pieces = match cell.get() {
             Some(p) => p,
             None => {
+                // One thread finds them; the others walk on meanwhile rather than wait, and
+                // only read the flag: a write per ray would bounce its cache line between
+                // the threads.
+                if self.claimed[o].load(Relaxed) {
+                    return false;
+                }
                 let entered = self.entered[o].fetch_add(1, Relaxed) as usize + 1;
-                // One thread finds them; the others walk on meanwhile rather than wait.
                 if entered < run.len() / 4 || self.claimed[o].swap(true, Relaxed) {
                     return false;
                 }
