@@ -152,6 +152,45 @@ pub struct Integrator<'a> {
     surfacing: Vec<Surfacing>,
     /// Closed pieces of objects, asked about by opaque shadow rays passing into them.
     solids: Solids<'a>,
+    /// Per triangle, the sides it is drawn and casts from ([`DRAWN_FRONT`] …): what the
+    /// traversals' filters ask, one byte instead of the object's and the material's records
+    /// (empty when no face is culled and every object casts).
+    sides: Vec<u8>,
+}
+
+/// [`Integrator::sides`] bits: camera and reflection rays that meet the triangle's front
+/// (back) stop there; shadow rays that meet its front (back) are blocked.
+const DRAWN_FRONT: u8 = 1;
+const DRAWN_BACK: u8 = 2;
+const CASTS_FRONT: u8 = 4;
+const CASTS_BACK: u8 = 8;
+
+/// Each triangle's [`Integrator::sides`] bits, from its object's and material's rules.
+fn sides(soup: &Soup) -> Vec<u8> {
+    soup.tri_object
+        .iter()
+        .zip(&soup.tri_material)
+        .map(|(&o, &m)| {
+            let obj = &soup.objects[o as usize];
+            let cull = soup.materials[m as usize].cull;
+            // The shadow pass sees a face from the light, so from the side the shadow ray
+            // did not meet.
+            let casts = |front: bool| match obj.cast_shadows {
+                CastShadows::Off => false,
+                CastShadows::TwoSided => true,
+                CastShadows::On | CastShadows::ShadowsOnly => !cull.skips(!front),
+            };
+            let drawn = |front: bool| obj.visible() && !cull.skips(front);
+            [
+                (drawn(true), DRAWN_FRONT),
+                (drawn(false), DRAWN_BACK),
+                (casts(true), CASTS_FRONT),
+                (casts(false), CASTS_BACK),
+            ]
+            .iter()
+            .fold(0, |b, &(on, bit)| if on { b | bit } else { b })
+        })
+        .collect()
 }
 
 /// Replace NaN and ±Inf channels by 0; true when something was replaced.
@@ -232,6 +271,11 @@ impl<'a> Integrator<'a> {
                 Solids::new(soup)
             } else {
                 Solids::none(soup)
+            },
+            sides: if plan.culling.enabled || shadow_filter {
+                sides(soup)
+            } else {
+                Vec::new()
             },
         }
     }
@@ -677,26 +721,14 @@ impl<'a> Integrator<'a> {
     /// (`front`) or back: a shadows-only object, or a face its material culls.
     #[inline(always)]
     fn culled(&self, prim: usize, front: bool) -> bool {
-        let obj = &self.soup.objects[self.soup.tri_object[prim] as usize];
-        !obj.visible()
-            || self.soup.materials[self.soup.tri_material[prim] as usize]
-                .cull
-                .skips(front)
+        self.sides[prim] & if front { DRAWN_FRONT } else { DRAWN_BACK } == 0
     }
 
     /// Whether the hit triangle `prim` blocks a shadow ray (travelling towards the light)
-    /// that meets its front (`front`) or back: the shadow pass sees it from the light, so
-    /// from the other side.
+    /// that meets its front (`front`) or back.
+    #[inline(always)]
     fn casts(&self, prim: usize, front: bool) -> bool {
-        let obj = &self.soup.objects[self.soup.tri_object[prim] as usize];
-        match obj.cast_shadows {
-            CastShadows::Off => false,
-            CastShadows::TwoSided => true,
-            CastShadows::On | CastShadows::ShadowsOnly => !self.soup.materials
-                [self.soup.tri_material[prim] as usize]
-                .cull
-                .skips(!front),
-        }
+        self.sides[prim] & if front { CASTS_FRONT } else { CASTS_BACK } != 0
     }
 
     /// The share of a light's light that reaches the surface at `p` along unit `dir` from
