@@ -44,6 +44,10 @@ pub(crate) trait Tracer: Sync {
     fn closest4(&self, rays: &[Ray; 4]) -> [Found; 4] {
         rays.each_ref().map(|r| self.closest(r))
     }
+    /// Four any-hit rays at once, likewise.
+    fn occluded4(&self, rays: &[Ray; 4]) -> [bool; 4] {
+        rays.each_ref().map(|r| self.occluded(r))
+    }
 }
 
 fn found(hit: Option<(f32, u32, f32, f32)>) -> Found {
@@ -68,6 +72,10 @@ impl Tracer for Accel {
     fn closest4(&self, rays: &[Ray; 4]) -> [Found; 4] {
         self.intersect4(rays).map(found_kd)
     }
+    #[inline]
+    fn occluded4(&self, rays: &[Ray; 4]) -> [bool; 4] {
+        Accel::occluded4(self, rays)
+    }
 }
 
 #[cfg(feature = "embree")]
@@ -83,6 +91,10 @@ impl Tracer for crate::embree::EmbreeScene {
     #[inline]
     fn closest4(&self, rays: &[Ray; 4]) -> [Found; 4] {
         self.intersect4(rays).map(found)
+    }
+    #[inline]
+    fn occluded4(&self, rays: &[Ray; 4]) -> [bool; 4] {
+        crate::embree::EmbreeScene::occluded4(self, rays)
     }
 }
 

@@ -93,10 +93,10 @@ struct RtcRayHit {
     hit: RtcHit,
 }
 
-/// `struct RTCRayHit4`: `RTCRay4` then `RTCHit4`, lane-major arrays (320 bytes, 16-byte
-/// aligned; one instance level).
+/// `struct RTCRay4`: lane-major arrays (192 bytes, 16-byte aligned).
 #[repr(C, align(16))]
-struct RtcRayHit4 {
+#[derive(Clone, Copy)]
+struct RtcRay4 {
     org: [[f32; 4]; 3],
     tnear: [f32; 4],
     dir: [[f32; 4]; 3],
@@ -105,6 +105,13 @@ struct RtcRayHit4 {
     mask: [u32; 4],
     id: [u32; 4],
     flags: [u32; 4],
+}
+
+/// `struct RTCRayHit4`: `RTCRay4` then `RTCHit4`, lane-major arrays (320 bytes, 16-byte
+/// aligned; one instance level).
+#[repr(C, align(16))]
+struct RtcRayHit4 {
+    ray: RtcRay4,
     ng: [[f32; 4]; 3],
     u: [f32; 4],
     v: [f32; 4],
@@ -119,6 +126,7 @@ struct Valid4([i32; 4]);
 
 const _: () = {
     assert!(std::mem::size_of::<RtcRayHit4>() == 320);
+    assert!(std::mem::size_of::<RtcRay4>() == 192);
     assert!(std::mem::size_of::<RtcIntersectContext>() == 24);
     assert!(std::mem::size_of::<RtcRay>() == 48);
     assert!(std::mem::align_of::<RtcRay>() == 16);
@@ -164,6 +172,12 @@ extern "C" {
         scene: RtcScene,
         context: *mut RtcIntersectContext,
         rayhit: *mut RtcRayHit4,
+    );
+    fn rtcOccluded4(
+        valid: *const Valid4,
+        scene: RtcScene,
+        context: *mut RtcIntersectContext,
+        ray: *mut RtcRay4,
     );
 }
 
@@ -399,11 +413,10 @@ impl EmbreeScene {
         ))
     }
 
-    /// [`EmbreeScene::intersect`] on four rays with one `rtcIntersect4` call.
-    #[inline]
-    pub fn intersect4(&self, rays: &[Ray; 4]) -> [Option<(f32, u32, f32, f32)>; 4] {
+    /// Four rays lane by lane, as the packet calls take them.
+    fn rtc_ray4(rays: &[Ray; 4]) -> RtcRay4 {
         let lane = |f: &dyn Fn(&Ray) -> f32| rays.each_ref().map(f);
-        let mut rh = RtcRayHit4 {
+        RtcRay4 {
             org: [
                 lane(&|r| r.origin.x),
                 lane(&|r| r.origin.y),
@@ -416,6 +429,22 @@ impl EmbreeScene {
             mask: [u32::MAX; 4],
             id: [0; 4],
             flags: [0; 4],
+        }
+    }
+
+    /// Neighbouring pixels' rays: Embree's hint for rays that travel together.
+    fn coherent_context() -> RtcIntersectContext {
+        RtcIntersectContext {
+            flags: RTC_INTERSECT_CONTEXT_FLAG_COHERENT,
+            ..init_context()
+        }
+    }
+
+    /// [`EmbreeScene::intersect`] on four rays with one `rtcIntersect4` call.
+    #[inline]
+    pub fn intersect4(&self, rays: &[Ray; 4]) -> [Option<(f32, u32, f32, f32)>; 4] {
+        let mut rh = RtcRayHit4 {
+            ray: Self::rtc_ray4(rays),
             ng: [[0.0; 4]; 3],
             u: [0.0; 4],
             v: [0.0; 4],
@@ -424,21 +453,28 @@ impl EmbreeScene {
             inst_id: [RTC_INVALID_GEOMETRY_ID; 4],
         };
         let valid = Valid4([-1; 4]);
-        // Neighbouring pixels' rays: Embree's hint for rays that travel together.
-        let mut ctx = RtcIntersectContext {
-            flags: RTC_INTERSECT_CONTEXT_FLAG_COHERENT,
-            ..init_context()
-        };
+        let mut ctx = Self::coherent_context();
         // SAFETY: committed scene; valid, ctx and rh are valid and 16-byte aligned.
         unsafe { rtcIntersect4(&valid, self.scene, &mut ctx, &mut rh) };
         std::array::from_fn(|l| {
             (rh.geom_id[l] != RTC_INVALID_GEOMETRY_ID).then_some((
-                rh.tfar[l],
+                rh.ray.tfar[l],
                 rh.prim_id[l],
                 rh.u[l],
                 rh.v[l],
             ))
         })
+    }
+
+    /// [`EmbreeScene::occluded`] on four rays with one `rtcOccluded4` call.
+    #[inline]
+    pub fn occluded4(&self, rays: &[Ray; 4]) -> [bool; 4] {
+        let mut r = Self::rtc_ray4(rays);
+        let valid = Valid4([-1; 4]);
+        let mut ctx = Self::coherent_context();
+        // SAFETY: committed scene; valid, ctx and r are valid and 16-byte aligned.
+        unsafe { rtcOccluded4(&valid, self.scene, &mut ctx, &mut r) };
+        r.tfar.map(|t| t == f32::NEG_INFINITY)
     }
 
     /// Whether anything blocks the ray in [tmin, tmax] (Embree sets tfar to −inf).
@@ -528,5 +564,6 @@ mod tests {
         for (r, g) in rays.iter().zip(got) {
             assert_eq!(g, s.intersect(r));
         }
+        assert_eq!(s.occluded4(&rays), [true, true, false, true]);
     }
 }

@@ -34,6 +34,7 @@ pub fn header(cfg: &Config) -> Vec<String> {
             "rays: primary {0}×{0} camera (the soup's when it has one, else a 45° view framing the bounds); \
              primary ×4: the same rays in 2×2 pixel blocks, one packet query per block (k-d tree `intersect4`, Embree `rtcIntersect4`); \
              shadow rays from every primary hit of the k-d tree to a light above the scene (any-hit); \
+             shadow ×4: those of the primary ×4 hits, in block order, four per packet query (k-d tree `occluded4`, Embree `rtcOccluded4`); \
              {1} random rays (origins uniform in the bounds, directions uniform on the sphere)",
             cfg.image, cfg.random_rays
         ),
@@ -53,7 +54,7 @@ pub fn header(cfg: &Config) -> Vec<String> {
             .map(|d| d.version())
             .unwrap_or_else(|e| format!("unavailable ({e})"));
         h.push(format!(
-            "Embree {version}: build quality {}, scene flags none, rtcIntersect1 / rtcOccluded1 with the incoherent context flag, rtcIntersect4 with the coherent one for primary ×4; \
+            "Embree {version}: build quality {}, scene flags none, rtcIntersect1 / rtcOccluded1 with the incoherent context flag, rtcIntersect4 / rtcOccluded4 with the coherent one for primary ×4 and shadow ×4; \
              build time includes filling its vertex and index buffers; bytes/tri from its memory monitor",
             cfg.embree_quality.name()
         ));

@@ -9,6 +9,8 @@ pub enum Kind {
     /// The same camera rays in 2×2 pixel blocks, each block one packet query.
     PrimaryPackets,
     Shadow,
+    /// Shadow rays from the primary ×4 hits, in their order, four per packet query.
+    ShadowPackets,
     Random,
     /// From random surface points toward the light, closest hit.
     SurfaceLight,
@@ -21,10 +23,11 @@ pub enum Kind {
 }
 
 impl Kind {
-    pub const ALL: [Kind; 8] = [
+    pub const ALL: [Kind; 9] = [
         Kind::Primary,
         Kind::PrimaryPackets,
         Kind::Shadow,
+        Kind::ShadowPackets,
         Kind::Random,
         Kind::SurfaceLight,
         Kind::SurfaceLightAny,
@@ -36,6 +39,7 @@ impl Kind {
             Kind::Primary => "primary",
             Kind::PrimaryPackets => "primary ×4",
             Kind::Shadow => "shadow",
+            Kind::ShadowPackets => "shadow ×4",
             Kind::Random => "random",
             Kind::SurfaceLight => "surface→light",
             Kind::SurfaceLightAny => "surface→light any",
@@ -43,11 +47,15 @@ impl Kind {
             Kind::SurfaceHemisphereAny => "surface→hemisphere any",
         }
     }
+    /// Traced four rays per query.
+    pub fn packets(self) -> bool {
+        matches!(self, Kind::PrimaryPackets | Kind::ShadowPackets)
+    }
     /// Traced as any-hit (occlusion) queries rather than closest hits.
     pub fn any_hit(self) -> bool {
         matches!(
             self,
-            Kind::Shadow | Kind::SurfaceLightAny | Kind::SurfaceHemisphereAny
+            Kind::Shadow | Kind::ShadowPackets | Kind::SurfaceLightAny | Kind::SurfaceHemisphereAny
         )
     }
 }

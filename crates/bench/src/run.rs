@@ -40,10 +40,17 @@ impl Bench<'_> {
             for _ in 0..self.cfg.runs.max(1) {
                 for (c, (_, tracer)) in who.iter().enumerate() {
                     let start = Instant::now();
-                    let a = if kind.any_hit() {
+                    let (packets, rest) = rays.as_chunks::<4>();
+                    let a = if kind == Kind::ShadowPackets {
+                        let mut blocked: Vec<_> = trace(pool, packets, |p| tracer.occluded4(p))
+                            .into_iter()
+                            .flatten()
+                            .collect();
+                        blocked.extend(rest.iter().map(|r| tracer.occluded(r)));
+                        Answers::Occluded(blocked)
+                    } else if kind.any_hit() {
                         Answers::Occluded(trace(pool, rays, |r| tracer.occluded(r)))
                     } else if kind == Kind::PrimaryPackets {
-                        let (packets, rest) = rays.as_chunks::<4>();
                         let mut found: Vec<_> = trace(pool, packets, |p| tracer.closest4(p))
                             .into_iter()
                             .flatten()
@@ -260,12 +267,13 @@ fn run_scene(
         rays::Toward::Direction(rays::hemisphere(rng, ng))
     });
 
-    let mut shadow = vec![];
+    let (mut shadow, mut shadow_blocks) = (vec![], vec![]);
     for kind in Kind::ALL {
         let set: &[Ray] = match kind {
             Kind::Primary => &primary,
             Kind::PrimaryPackets => &primary_blocks,
             Kind::Shadow => &shadow,
+            Kind::ShadowPackets => &shadow_blocks,
             Kind::Random => &random,
             Kind::SurfaceLight | Kind::SurfaceLightAny => &surface_light,
             Kind::SurfaceHemisphere | Kind::SurfaceHemisphereAny => &surface_hemisphere,
@@ -311,14 +319,17 @@ fn run_scene(
             let answers = b.traverse(&[(BRUTE, brute)], kind, &sub);
             b.agree(BRUTE, kind, set, &reference, &answers[0], Some(&idx), None);
         }
-        if kind == Kind::Primary {
-            // Shadow rays start at the k-d tree's primary hits.
-            if let Answers::Closest(hits) = &reference {
-                let hits: Vec<_> = hits
-                    .iter()
-                    .map(|h| h.is_hit().then_some((h.prim, h.u, h.v)))
-                    .collect();
-                shadow = rays::shadow(tris, &hits, rays::light_above(bounds), bounds);
+        // Shadow rays start at the k-d tree's primary hits, in the order of their set (so
+        // from 2×2 pixel blocks for the packets).
+        if let (Kind::Primary | Kind::PrimaryPackets, Answers::Closest(hits)) = (kind, &reference) {
+            let hits: Vec<_> = hits
+                .iter()
+                .map(|h| h.is_hit().then_some((h.prim, h.u, h.v)))
+                .collect();
+            let rays = rays::shadow(tris, &hits, rays::light_above(bounds), bounds);
+            match kind {
+                Kind::Primary => shadow = rays,
+                _ => shadow_blocks = rays,
             }
         }
     }

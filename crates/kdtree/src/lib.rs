@@ -200,6 +200,21 @@ impl Accel {
         self.tree().any(ray, blocks, &mut ())
     }
 
+    /// [`Accel::occluded`] on four rays at once, the same answers bit for bit (rays that do
+    /// not travel side by side are traced one by one, as for [`Accel::intersect4`]).
+    pub fn occluded4(&self, rays: &[Ray; LANES]) -> [bool; LANES] {
+        self.tree().any4(rays, |_, _, _| true)
+    }
+
+    /// [`Accel::occluded_filtered`] on four rays at once; `blocks` is told the lane too.
+    pub fn occluded4_filtered(
+        &self,
+        rays: &[Ray; LANES],
+        blocks: impl FnMut(usize, &Hit, bool) -> bool,
+    ) -> [bool; LANES] {
+        self.tree().any4(rays, blocks)
+    }
+
     /// [`Accel::intersect`] that also adds what the traversal did to `counts` (benchmarks;
     /// the plain query is a separate instantiation and counts nothing).
     pub fn intersect_counted(&self, ray: &Ray, counts: &mut Counts) -> Option<Hit> {

@@ -1,21 +1,23 @@
 //! Four rays through the tree together, for rays that travel side by side (a camera's
-//! neighbouring pixels): one walk of the tree fetches each node and leaf list once for all
-//! four, where four single walks fetch them four times.
+//! neighbouring pixels, and their shadow rays toward one light): one walk of the tree
+//! fetches each node and leaf list once for all four, where four single walks fetch them
+//! four times.
 //!
 //! Each lane sees exactly what its own single-ray walk would: the same cells in the same
 //! order over the same intervals, the same triangle tests against the same bounds, and the
-//! same questions to `accept`. At a node a lane goes to the first child, the second or both
-//! by the single walk's rule, with the single walk's intervals; the packet goes where any of
-//! its lanes goes and carries a mask of the lanes that go there. A waiting cell is skipped
-//! for a lane whose best hit is before it, as in the single walk. The four answers are
-//! therefore the single queries' answers, bit for bit. Rays whose directions differ in sign
-//! on some axis or in their dominant axis would want the children in different orders: they
-//! are traced one by one.
+//! same questions to the filter. At a node a lane goes to the first child, the second or
+//! both by the single walk's rule, with the single walk's intervals; the packet goes where
+//! any of its lanes goes and carries a mask of the lanes that go there. A closest-hit lane
+//! skips a waiting cell that starts beyond its best hit, an any-hit lane leaves the walk at
+//! its first blocker, as in the single walks. The four answers are therefore the single
+//! queries' answers, bit for bit. Rays whose directions differ in sign on some axis or in
+//! their dominant axis would want the children in different orders: they are traced one by
+//! one.
 
 use crate::traverse::{setup, Setup, Tree, STACK};
 use crate::triangle::PAD;
 use crate::Ray;
-use formats::Hit;
+use formats::{Hit, KdNode};
 use glam::Vec4;
 use std::mem::MaybeUninit;
 
@@ -37,6 +39,108 @@ fn lanes_of(mask: u8) -> impl Iterator<Item = usize> {
     (0..LANES).filter(move |l| mask >> l & 1 != 0)
 }
 
+/// Four rays' numbers for one walk: each lane's setup (a lane without one borrows the
+/// lead's and never becomes active), the lanes that have one, and, axis by axis, the
+/// origins and reciprocal directions, so that a node's four plane distances are one vector
+/// operation, and which child comes first.
+struct Packet {
+    s: [Setup; LANES],
+    live: u8,
+    o: [Vec4; 3],
+    inv: [Vec4; 3],
+    forward: [bool; 3],
+}
+
+impl Packet {
+    /// None when the rays would want the children in different orders (their directions
+    /// differ in sign on some axis or in their dominant axis) or fewer than two have a
+    /// setup: then each is traced alone. Some((None, 0)) inside: no ray meets the box.
+    fn new(rays: &[Ray; LANES], bounds: &crate::aabb::Aabb) -> Option<Option<Packet>> {
+        let setups = rays.each_ref().map(|r| setup(r, bounds));
+        let mut live = 0u8;
+        for (l, s) in setups.iter().enumerate() {
+            live |= (s.is_some() as u8) << l;
+        }
+        let Some(lead) = setups.iter().flatten().next().copied() else {
+            return Some(None);
+        };
+        let together = live.count_ones() > 1
+            && setups.iter().flatten().all(|s| {
+                s.pre.kz == lead.pre.kz && (0..3).all(|a| (s.inv[a] > 0.0) == (lead.inv[a] > 0.0))
+            });
+        if !together {
+            return None;
+        }
+        let s = setups.map(|s| s.unwrap_or(lead));
+        let axis = |f: fn(&Setup, usize) -> f32| -> [Vec4; 3] {
+            std::array::from_fn(|a| Vec4::from_array(s.each_ref().map(|s| f(s, a))))
+        };
+        Some(Some(Packet {
+            o: axis(|s, a| s.o[a]),
+            inv: axis(|s, a| s.inv[a]),
+            forward: [lead.inv[0] > 0.0, lead.inv[1] > 0.0, lead.inv[2] > 0.0],
+            s,
+            live,
+        }))
+    }
+
+    fn t0(&self) -> Vec4 {
+        Vec4::from_array(self.s.each_ref().map(|s| s.t0))
+    }
+
+    fn t1(&self) -> Vec4 {
+        Vec4::from_array(self.s.each_ref().map(|s| s.t1))
+    }
+}
+
+/// `traverse::take_step` in four lanes at once, the same operations on each lane's
+/// numbers: only the first child, only the second, or both, split at the plane. The packet
+/// goes where any of the lanes in `mask` goes, and a far child visited by some waits on
+/// the stack with their intervals.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn step4(
+    p: &Packet,
+    node: KdNode,
+    node_i: &mut u32,
+    mask: &mut u8,
+    t0: &mut Vec4,
+    t1: &mut Vec4,
+    stack: &mut [MaybeUninit<Waiting>; STACK],
+    sp: &mut usize,
+) {
+    let a = node.axis();
+    let (below, above) = (*node_i + 1, node.above_child());
+    let (first, second) = if p.forward[a] {
+        (below, above)
+    } else {
+        (above, below)
+    };
+    let tp = (Vec4::splat(node.split()) - p.o[a]) * p.inv[a];
+    let only_first = tp.cmpgt(up4(*t1));
+    let only_second = tp.cmplt(down4(*t0)) & !only_first;
+    let both = !(only_first | only_second);
+    let near = (!only_second).bitmask() as u8 & *mask;
+    let far = (!only_first).bitmask() as u8 & *mask;
+    // `near_end` and `far_start`: a NaN plane distance keeps the whole interval.
+    let near_t1 = Vec4::select(both & tp.cmple(*t1), tp, *t1);
+    let far_t0 = Vec4::select(both & tp.cmpge(*t0), tp, *t0);
+    if near == 0 {
+        (*node_i, *mask, *t0) = (second, far, far_t0);
+    } else {
+        if far != 0 {
+            stack[*sp] = MaybeUninit::new(Waiting {
+                node: second,
+                t0: far_t0,
+                t1: *t1,
+                lanes: far,
+            });
+            *sp += 1;
+        }
+        (*node_i, *mask, *t1) = (first, near, near_t1);
+    }
+}
+
 impl Tree<'_> {
     /// The closest hits of four rays: lane `l` is `closest(&rays[l], accept for l)`.
     /// `accept` is asked with the lane first.
@@ -46,29 +150,18 @@ impl Tree<'_> {
         rays: &[Ray; LANES],
         mut accept: F,
     ) -> [Option<Hit>; LANES] {
-        let setups = rays.each_ref().map(|r| setup(r, self.bounds));
-        let mut live = 0u8;
-        for (l, s) in setups.iter().enumerate() {
-            live |= (s.is_some() as u8) << l;
-        }
-        let Some(lead) = setups.iter().flatten().next().copied() else {
-            return [None; LANES];
-        };
-        let together = live.count_ones() > 1
-            && setups.iter().flatten().all(|s| {
-                s.pre.kz == lead.pre.kz && (0..3).all(|a| (s.inv[a] > 0.0) == (lead.inv[a] > 0.0))
-            });
-        if !together {
+        let Some(packet) = Packet::new(rays, self.bounds) else {
             return std::array::from_fn(|l| {
                 self.closest(&rays[l], |h, front| accept(l, h, front), &mut ())
             });
-        }
-        // A lane without a setup never becomes active; it borrows the lead's numbers.
-        let s = setups.map(|s| s.unwrap_or(lead));
-        match lead.pre.kz {
-            0 => self.closest4_along::<0, F>(rays, &s, live, &mut accept),
-            1 => self.closest4_along::<1, F>(rays, &s, live, &mut accept),
-            _ => self.closest4_along::<2, F>(rays, &s, live, &mut accept),
+        };
+        let Some(p) = packet else {
+            return [None; LANES];
+        };
+        match p.s[0].pre.kz {
+            0 => self.closest4_along::<0, F>(rays, &p, &mut accept),
+            1 => self.closest4_along::<1, F>(rays, &p, &mut accept),
+            _ => self.closest4_along::<2, F>(rays, &p, &mut accept),
         }
     }
 
@@ -76,8 +169,7 @@ impl Tree<'_> {
     fn closest4_along<const KZ: usize, F: FnMut(usize, &Hit, bool) -> bool>(
         &self,
         rays: &[Ray; LANES],
-        s: &[Setup; LANES],
-        live: u8,
+        p: &Packet,
         accept: &mut F,
     ) -> [Option<Hit>; LANES] {
         let mut best = [Hit::MISS; LANES];
@@ -85,59 +177,27 @@ impl Tree<'_> {
         let mut best_t = rays.each_ref().map(|r| r.tmax);
         let mut stack = [MaybeUninit::<Waiting>::uninit(); STACK];
         let mut sp = 0;
-        let (mut node_i, mut mask) = (0u32, live);
-        let mut t0 = Vec4::from_array(s.each_ref().map(|s| s.t0));
-        let mut t1 = Vec4::from_array(s.each_ref().map(|s| s.t1));
-        // The lanes share the direction's signs, so the children's order.
-        let lead = &s[live.trailing_zeros() as usize];
-        let forward = [lead.inv[0] > 0.0, lead.inv[1] > 0.0, lead.inv[2] > 0.0];
-        // Origins and reciprocal directions axis by axis, so a node's four plane distances
-        // are one vector operation.
-        let o: [Vec4; 3] = std::array::from_fn(|a| Vec4::from_array(s.each_ref().map(|s| s.o[a])));
-        let inv: [Vec4; 3] =
-            std::array::from_fn(|a| Vec4::from_array(s.each_ref().map(|s| s.inv[a])));
+        let (mut node_i, mut mask, mut t0, mut t1) = (0u32, p.live, p.t0(), p.t1());
         loop {
             let node = self.node(node_i);
             if !node.is_leaf() {
-                let a = node.axis();
-                let (below, above) = (node_i + 1, node.above_child());
-                let (first, second) = if forward[a] {
-                    (below, above)
-                } else {
-                    (above, below)
-                };
-                // `traverse::step` in four lanes at once, the same operations on each lane's
-                // numbers: only the first child, only the second, or both, split at the plane.
-                let tp = (Vec4::splat(node.split()) - o[a]) * inv[a];
-                let only_first = tp.cmpgt(up4(t1));
-                let only_second = tp.cmplt(down4(t0)) & !only_first;
-                let both = !(only_first | only_second);
-                let near = (!only_second).bitmask() as u8 & mask;
-                let far = (!only_first).bitmask() as u8 & mask;
-                // `near_end` and `far_start`: a NaN plane distance keeps the whole interval.
-                let near_t1 = Vec4::select(both & tp.cmple(t1), tp, t1);
-                let far_t0 = Vec4::select(both & tp.cmpge(t0), tp, t0);
-                if near == 0 {
-                    (node_i, mask, t0) = (second, far, far_t0);
-                } else {
-                    if far != 0 {
-                        stack[sp] = MaybeUninit::new(Waiting {
-                            node: second,
-                            t0: far_t0,
-                            t1,
-                            lanes: far,
-                        });
-                        sp += 1;
-                    }
-                    (node_i, mask, t1) = (first, near, near_t1);
-                }
+                step4(
+                    p,
+                    node,
+                    &mut node_i,
+                    &mut mask,
+                    &mut t0,
+                    &mut t1,
+                    &mut stack,
+                    &mut sp,
+                );
                 continue;
             }
             let leaf = self.leaf(node);
             for l in lanes_of(mask) {
                 let mut accept_l = |h: &Hit, front: bool| accept(l, h, front);
                 self.leaf_closest::<KZ, _>(
-                    &s[l],
+                    &p.s[l],
                     &rays[l],
                     leaf,
                     &mut best[l],
@@ -156,6 +216,82 @@ impl Tree<'_> {
                 let ahead = Vec4::from_array(best_t).cmpge(down4(w.t0)).bitmask() as u8;
                 if w.lanes & ahead != 0 {
                     (node_i, mask, t0, t1) = (w.node, w.lanes & ahead, w.t0, w.t1);
+                    break;
+                }
+            }
+        }
+    }
+
+    /// Whether each of four rays is blocked: lane `l` is `any(&rays[l], blocks for l)`,
+    /// `blocks` asked with the lane first. A lane leaves the walk at its first blocker.
+    #[inline(always)]
+    pub fn any4<F: FnMut(usize, &Hit, bool) -> bool>(
+        &self,
+        rays: &[Ray; LANES],
+        mut blocks: F,
+    ) -> [bool; LANES] {
+        let Some(packet) = Packet::new(rays, self.bounds) else {
+            return std::array::from_fn(|l| {
+                self.any(&rays[l], |h, front| blocks(l, h, front), &mut ())
+            });
+        };
+        let Some(p) = packet else {
+            return [false; LANES];
+        };
+        let blocked = match p.s[0].pre.kz {
+            0 => self.any4_along::<0, F>(rays, &p, &mut blocks),
+            1 => self.any4_along::<1, F>(rays, &p, &mut blocks),
+            _ => self.any4_along::<2, F>(rays, &p, &mut blocks),
+        };
+        std::array::from_fn(|l| blocked >> l & 1 != 0)
+    }
+
+    /// The lanes blocked, as a mask.
+    #[inline(always)]
+    fn any4_along<const KZ: usize, F: FnMut(usize, &Hit, bool) -> bool>(
+        &self,
+        rays: &[Ray; LANES],
+        p: &Packet,
+        blocks: &mut F,
+    ) -> u8 {
+        let mut blocked = 0u8;
+        let mut stack = [MaybeUninit::<Waiting>::uninit(); STACK];
+        let mut sp = 0;
+        let (mut node_i, mut mask, mut t0, mut t1) = (0u32, p.live, p.t0(), p.t1());
+        loop {
+            let node = self.node(node_i);
+            if !node.is_leaf() {
+                step4(
+                    p,
+                    node,
+                    &mut node_i,
+                    &mut mask,
+                    &mut t0,
+                    &mut t1,
+                    &mut stack,
+                    &mut sp,
+                );
+                continue;
+            }
+            let leaf = self.leaf(node);
+            for l in lanes_of(mask) {
+                let mut blocks_l = |h: &Hit, front: bool| blocks(l, h, front);
+                if self.leaf_any::<KZ, _>(&p.s[l], &rays[l], leaf, &mut blocks_l) {
+                    blocked |= 1 << l;
+                }
+            }
+            if blocked == p.live {
+                return blocked;
+            }
+            loop {
+                if sp == 0 {
+                    return blocked;
+                }
+                sp -= 1;
+                // SAFETY: as in `closest4_along`.
+                let w = unsafe { stack[sp].assume_init() };
+                if w.lanes & !blocked != 0 {
+                    (node_i, mask, t0, t1) = (w.node, w.lanes & !blocked, w.t0, w.t1);
                     break;
                 }
             }

@@ -487,24 +487,8 @@ impl Tree<'_> {
             }
             let leaf = self.leaf(node);
             count.leaf(leaf.len());
-            if leaf.len() >= 2 {
-                for group in leaf.chunks(4) {
-                    let (lanes, hits) = self.test4::<KZ>(s, ray, group, ray.tmax);
-                    for l in hits.hit_lanes() {
-                        let h = hits.raw(l);
-                        if blocks(&candidate(self.soup_index(lanes[l]), h), h.front) {
-                            return true;
-                        }
-                    }
-                }
-            } else {
-                for &p in leaf {
-                    if let Some(h) = test::<KZ>(s, ray, self.tri(p), ray.tmax) {
-                        if blocks(&candidate(self.soup_index(p), h), h.front) {
-                            return true;
-                        }
-                    }
-                }
+            if self.leaf_any::<KZ, F>(s, ray, leaf, blocks) {
+                return true;
             }
             if sp == 0 {
                 return false;
@@ -512,6 +496,40 @@ impl Tree<'_> {
             sp -= 1;
             (node_i, t0, t1) = pop(&stack, sp);
         }
+    }
+}
+
+impl Tree<'_> {
+    /// A leaf's triangles for an any-hit walk: whether `blocks` takes one of its hits,
+    /// asked in the leaf's order.
+    #[inline(always)]
+    pub(crate) fn leaf_any<const KZ: usize, F: FnMut(&Hit, bool) -> bool>(
+        &self,
+        s: &Setup,
+        ray: &Ray,
+        leaf: &[u32],
+        blocks: &mut F,
+    ) -> bool {
+        if leaf.len() >= 2 {
+            for group in leaf.chunks(4) {
+                let (lanes, hits) = self.test4::<KZ>(s, ray, group, ray.tmax);
+                for l in hits.hit_lanes() {
+                    let h = hits.raw(l);
+                    if blocks(&candidate(self.soup_index(lanes[l]), h), h.front) {
+                        return true;
+                    }
+                }
+            }
+        } else {
+            for &p in leaf {
+                if let Some(h) = test::<KZ>(s, ray, self.tri(p), ray.tmax) {
+                    if blocks(&candidate(self.soup_index(p), h), h.front) {
+                        return true;
+                    }
+                }
+            }
+        }
+        false
     }
 }
 

@@ -1,5 +1,5 @@
 //! Four rays traced together give each ray the answer it gets alone, bit for bit, and ask
-//! the filter the same questions in the same order.
+//! the filter the same questions in the same order: closest hits and any hits.
 
 use formats::{BuildParams, Hit};
 use glam::Vec3;
@@ -11,8 +11,10 @@ type Asked = Vec<(u32, u32, bool)>;
 
 /// Lane by lane, `intersect4` against `intersect` and `intersect4_filtered` against
 /// `intersect_filtered` (refusing every third triangle and the back of every fifth), with
-/// the filter's questions recorded on both sides. Returns how many lanes hit.
+/// the filter's questions recorded on both sides, and the same for `occluded4` and
+/// `occluded4_filtered`. Returns how many lanes hit.
 fn check(accel: &Accel, rays: &[Ray; LANES]) -> usize {
+    check_any(accel, rays);
     let got = accel.intersect4(rays);
     let keep =
         |h: &Hit, front: bool| !h.prim.is_multiple_of(3) && (front || !h.prim.is_multiple_of(5));
@@ -35,6 +37,38 @@ fn check(accel: &Accel, rays: &[Ray; LANES]) -> usize {
         assert_eq!(asked4[l], asked, "filter questions, lane {l} of {rays:?}");
     }
     hits
+}
+
+/// Returns how many lanes are blocked.
+fn check_any(accel: &Accel, rays: &[Ray; LANES]) -> usize {
+    let got = accel.occluded4(rays);
+    let blocks =
+        |h: &Hit, front: bool| !h.prim.is_multiple_of(3) && (front || !h.prim.is_multiple_of(5));
+    let mut asked4: [Asked; LANES] = Default::default();
+    let got_filtered = accel.occluded4_filtered(rays, |l, h, front| {
+        asked4[l].push((h.prim, h.t.to_bits(), front));
+        blocks(h, front)
+    });
+    let mut blocked = 0;
+    for (l, ray) in rays.iter().enumerate() {
+        let want = accel.occluded(ray);
+        assert_eq!(got[l], want, "any hit, lane {l} of {rays:?}");
+        blocked += want as usize;
+        let mut asked = Asked::new();
+        let want = accel.occluded_filtered(ray, |h, front| {
+            asked.push((h.prim, h.t.to_bits(), front));
+            blocks(h, front)
+        });
+        assert_eq!(
+            got_filtered[l], want,
+            "filtered any hit, lane {l} of {rays:?}"
+        );
+        assert_eq!(
+            asked4[l], asked,
+            "any-hit filter questions, lane {l} of {rays:?}"
+        );
+    }
+    blocked
 }
 
 fn scene() -> Vec<[Vec3; 3]> {
@@ -138,4 +172,53 @@ fn hard_lanes_and_mixed_packets_get_their_single_answers() {
         hits += check(&accel, &rays);
     }
     assert!(hits > 1000, "{hits} lanes hit");
+}
+
+/// Shadow rays as a renderer forms them: from the surface points that a 2×2 block of camera
+/// rays hits, just off the surface, toward a point light, stopping short of it.
+#[test]
+fn shadow_rays_of_neighbouring_pixels_get_their_single_answers() {
+    let tris = scene();
+    let accel = Accel::build(&tris, &BuildParams::default());
+    let mut rng = Rng(7);
+    let (mut blocked, mut lanes) = (0, 0);
+    for _ in 0..8 {
+        let eye = Vec3::new(
+            rng.range(-6.0, 6.0),
+            rng.range(1.0, 5.0),
+            rng.range(-6.0, 6.0),
+        );
+        let light = Vec3::new(
+            rng.range(-3.0, 3.0),
+            rng.range(3.0, 6.0),
+            rng.range(-3.0, 3.0),
+        );
+        let forward = (Vec3::new(0.0, 0.8, 0.0) - eye).normalize();
+        let right = forward.cross(Vec3::Y).normalize();
+        let up = right.cross(forward);
+        let n = 40;
+        for py in (0..n).step_by(2) {
+            for px in (0..n).step_by(2) {
+                let shadow: [Ray; LANES] = std::array::from_fn(|l| {
+                    let (x, y) = ((px + l % 2) as f32, (py + l / 2) as f32);
+                    let sx = (x + 0.5) / n as f32 * 2.0 - 1.0;
+                    let sy = 1.0 - (y + 0.5) / n as f32 * 2.0;
+                    let dir = (forward + 0.7 * (sx * right + sy * up)).normalize();
+                    // A miss leaves from far along the ray, toward the light all the same.
+                    let t = accel
+                        .intersect(&Ray::new(eye, dir, 0.0, f32::INFINITY))
+                        .map_or(20.0, |h| h.t);
+                    let p = eye + dir * (t * (1.0 - 1e-4));
+                    let to = light - p;
+                    Ray::new(p, to / to.length(), 1e-4, to.length() * 0.999)
+                });
+                blocked += check_any(&accel, &shadow);
+                lanes += LANES;
+            }
+        }
+    }
+    assert!(
+        blocked > lanes / 10 && blocked < lanes * 9 / 10,
+        "{blocked} of {lanes} shadow rays blocked"
+    );
 }
