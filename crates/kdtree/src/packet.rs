@@ -55,6 +55,7 @@ impl Packet {
     /// None when the rays would want the children in different orders (their directions
     /// differ in sign on some axis or in their dominant axis) or fewer than two have a
     /// setup: then each is traced alone. Some((None, 0)) inside: no ray meets the box.
+    #[inline(always)]
     fn new(rays: &[Ray; LANES], bounds: &crate::aabb::Aabb) -> Option<Option<Packet>> {
         let setups = rays.each_ref().map(|r| setup(r, bounds));
         let mut live = 0u8;
@@ -84,10 +85,12 @@ impl Packet {
         }))
     }
 
+    #[inline(always)]
     fn t0(&self) -> Vec4 {
         Vec4::from_array(self.s.each_ref().map(|s| s.t0))
     }
 
+    #[inline(always)]
     fn t1(&self) -> Vec4 {
         Vec4::from_array(self.s.each_ref().map(|s| s.t1))
     }
