@@ -51,38 +51,48 @@ struct Packet {
     forward: [bool; 3],
 }
 
+/// How four rays go through the tree. Built and taken apart within one query, on the
+/// stack: boxing the large variant would allocate per packet.
+#[allow(clippy::large_enum_variant)]
+enum Walk {
+    /// As one packet.
+    Together(Packet),
+    /// One by one: their directions differ in sign on some axis or in their dominant axis,
+    /// so they would want the children in different orders, or only one meets the tree.
+    Alone,
+    /// Not at all: none meets the tree's box with a usable direction and interval.
+    Nowhere,
+}
+
 impl Packet {
-    /// None when the rays would want the children in different orders (their directions
-    /// differ in sign on some axis or in their dominant axis) or fewer than two have a
-    /// setup: then each is traced alone. Some((None, 0)) inside: no ray meets the box.
     #[inline(always)]
-    fn new(rays: &[Ray; LANES], bounds: &crate::aabb::Aabb) -> Option<Option<Packet>> {
+    fn walk(rays: &[Ray; LANES], bounds: &crate::aabb::Aabb) -> Walk {
         let setups = rays.each_ref().map(|r| setup(r, bounds));
         let mut live = 0u8;
         for (l, s) in setups.iter().enumerate() {
             live |= (s.is_some() as u8) << l;
         }
         let Some(lead) = setups.iter().flatten().next().copied() else {
-            return Some(None);
+            return Walk::Nowhere;
         };
         let together = live.count_ones() > 1
             && setups.iter().flatten().all(|s| {
                 s.pre.kz == lead.pre.kz && (0..3).all(|a| (s.inv[a] > 0.0) == (lead.inv[a] > 0.0))
             });
         if !together {
-            return None;
+            return Walk::Alone;
         }
         let s = setups.map(|s| s.unwrap_or(lead));
         let axis = |f: fn(&Setup, usize) -> f32| -> [Vec4; 3] {
             std::array::from_fn(|a| Vec4::from_array(s.each_ref().map(|s| f(s, a))))
         };
-        Some(Some(Packet {
+        Walk::Together(Packet {
             o: axis(|s, a| s.o[a]),
             inv: axis(|s, a| s.inv[a]),
             forward: [lead.inv[0] > 0.0, lead.inv[1] > 0.0, lead.inv[2] > 0.0],
             s,
             live,
-        }))
+        })
     }
 
     #[inline(always)]
@@ -153,13 +163,14 @@ impl Tree<'_> {
         rays: &[Ray; LANES],
         mut accept: F,
     ) -> [Option<Hit>; LANES] {
-        let Some(packet) = Packet::new(rays, self.bounds) else {
-            return std::array::from_fn(|l| {
-                self.closest(&rays[l], |h, front| accept(l, h, front), &mut ())
-            });
-        };
-        let Some(p) = packet else {
-            return [None; LANES];
+        let p = match Packet::walk(rays, self.bounds) {
+            Walk::Together(p) => p,
+            Walk::Alone => {
+                return std::array::from_fn(|l| {
+                    self.closest(&rays[l], |h, front| accept(l, h, front), &mut ())
+                })
+            }
+            Walk::Nowhere => return [None; LANES],
         };
         match p.s[0].pre.kz {
             0 => self.closest4_along::<0, F>(rays, &p, &mut accept),
@@ -233,13 +244,14 @@ impl Tree<'_> {
         rays: &[Ray; LANES],
         mut blocks: F,
     ) -> [bool; LANES] {
-        let Some(packet) = Packet::new(rays, self.bounds) else {
-            return std::array::from_fn(|l| {
-                self.any(&rays[l], |h, front| blocks(l, h, front), &mut ())
-            });
-        };
-        let Some(p) = packet else {
-            return [false; LANES];
+        let p = match Packet::walk(rays, self.bounds) {
+            Walk::Together(p) => p,
+            Walk::Alone => {
+                return std::array::from_fn(|l| {
+                    self.any(&rays[l], |h, front| blocks(l, h, front), &mut ())
+                })
+            }
+            Walk::Nowhere => return [false; LANES],
         };
         let blocked = match p.s[0].pre.kz {
             0 => self.any4_along::<0, F>(rays, &p, &mut blocks),
