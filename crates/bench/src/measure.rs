@@ -78,6 +78,24 @@ where
     out
 }
 
+/// [`trace`] four rays per call: `four` on each run of four consecutive rays, `one` on the
+/// one to three left at the end. Answers in ray order.
+pub fn trace4<R, T>(
+    pool: &rayon::ThreadPool,
+    rays: &[R],
+    four: impl Fn(&[R; 4]) -> [T; 4] + Sync,
+    one: impl Fn(&R) -> T,
+) -> Vec<T>
+where
+    R: Sync,
+    T: Send + Copy + Default,
+{
+    let (packets, rest) = rays.as_chunks::<4>();
+    let mut out: Vec<T> = trace(pool, packets, four).into_iter().flatten().collect();
+    out.extend(rest.iter().map(one));
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

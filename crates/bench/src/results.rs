@@ -47,10 +47,6 @@ impl Kind {
             Kind::SurfaceHemisphereAny => "surface→hemisphere any",
         }
     }
-    /// Traced four rays per query.
-    pub fn packets(self) -> bool {
-        matches!(self, Kind::PrimaryPackets | Kind::ShadowPackets)
-    }
     /// Traced as any-hit (occlusion) queries rather than closest hits.
     pub fn any_hit(self) -> bool {
         matches!(

@@ -9,7 +9,7 @@ use crate::contenders::EMBREE;
 use crate::contenders::{Brute, Tracer, BRUTE, KDTREE, MEDIAN};
 use crate::error::BenchError;
 use crate::header::{header, load_average};
-use crate::measure::{median, pool, process_cpu_seconds, timed, trace};
+use crate::measure::{median, pool, process_cpu_seconds, timed, trace, trace4};
 use crate::rays::{self, View};
 use crate::results::{BuildRow, Kind, Report, Role, SceneResult, TraceRow, WorkRow};
 use crate::scenes::{self, Scene};
@@ -40,23 +40,22 @@ impl Bench<'_> {
             for _ in 0..self.cfg.runs.max(1) {
                 for (c, (_, tracer)) in who.iter().enumerate() {
                     let start = Instant::now();
-                    let (packets, rest) = rays.as_chunks::<4>();
                     let a = if kind == Kind::ShadowPackets {
-                        let mut blocked: Vec<_> = trace(pool, packets, |p| tracer.occluded4(p))
-                            .into_iter()
-                            .flatten()
-                            .collect();
-                        blocked.extend(rest.iter().map(|r| tracer.occluded(r)));
-                        Answers::Occluded(blocked)
+                        Answers::Occluded(trace4(
+                            pool,
+                            rays,
+                            |p| tracer.occluded4(p),
+                            |r| tracer.occluded(r),
+                        ))
                     } else if kind.any_hit() {
                         Answers::Occluded(trace(pool, rays, |r| tracer.occluded(r)))
                     } else if kind == Kind::PrimaryPackets {
-                        let mut found: Vec<_> = trace(pool, packets, |p| tracer.closest4(p))
-                            .into_iter()
-                            .flatten()
-                            .collect();
-                        found.extend(rest.iter().map(|r| tracer.closest(r)));
-                        Answers::Closest(found)
+                        Answers::Closest(trace4(
+                            pool,
+                            rays,
+                            |p| tracer.closest4(p),
+                            |r| tracer.closest(r),
+                        ))
                     } else {
                         Answers::Closest(trace(pool, rays, |r| tracer.closest(r)))
                     };

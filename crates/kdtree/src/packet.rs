@@ -155,6 +155,29 @@ fn step4(
 }
 
 impl Tree<'_> {
+    /// Steps from node `node_i` down to the leaf the packet reaches first, pushing the far
+    /// children it passes; returns that leaf.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn to_leaf(
+        &self,
+        p: &Packet,
+        node_i: &mut u32,
+        mask: &mut u8,
+        t0: &mut Vec4,
+        t1: &mut Vec4,
+        stack: &mut [MaybeUninit<Waiting>; STACK],
+        sp: &mut usize,
+    ) -> &[u32] {
+        loop {
+            let node = self.node(*node_i);
+            if node.is_leaf() {
+                return self.leaf(node);
+            }
+            step4(p, node, node_i, mask, t0, t1, stack, sp);
+        }
+    }
+
     /// The closest hits of four rays: lane `l` is `closest(&rays[l], accept for l)`.
     /// `accept` is asked with the lane first.
     #[inline(always)]
@@ -193,21 +216,15 @@ impl Tree<'_> {
         let mut sp = 0;
         let (mut node_i, mut mask, mut t0, mut t1) = (0u32, p.live, p.t0(), p.t1());
         loop {
-            let node = self.node(node_i);
-            if !node.is_leaf() {
-                step4(
-                    p,
-                    node,
-                    &mut node_i,
-                    &mut mask,
-                    &mut t0,
-                    &mut t1,
-                    &mut stack,
-                    &mut sp,
-                );
-                continue;
-            }
-            let leaf = self.leaf(node);
+            let leaf = self.to_leaf(
+                p,
+                &mut node_i,
+                &mut mask,
+                &mut t0,
+                &mut t1,
+                &mut stack,
+                &mut sp,
+            );
             for l in lanes_of(mask) {
                 let mut accept_l = |h: &Hit, front: bool| accept(l, h, front);
                 self.leaf_closest::<KZ, _>(
@@ -274,21 +291,15 @@ impl Tree<'_> {
         let mut sp = 0;
         let (mut node_i, mut mask, mut t0, mut t1) = (0u32, p.live, p.t0(), p.t1());
         loop {
-            let node = self.node(node_i);
-            if !node.is_leaf() {
-                step4(
-                    p,
-                    node,
-                    &mut node_i,
-                    &mut mask,
-                    &mut t0,
-                    &mut t1,
-                    &mut stack,
-                    &mut sp,
-                );
-                continue;
-            }
-            let leaf = self.leaf(node);
+            let leaf = self.to_leaf(
+                p,
+                &mut node_i,
+                &mut mask,
+                &mut t0,
+                &mut t1,
+                &mut stack,
+                &mut sp,
+            );
             for l in lanes_of(mask) {
                 let mut blocks_l = |h: &Hit, front: bool| blocks(l, h, front);
                 if self.leaf_any::<KZ, _>(&p.s[l], &rays[l], leaf, &mut blocks_l) {

@@ -91,6 +91,22 @@ fn scene() -> Vec<[Vec3; 3]> {
     tris
 }
 
+/// A camera at `eye` looking at the sphere's centre: its forward, right and up axes.
+fn looking_at_scene(eye: Vec3) -> [Vec3; 3] {
+    let forward = (Vec3::new(0.0, 0.8, 0.0) - eye).normalize();
+    let right = forward.cross(Vec3::Y).normalize();
+    [forward, right, right.cross(forward)]
+}
+
+/// The direction (not unit) through the centre of lane `l`'s pixel of the 2×2 block at
+/// (`px`, `py`) of an `n`×`n` image (lanes row by row).
+fn pixel_dir([forward, right, up]: [Vec3; 3], n: u32, px: u32, py: u32, l: usize) -> Vec3 {
+    let (x, y) = ((px + l as u32 % 2) as f32, (py + l as u32 / 2) as f32);
+    let sx = (x + 0.5) / n as f32 * 2.0 - 1.0;
+    let sy = 1.0 - (y + 0.5) / n as f32 * 2.0;
+    forward + 0.7 * (sx * right + sy * up)
+}
+
 /// Camera rays of 2×2 pixel blocks (the packets a renderer forms), from several viewpoints,
 /// some with the lanes' intervals cut differently.
 #[test]
@@ -105,17 +121,12 @@ fn neighbouring_camera_rays_get_their_single_answers() {
             rng.range(0.5, 5.0),
             rng.range(-6.0, 6.0),
         );
-        let forward = (Vec3::new(0.0, 0.8, 0.0) - eye).normalize();
-        let right = forward.cross(Vec3::Y).normalize();
-        let up = right.cross(forward);
+        let axes = looking_at_scene(eye);
         let n = 48;
         for py in (0..n).step_by(2) {
             for px in (0..n).step_by(2) {
                 let rays: [Ray; LANES] = std::array::from_fn(|l| {
-                    let (x, y) = ((px + l % 2) as f32, (py + l / 2) as f32);
-                    let sx = (x + 0.5) / n as f32 * 2.0 - 1.0;
-                    let sy = 1.0 - (y + 0.5) / n as f32 * 2.0;
-                    let dir = forward + 0.7 * (sx * right + sy * up);
+                    let dir = pixel_dir(axes, n, px, py, l);
                     let (tmin, tmax) = match (view + l) % 4 {
                         0 => (0.0, f32::INFINITY),
                         1 => (0.0, rng.range(2.0, 9.0)),
@@ -193,17 +204,12 @@ fn shadow_rays_of_neighbouring_pixels_get_their_single_answers() {
             rng.range(3.0, 6.0),
             rng.range(-3.0, 3.0),
         );
-        let forward = (Vec3::new(0.0, 0.8, 0.0) - eye).normalize();
-        let right = forward.cross(Vec3::Y).normalize();
-        let up = right.cross(forward);
+        let axes = looking_at_scene(eye);
         let n = 40;
         for py in (0..n).step_by(2) {
             for px in (0..n).step_by(2) {
                 let shadow: [Ray; LANES] = std::array::from_fn(|l| {
-                    let (x, y) = ((px + l % 2) as f32, (py + l / 2) as f32);
-                    let sx = (x + 0.5) / n as f32 * 2.0 - 1.0;
-                    let sy = 1.0 - (y + 0.5) / n as f32 * 2.0;
-                    let dir = (forward + 0.7 * (sx * right + sy * up)).normalize();
+                    let dir = pixel_dir(axes, n, px, py, l).normalize();
                     // A miss leaves from far along the ray, toward the light all the same.
                     let t = accel
                         .intersect(&Ray::new(eye, dir, 0.0, f32::INFINITY))
