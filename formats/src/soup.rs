@@ -1,5 +1,7 @@
 //! The triangle soup: world-space geometry plus everything the renderer needs from the
-//! scene. Right-handed, Y up, metres: Unity's left-handed positions with X negated, so an
+//! scene. Triangles index shared vertices, as the meshes they come from do: a closed mesh
+//! has about half as many vertices as triangles, so this is a third of the bytes of three
+//! corners per triangle to write, hash, read and keep in memory. Right-handed, Y up, metres: Unity's left-handed positions with X negated, so an
 //! OBJ placed at the identity in Unity keeps its file's coordinates. Colours are linear RGB.
 
 use crate::texture::{Texture, TextureRef};
@@ -9,18 +11,20 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 pub const MAGIC: &[u8; 8] = b"UTSOUP\0\0";
-pub const VERSION: u32 = 3;
+pub const VERSION: u32 = 4;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Soup {
-    /// Three world-space vertices per triangle, counter-clockwise seen from the front.
-    pub triangles: Vec<[Vec3; 3]>,
-    /// Per-vertex shading normals (unit length), parallel to `triangles`.
-    pub normals: Vec<[Vec3; 3]>,
-    /// Per-vertex texture coordinates (the mesh's first UV channel, Unity's convention:
-    /// (0, 0) is the image's bottom-left), parallel to `triangles` when any material has a
+    /// World-space vertex positions.
+    pub positions: Vec<Vec3>,
+    /// Unit shading normal of each vertex, parallel to `positions`.
+    pub normals: Vec<Vec3>,
+    /// Texture coordinates of each vertex (the mesh's first UV channel, Unity's convention:
+    /// (0, 0) is the image's bottom-left), parallel to `positions` when any material has a
     /// texture, empty otherwise; (0, 0) where a mesh has none.
-    pub uvs: Vec<[Vec2; 3]>,
+    pub uvs: Vec<Vec2>,
+    /// Three indices into `positions` per triangle, counter-clockwise seen from the front.
+    pub triangles: Vec<[u32; 3]>,
     /// Index into `materials`, one per triangle.
     pub tri_material: Vec<u32>,
     /// Index into `objects`, one per triangle.
@@ -36,7 +40,7 @@ pub struct Soup {
     pub warnings: Vec<String>,
     /// Degenerate triangles (zero area, repeated or collinear vertices) dropped.
     pub dropped_degenerate: u64,
-    /// BLAKE3 of the positions in soup order (see [`geometry_hash`]).
+    /// BLAKE3 of the positions and triangles (see [`indexed_geometry_hash`]).
     pub geometry_hash: Digest,
 }
 
@@ -329,31 +333,40 @@ impl Default for Environment {
     }
 }
 
-/// BLAKE3 of the triangle positions in soup order, each coordinate as f32 little-endian.
-pub fn geometry_hash(triangles: &[[Vec3; 3]]) -> Digest {
+/// BLAKE3 of an indexed geometry: the positions, each coordinate as f32 little-endian, then
+/// the triangles' indices as u32 little-endian. It names the soup's k-d tree in the cache.
+pub fn indexed_geometry_hash(positions: &[Vec3], triangles: &[[u32; 3]]) -> Digest {
     let mut h = blake3::Hasher::new();
-    hash_positions(&mut h, triangles);
+    hash_le(&mut h, positions);
+    hash_le(&mut h, triangles);
     *h.finalize().as_bytes()
 }
 
-/// On a little-endian machine the positions in memory are the hashed bytes themselves, so
-/// two million triangles (75 MB) are hashed in place on all cores.
-#[cfg(target_endian = "little")]
-fn hash_positions(h: &mut blake3::Hasher, triangles: &[[Vec3; 3]]) {
-    envelope::hash_into(h, bytemuck::cast_slice(triangles));
+/// The geometry hash of bare triangles: that of a soup that gives each triangle three
+/// vertices of its own, in order (what [`Soup::push_triangle`] builds).
+pub fn geometry_hash(triangles: &[[Vec3; 3]]) -> Digest {
+    let indices: Vec<[u32; 3]> = (0..triangles.len() as u32)
+        .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+        .collect();
+    indexed_geometry_hash(bytemuck::cast_slice(triangles), &indices)
 }
 
+/// On a little-endian machine the arrays in memory are the hashed bytes themselves, so a
+/// soup's 50 MB of geometry (two million triangles) is hashed in place on all cores.
+#[cfg(target_endian = "little")]
+fn hash_le<T: bytemuck::Pod>(h: &mut blake3::Hasher, items: &[T]) {
+    envelope::hash_into(h, bytemuck::cast_slice(items));
+}
+
+/// Elsewhere each 4-byte number (both arrays are made of them) is swapped first.
 #[cfg(not(target_endian = "little"))]
-fn hash_positions(h: &mut blake3::Hasher, triangles: &[[Vec3; 3]]) {
-    let mut buf = Vec::with_capacity(36 * 4096);
-    for chunk in triangles.chunks(4096) {
+fn hash_le<T: bytemuck::Pod>(h: &mut blake3::Hasher, items: &[T]) {
+    let words: &[u32] = bytemuck::cast_slice(items);
+    let mut buf = Vec::with_capacity(4 * 4096);
+    for chunk in words.chunks(4096) {
         buf.clear();
-        for t in chunk {
-            for v in t {
-                for c in v.to_array() {
-                    buf.extend_from_slice(&c.to_le_bytes());
-                }
-            }
+        for w in chunk {
+            buf.extend_from_slice(&w.to_le_bytes());
         }
         h.update(&buf);
     }
@@ -363,9 +376,10 @@ impl Soup {
     /// An empty soup with Unity's default camera and a black environment.
     pub fn empty() -> Self {
         Soup {
-            triangles: vec![],
+            positions: vec![],
             normals: vec![],
             uvs: vec![],
+            triangles: vec![],
             tri_material: vec![],
             tri_object: vec![],
             objects: vec![],
@@ -380,20 +394,90 @@ impl Soup {
         }
     }
 
-    /// Recompute `geometry_hash` from the triangles (call after changing geometry).
+    /// Recompute `geometry_hash` from the geometry (call after changing it).
     pub fn seal(&mut self) {
-        self.geometry_hash = geometry_hash(&self.triangles);
+        self.geometry_hash = indexed_geometry_hash(&self.positions, &self.triangles);
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// The positions of triangle `t`'s corners.
+    #[inline]
+    pub fn corners(&self, t: usize) -> [Vec3; 3] {
+        self.triangles[t].map(|v| self.positions[v as usize])
+    }
+
+    /// The shading normals at triangle `t`'s corners.
+    #[inline]
+    pub fn corner_normals(&self, t: usize) -> [Vec3; 3] {
+        self.triangles[t].map(|v| self.normals[v as usize])
+    }
+
+    /// The texture coordinates at triangle `t`'s corners; (0, 0) in a soup without UVs.
+    #[inline]
+    pub fn corner_uvs(&self, t: usize) -> [Vec2; 3] {
+        if self.uvs.is_empty() {
+            return [Vec2::ZERO; 3];
+        }
+        self.triangles[t].map(|v| self.uvs[v as usize])
+    }
+
+    /// Every triangle's corners, in soup order: what the k-d tree is built from.
+    pub fn triangle_positions(&self) -> Vec<[Vec3; 3]> {
+        use rayon::prelude::*;
+        self.triangles
+            .par_iter()
+            .with_min_len(1 << 14)
+            .map(|t| t.map(|v| self.positions[v as usize]))
+            .collect()
+    }
+
+    /// Append a triangle with three vertices of its own, and its UVs when the soup has
+    /// them (`uvs` is ignored otherwise, and (0, 0) is stored when it is `None`). The
+    /// caller appends its material and object.
+    pub fn push_triangle(
+        &mut self,
+        corners: [Vec3; 3],
+        normals: [Vec3; 3],
+        uvs: Option<[Vec2; 3]>,
+    ) {
+        let first = self.positions.len() as u32;
+        let with_uvs = uvs.is_some() || !self.uvs.is_empty();
+        if with_uvs && self.uvs.len() < self.positions.len() {
+            self.uvs.resize(self.positions.len(), Vec2::ZERO);
+        }
+        self.positions.extend(corners);
+        self.normals.extend(normals);
+        if with_uvs {
+            self.uvs.extend(uvs.unwrap_or([Vec2::ZERO; 3]));
+        }
+        self.triangles.push([first, first + 1, first + 2]);
     }
 
     /// Check the cross-references a reader relies on, naming the first bad one.
     pub fn validate(&self) -> Result<(), String> {
         let n = self.triangles.len();
-        if self.normals.len() != n || self.tri_material.len() != n || self.tri_object.len() != n {
+        let v = self.positions.len();
+        if self.normals.len() != v {
+            return Err(format!("{v} vertices but {} normals", self.normals.len()));
+        }
+        if self.tri_material.len() != n || self.tri_object.len() != n {
             return Err(format!(
-                "{n} triangles but {} normals, {} material indices, {} object indices",
-                self.normals.len(),
+                "{n} triangles but {} material indices, {} object indices",
                 self.tri_material.len(),
                 self.tri_object.len()
+            ));
+        }
+        if let Some(i) = self
+            .triangles
+            .iter()
+            .position(|t| t.iter().any(|&i| i as usize >= v))
+        {
+            return Err(format!(
+                "triangle {i} names vertices {:?} of {v}",
+                self.triangles[i]
             ));
         }
         if let Some(i) = self
@@ -425,14 +509,10 @@ impl Soup {
                 self.objects[i].layer
             ));
         }
-        if let Some(i) = self
-            .triangles
-            .iter()
-            .position(|t| t.iter().any(|v| !v.is_finite()))
-        {
-            return Err(format!("triangle {i} has a non-finite vertex"));
+        if let Some(i) = self.positions.iter().position(|p| !p.is_finite()) {
+            return Err(format!("vertex {i} is not finite"));
         }
-        if geometry_hash(&self.triangles) != self.geometry_hash {
+        if indexed_geometry_hash(&self.positions, &self.triangles) != self.geometry_hash {
             return Err("geometry hash does not match the triangles".into());
         }
         Ok(())
@@ -444,11 +524,11 @@ impl Soup {
         for t in &self.textures {
             t.validate()?;
         }
-        let n = self.triangles.len();
+        let n = self.positions.len();
         let textured = self.materials.iter().any(|m| m.albedo_map.is_some());
         if !(self.uvs.is_empty() || self.uvs.len() == n) || (textured && self.uvs.len() != n) {
             return Err(format!(
-                "{n} triangles but {} UV triples{}",
+                "{n} vertices but {} UVs{}",
                 self.uvs.len(),
                 if textured {
                     " (a material has a texture)"
@@ -481,12 +561,8 @@ impl Soup {
                 ));
             }
         }
-        if let Some(i) = self
-            .uvs
-            .iter()
-            .position(|t| t.iter().any(|v| !v.is_finite()))
-        {
-            return Err(format!("triangle {i} has a non-finite UV"));
+        if let Some(i) = self.uvs.iter().position(|uv| !uv.is_finite()) {
+            return Err(format!("vertex {i} has a non-finite UV"));
         }
         Ok(())
     }
@@ -509,7 +585,7 @@ impl Soup {
     }
 }
 
-/// The fields after the per-triangle arrays, in payload order.
+/// The fields after the geometry arrays, in payload order.
 type SoupRest = (
     Vec<Object>,
     Vec<Material>,
@@ -523,7 +599,7 @@ type SoupRest = (
 );
 
 /// The fields in the order of SOUP.md (the order of the struct, so the bytes are those of its
-/// serde encoding), the per-triangle arrays as blocks.
+/// serde encoding), the geometry arrays as blocks.
 impl envelope::Artifact for Soup {
     const MAGIC: &'static [u8; 8] = MAGIC;
     const VERSION: u32 = VERSION;
@@ -533,9 +609,10 @@ impl envelope::Artifact for Soup {
         &self,
         p: &mut envelope::PayloadWriter<W>,
     ) -> Result<(), FormatError> {
-        p.array(&self.triangles)?;
+        p.array(&self.positions)?;
         p.array(&self.normals)?;
         p.array(&self.uvs)?;
+        p.array(&self.triangles)?;
         p.array(&self.tri_material)?;
         p.array(&self.tri_object)?;
         p.value(&(
@@ -552,9 +629,10 @@ impl envelope::Artifact for Soup {
     }
 
     fn read_payload(r: &mut envelope::PayloadReader) -> Result<Self, String> {
-        let triangles = r.array("triangles")?;
+        let positions = r.array("positions")?;
         let normals = r.array("normals")?;
         let uvs = r.array("uvs")?;
+        let triangles = r.array("triangles")?;
         let tri_material = r.array("tri_material")?;
         let tri_object = r.array("tri_object")?;
         let (
@@ -569,9 +647,10 @@ impl envelope::Artifact for Soup {
             geometry_hash,
         ): SoupRest = r.value("the fields after tri_object")?;
         Ok(Soup {
-            triangles,
+            positions,
             normals,
             uvs,
+            triangles,
             tri_material,
             tri_object,
             objects,

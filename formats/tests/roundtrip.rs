@@ -5,11 +5,10 @@ use std::path::Path;
 
 fn sample_soup() -> Soup {
     let mut s = Soup::empty();
-    s.triangles = vec![
-        [Vec3::ZERO, Vec3::X, Vec3::Y],
-        [Vec3::Z, Vec3::X, Vec3::ONE],
-    ];
-    s.normals = vec![[Vec3::Z; 3], [Vec3::Y; 3]];
+    // Two triangles sharing vertex 1 (X).
+    s.positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z, Vec3::ONE];
+    s.triangles = vec![[0, 1, 2], [3, 1, 4]];
+    s.normals = vec![Vec3::Z, Vec3::Z, Vec3::Z, Vec3::Y, Vec3::Y];
     s.tri_material = vec![0, 0];
     s.tri_object = vec![0, 0];
     s.objects = vec![Object {
@@ -19,8 +18,11 @@ fn sample_soup() -> Soup {
         ..Object::new("Cube", "builtin:Cube")
     }];
     s.uvs = vec![
-        [Vec2::ZERO, Vec2::X, Vec2::Y],
-        [Vec2::ONE, Vec2::new(0.25, 0.5), Vec2::new(-1.0, 2.0)],
+        Vec2::ZERO,
+        Vec2::X,
+        Vec2::Y,
+        Vec2::ONE,
+        Vec2::new(-1.0, 2.0),
     ];
     s.materials = vec![Material {
         albedo_map: Some(TextureRef {
@@ -94,7 +96,7 @@ fn soup_round_trips_through_a_file() {
     assert_eq!(Soup::read(&path).unwrap(), s);
     let bytes = std::fs::read(&path).unwrap();
     assert_eq!(&bytes[..8], b"UTSOUP\0\0");
-    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 3);
+    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 4);
     // Nothing but the artifact is left in the folder (the temp file was renamed).
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
 }
@@ -108,8 +110,8 @@ fn streamed_soup_file_is_the_encoded_bytes() {
     let path = dir.path().join("big.soup");
     let mut s = sample_soup();
     let n = 100_000;
-    s.triangles = (0..n)
-        .map(|i| {
+    s.positions = (0..n)
+        .flat_map(|i| {
             let f = i as f32;
             [
                 Vec3::new(f, 0.0, 1.0),
@@ -118,8 +120,12 @@ fn streamed_soup_file_is_the_encoded_bytes() {
             ]
         })
         .collect();
-    s.normals = vec![[Vec3::Y; 3]; n];
-    s.uvs = vec![[Vec2::X, Vec2::Y, Vec2::ONE]; n];
+    // Each triangle shares its first vertex with the previous one.
+    s.triangles = (0..n as u32)
+        .map(|i| [3 * i.saturating_sub(1), 3 * i + 1, 3 * i + 2])
+        .collect();
+    s.normals = vec![Vec3::Y; 3 * n];
+    s.uvs = vec![Vec2::X; 3 * n];
     s.tri_material = vec![0; n];
     s.tri_object = vec![0; n];
     s.warnings = (0..2000)
@@ -130,13 +136,17 @@ fn streamed_soup_file_is_the_encoded_bytes() {
     s.textures[0].height = 256;
     s.textures[0].texels = (0..256 * 256 * 4).map(|i| (i * 7 % 251) as u8).collect();
     s.seal();
-    // The geometry hash is over the coordinates as f32 little-endian, however it is computed.
+    // The geometry hash is over the coordinates as f32 little-endian, then the indices as
+    // u32 little-endian, however it is computed.
     let mut le = Vec::new();
+    for v in &s.positions {
+        for c in v.to_array() {
+            le.extend_from_slice(&c.to_le_bytes());
+        }
+    }
     for t in &s.triangles {
-        for v in t {
-            for c in v.to_array() {
-                le.extend_from_slice(&c.to_le_bytes());
-            }
+        for i in t {
+            le.extend_from_slice(&i.to_le_bytes());
         }
     }
     assert_eq!(&s.geometry_hash, blake3::hash(&le).as_bytes());
@@ -307,9 +317,38 @@ fn geometry_hash_depends_on_positions_only() {
     b.materials[0].color = Vec3::X;
     b.seal();
     assert_eq!(a.geometry_hash, b.geometry_hash);
-    b.triangles[0][0].x += 1e-6;
+    b.positions[0].x += 1e-6;
     b.seal();
     assert_ne!(a.geometry_hash, b.geometry_hash);
+    let mut c = a.clone();
+    c.triangles[1].swap(0, 1);
+    c.seal();
+    assert_ne!(
+        a.geometry_hash, c.geometry_hash,
+        "the indices are hashed too"
+    );
+}
+
+/// Every index a reader follows is checked on read: a triangle naming a vertex past the
+/// end, or a vertex without its normal.
+#[test]
+fn triangles_naming_missing_vertices_are_corrupt() {
+    let p = Path::new("idx.soup");
+    let refused = |edit: &dyn Fn(&mut Soup), want: &str| {
+        let mut s = sample_soup();
+        edit(&mut s);
+        s.seal();
+        let msg = Soup::from_bytes(&s.to_bytes(p).unwrap(), p)
+            .unwrap_err()
+            .to_string();
+        assert!(msg.contains(want), "{want}: {msg}");
+    };
+    refused(
+        &|s| s.triangles[1][2] = 5,
+        "triangle 1 names vertices [3, 1, 5] of 5",
+    );
+    refused(&|s| s.normals.truncate(4), "5 vertices but 4 normals");
+    refused(&|s| s.positions[3].y = f32::NAN, "vertex 3 is not finite");
 }
 
 /// SOUP.md promises a byte layout other programs can read: check its first fields by hand.
@@ -321,11 +360,23 @@ fn payload_layout_matches_soup_md() {
     let payload = &b[52..];
     let u64_at = |o: usize| u64::from_le_bytes(payload[o..o + 8].try_into().unwrap());
     let f32_at = |o: usize| f32::from_le_bytes(payload[o..o + 4].try_into().unwrap());
-    // triangles: u64 count, then 9 f32 per triangle, no inner lengths.
-    assert_eq!(u64_at(0), 2);
-    assert_eq!(f32_at(8 + 36 + 24), 1.0); // second triangle, second vertex (X), x
-                                          // normals follow directly.
-    assert_eq!(u64_at(8 + 72), 2);
+    // positions: u64 count, then 3 f32 per vertex, no inner lengths.
+    assert_eq!(u64_at(0), 5);
+    assert_eq!(f32_at(8 + 12), 1.0); // vertex 1 (X), x
+    assert_eq!(f32_at(8 + 4 * 12 + 8), 1.0); // vertex 4 (ONE), z
+                                             // normals follow directly, then the UVs (2 f32 each), then the triangles.
+    assert_eq!(u64_at(8 + 60), 5);
+    let uvs = 8 + 60 + 8 + 60;
+    assert_eq!(u64_at(uvs), 5);
+    let tris = uvs + 8 + 40;
+    assert_eq!(u64_at(tris), 2);
+    let u32_at = |o: usize| u32::from_le_bytes(payload[o..o + 4].try_into().unwrap());
+    assert_eq!(
+        [u32_at(tris + 20), u32_at(tris + 24), u32_at(tris + 28)],
+        [3, 1, 4],
+        "the second triangle's indices"
+    );
+    assert_eq!(u64_at(tris + 32), 2, "tri_material's count follows");
     // The last 32 bytes are the geometry hash.
     assert_eq!(&payload[payload.len() - 32..], &s.geometry_hash);
     // Option<f32> is one tag byte then the value; enums are a u32 index.
@@ -382,13 +433,13 @@ fn atomic_outputs_get_the_umask_permissions_not_the_temporary_files() {
 }
 
 #[test]
-fn a_version_2_soup_is_refused_with_the_versions_named() {
+fn a_version_3_soup_is_refused_with_the_versions_named() {
     let p = Path::new("old.soup");
     let mut b = sample_soup().to_bytes(p).unwrap();
-    b[8..12].copy_from_slice(&2u32.to_le_bytes());
+    b[8..12].copy_from_slice(&3u32.to_le_bytes());
     let msg = Soup::from_bytes(&b, p).unwrap_err().to_string();
     assert!(
-        msg.contains("soup format version 2, this build reads version 3"),
+        msg.contains("soup format version 3, this build reads version 4"),
         "{msg}"
     );
     assert!(msg.contains("re-run the stage that made it"), "{msg}");
@@ -452,15 +503,9 @@ fn bad_texture_references_are_corrupt() {
             .to_string();
         assert!(msg.contains(want), "{want}: {msg}");
     };
-    refused(
-        &|s| s.uvs.pop().map(drop).unwrap(),
-        "2 triangles but 1 UV triples",
-    );
+    refused(&|s| s.uvs.pop().map(drop).unwrap(), "5 vertices but 4 UVs");
     refused(&|s| s.uvs.clear(), "(a material has a texture)");
-    refused(
-        &|s| s.uvs[1][2].y = f32::NAN,
-        "triangle 1 has a non-finite UV",
-    );
+    refused(&|s| s.uvs[4].y = f32::NAN, "vertex 4 has a non-finite UV");
     refused(
         &|s| s.materials[0].albedo_map.as_mut().unwrap().texture = 1,
         "material 0 names texture 1 of 1",

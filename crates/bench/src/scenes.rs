@@ -63,7 +63,7 @@ pub fn load_soup(path: &Path) -> Result<Scene, BenchError> {
     };
     Ok(Scene {
         name: stem(path),
-        triangles: soup.triangles,
+        triangles: soup.triangle_positions(),
         view,
         notes,
     })

@@ -87,7 +87,7 @@ impl Accel {
                 soup: formats::hex(&soup.geometry_hash),
             });
         }
-        Self::assemble(&soup.triangles, kd)
+        Self::assemble(soup.triangle_count(), |t| soup.corners(t), kd)
     }
 
     /// Pair bare triangles with their tree (the geometry hash is recomputed and checked).
@@ -99,24 +99,29 @@ impl Accel {
                 soup: formats::hex(&hash),
             });
         }
-        Self::assemble(triangles, kd)
+        Self::assemble(triangles.len(), |t| triangles[t], kd)
     }
 
     /// Build a tree with `params` and wrap it (tests, benchmarks, tools).
     pub fn build(triangles: &[[Vec3; 3]], params: &BuildParams) -> Accel {
         let kd = build(triangles, params, formats::soup::geometry_hash(triangles));
-        Self::assemble(triangles, &kd).expect("a freshly built tree fits its triangles")
+        Self::assemble(triangles.len(), |t| triangles[t], &kd)
+            .expect("a freshly built tree fits its triangles")
     }
 
-    fn assemble(triangles: &[[Vec3; 3]], kd: &KdFile) -> Result<Accel, AccelError> {
+    /// `count` triangles, the corners of each given by `corners`.
+    fn assemble(
+        count: usize,
+        corners: impl Fn(usize) -> [Vec3; 3],
+        kd: &KdFile,
+    ) -> Result<Accel, AccelError> {
         kd.validate()
             .map_err(|detail| AccelError::Corrupt { detail })?;
-        if kd.stats.triangles != triangles.len() as u64 {
+        if kd.stats.triangles != count as u64 {
             return Err(AccelError::Corrupt {
                 detail: format!(
-                    "the tree indexes {} triangles, the soup has {}",
+                    "the tree indexes {} triangles, the soup has {count}",
                     kd.stats.triangles,
-                    triangles.len()
                 ),
             });
         }
@@ -129,13 +134,13 @@ impl Accel {
             tris,
             soup_index,
             leaf_tris,
-        } = renumber(triangles, &kd.leaf_tris);
+        } = renumber(count, corners, &kd.leaf_tris);
         Ok(Accel {
             tris,
             soup_index,
             nodes: kd.nodes.clone(),
             leaf_tris,
-            input_triangles: triangles.len(),
+            input_triangles: count,
             bounds: Aabb {
                 lo: kd.bounds[0].to_array(),
                 hi: kd.bounds[1].to_array(),
@@ -266,9 +271,13 @@ pub struct Renumbered {
 
 /// Renumber `triangles` by their first appearance in `leaf_tris` (a tree's leaf lists in
 /// soup indices).
-pub fn renumber(triangles: &[[Vec3; 3]], leaf_tris: &[u32]) -> Renumbered {
-    let mut slot = vec![u32::MAX; triangles.len()];
-    let mut soup_index = Vec::with_capacity(triangles.len());
+pub fn renumber(
+    count: usize,
+    corners: impl Fn(usize) -> [Vec3; 3],
+    leaf_tris: &[u32],
+) -> Renumbered {
+    let mut slot = vec![u32::MAX; count];
+    let mut soup_index = Vec::with_capacity(count);
     let leaf_tris = leaf_tris
         .iter()
         .map(|&p| {
@@ -282,10 +291,7 @@ pub fn renumber(triangles: &[[Vec3; 3]], leaf_tris: &[u32]) -> Renumbered {
         .collect();
     let tris = soup_index
         .iter()
-        .map(|&p| {
-            let t = &triangles[p as usize];
-            [t[0].to_array(), t[1].to_array(), t[2].to_array()]
-        })
+        .map(|&p| corners(p as usize).map(|v| v.to_array()))
         .collect();
     Renumbered {
         tris,

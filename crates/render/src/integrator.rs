@@ -288,7 +288,7 @@ impl<'a> Integrator<'a> {
     /// The interpolated UV of triangle `prim` at barycentrics (u, v): corner 0 weighs
     /// 1 − u − v, corner 1 u, corner 2 v, as for the normals.
     fn uv_at(&self, prim: usize, u: f32, v: f32) -> Vec2 {
-        let t = &self.soup.uvs[prim];
+        let t = self.soup.corner_uvs(prim);
         t[0] * (1.0 - u - v) + t[1] * u + t[2] * v
     }
 
@@ -297,7 +297,12 @@ impl<'a> Integrator<'a> {
     fn texel(&self, map: &(usize, Tiling), prim: usize, hit: &Hit, dir: Vec3, width: f32) -> Vec4 {
         let uv = self.uv_at(prim, hit.u, hit.v);
         let w = if self.filter == TextureFilter::Cone && width > 0.0 {
-            cone_footprint(width, dir, self.soup.triangles[prim], self.soup.uvs[prim])
+            cone_footprint(
+                width,
+                dir,
+                self.soup.corners(prim),
+                self.soup.corner_uvs(prim),
+            )
         } else {
             0.0
         };
@@ -521,7 +526,7 @@ impl<'a> Integrator<'a> {
             }
         }
 
-        let tri = &self.soup.triangles[prim];
+        let tri = &self.soup.corners(prim);
         let (p, err) = hit_point(tri, hit.u, hit.v);
 
         // Geometric normal, turned to face where the ray came from.
@@ -535,7 +540,7 @@ impl<'a> Integrator<'a> {
             margin: intersector_margin(tri),
             ng,
         };
-        let ns_tri = &self.soup.normals[prim];
+        let ns_tri = self.soup.corner_normals(prim);
         let b0 = 1.0 - hit.u - hit.v;
         let mut ns = (ns_tri[0] * b0 + ns_tri[1] * hit.u + ns_tri[2] * hit.v).normalize_or_zero();
         if ns == Vec3::ZERO || !ns.is_finite() {

@@ -149,7 +149,9 @@ fn closed_pieces(soup: &Soup, o: usize, run: Range<usize>) -> Pieces {
             boxes: Vec::new(),
         };
     }
-    let list = &soup.triangles[run.clone()];
+    // Welded by position, not by the soup's vertex numbers: a hard edge splits its
+    // vertices, yet closes the piece.
+    let list: Vec<[Vec3; 3]> = run.clone().map(|t| soup.corners(t)).collect();
     let n = list.len();
     let mut parent: Vec<u32> = (0..n as u32).collect();
     let mut open = vec![false; n];
@@ -299,8 +301,7 @@ mod tests {
         }
         for (o, u, v) in faces {
             for t in [[o, o + u, o + u + v], [o, o + u + v, o + v]] {
-                s.triangles.push(t);
-                s.normals.push([Vec3::Y; 3]);
+                s.push_triangle(t, [Vec3::Y; 3], None);
                 s.tri_material.push(0);
                 s.tri_object.push(0);
             }

@@ -14,7 +14,8 @@ pub fn to_obj(soup: &Soup) -> String {
         soup.objects.len()
     );
     let mut current = u32::MAX;
-    for (i, (t, n)) in soup.triangles.iter().zip(&soup.normals).enumerate() {
+    for i in 0..soup.triangle_count() {
+        let (t, n) = (soup.corners(i), soup.corner_normals(i));
         let obj = soup.tri_object[i];
         if obj != current {
             current = obj;

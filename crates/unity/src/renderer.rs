@@ -5,7 +5,7 @@
 use crate::emit::{flip, EmitError, Emitter};
 use crate::layer::layer;
 use crate::mesh::Mesh;
-use formats::{CastShadows, Object};
+use formats::{CastShadows, Object, Soup};
 use glam::{Mat3, Mat4, Vec2, Vec3};
 use rayon::prelude::*;
 
@@ -59,9 +59,10 @@ impl Emitter<'_, '_> {
             },
             receive_shadows: r.i64_at("m_ReceiveShadows") != Some(0),
         });
-        let placed = Placed::new(mesh, world);
+        // Resolve every slot first: whether any of them is textured decides whether the
+        // vertices carry UVs.
+        let mut parts: Vec<(&[[u32; 3]], u32)> = Vec::new();
         let mut origins: Vec<(u32, String)> = Vec::new();
-        let mut emitted = 0usize;
         for (si, tris) in mesh.submeshes.iter().enumerate() {
             if tris.is_empty() {
                 continue;
@@ -76,11 +77,31 @@ impl Emitter<'_, '_> {
             if !origins.iter().any(|(m, _)| *m == mat) {
                 origins.push((mat, origin));
             }
-            emitted += self.place(&placed, tris, flip_winding, mat, obj_index);
+            parts.push((tris, mat));
+        }
+        if self.soup.positions.len() + mesh.positions.len() > u32::MAX as usize {
+            self.soup.objects.pop();
+            self.soup.warnings.push(format!(
+                "{what}: the soup would hold more than 2^32 vertices with this mesh; skipped"
+            ));
+            return Ok(());
+        }
+        let textured = parts
+            .iter()
+            .any(|&(_, m)| self.soup.materials[m as usize].albedo_map.is_some());
+        let base = place_vertices(&mut self.soup, mesh, world, textured);
+        let mut emitted = 0usize;
+        for (tris, mat) in parts {
+            emitted += place_triangles(&mut self.soup, base, tris, flip_winding, mat, obj_index);
         }
         if emitted == 0 {
-            // Keep object indices dense in what renders: drop an object without triangles.
+            // Keep object indices dense in what renders: drop an object without triangles,
+            // and its vertices.
             self.soup.objects.pop();
+            let soup = &mut self.soup;
+            soup.positions.truncate(base as usize);
+            soup.normals.truncate(base as usize);
+            soup.uvs.truncate(base.min(soup.uvs.len() as u32) as usize);
         } else {
             self.material_origins.push(origins);
         }
@@ -89,150 +110,108 @@ impl Emitter<'_, '_> {
 }
 
 /// Sub-meshes and meshes smaller than this are placed on the calling thread: waking the
-/// pool costs more than transforming a few thousand triangles, and real scenes have
+/// pool costs more than transforming a few thousand vertices, and real scenes have
 /// hundreds of small objects.
 const PARALLEL_MIN: usize = 8192;
 
-/// A mesh's vertices in world space, soup handedness. Each vertex is transformed once
-/// rather than once per corner (a closed mesh has about six corners per vertex); a corner
-/// then copies the very values the per-corner transform computed. Texture coordinates do
-/// not move with the mesh, so they are the mesh's own.
-struct Placed<'m> {
-    positions: Vec<Vec3>,
-    normals: Vec<Vec3>,
-    uvs: &'m [Vec2],
-}
-
-impl<'m> Placed<'m> {
-    fn new(mesh: &'m Mesh, world: Mat4) -> Self {
-        let normal_m = Mat3::from_mat4(world).inverse().transpose();
-        let position = |p: &Vec3| flip(world.transform_point3(*p));
-        let normal = |n: &Vec3| {
-            let n = flip((normal_m * *n).normalize_or_zero());
-            if n == Vec3::ZERO {
-                Vec3::Y
-            } else {
-                n
-            }
-        };
-        if mesh.positions.len() < PARALLEL_MIN {
-            Placed {
-                positions: mesh.positions.iter().map(position).collect(),
-                normals: mesh.normals.iter().map(normal).collect(),
-                uvs: &mesh.uvs,
-            }
+/// Append `mesh`'s vertices placed by `world` (Unity space) to the soup, in soup
+/// handedness, on all threads for large meshes (rayon's indexed `par_extend` writes in
+/// place, in order); the index of the first. Each vertex is transformed once and shared by
+/// the triangles that name it (a closed mesh has about six corners per vertex).
+///
+/// UVs are stored only once a textured material has been seen: until then `soup.uvs` stays
+/// empty (and an untextured soup never pays), from then on every vertex gets its mesh's
+/// UVs, or (0, 0) when the mesh has none (or fewer than positions). Texture coordinates do
+/// not move with the mesh.
+fn place_vertices(soup: &mut Soup, mesh: &Mesh, world: Mat4, textured: bool) -> u32 {
+    let normal_m = Mat3::from_mat4(world).inverse().transpose();
+    let position = |p: &Vec3| flip(world.transform_point3(*p));
+    let normal = |n: &Vec3| {
+        let n = flip((normal_m * *n).normalize_or_zero());
+        if n == Vec3::ZERO {
+            Vec3::Y
         } else {
-            Placed {
-                positions: mesh.positions.par_iter().map(position).collect(),
-                normals: mesh.normals.par_iter().map(normal).collect(),
-                uvs: &mesh.uvs,
-            }
+            n
+        }
+    };
+    let base = soup.positions.len();
+    if textured && soup.uvs.len() < base {
+        soup.uvs.resize(base, Vec2::ZERO);
+    }
+    if mesh.positions.len() < PARALLEL_MIN {
+        soup.positions.extend(mesh.positions.iter().map(position));
+        soup.normals.extend(mesh.normals.iter().map(normal));
+    } else {
+        soup.positions
+            .par_extend(mesh.positions.par_iter().map(position));
+        soup.normals.par_extend(mesh.normals.par_iter().map(normal));
+    }
+    if !soup.uvs.is_empty() || textured {
+        if mesh.uvs.len() == mesh.positions.len() {
+            soup.uvs.extend_from_slice(&mesh.uvs);
+        } else {
+            soup.uvs.resize(soup.positions.len(), Vec2::ZERO);
         }
     }
+    base as u32
 }
 
-impl Emitter<'_, '_> {
-    /// Append sub-mesh `tris` of the `placed` mesh to the soup; how many triangles it kept
-    /// (degenerate ones are dropped and counted).
-    ///
-    /// Large sub-meshes are gathered on all threads straight into the soup's vectors
-    /// (rayon's indexed `par_extend` writes in place, in order), positions and normals as
-    /// two passes, so the output is the same as a sequential loop's. Degenerate triangles
-    /// are found afterwards and squeezed out in order; they are rare.
-    ///
-    /// UVs cost a third pass, so they are gathered only once a textured material has been
-    /// seen: until then `soup.uvs` stays empty (and an untextured soup never pays), from
-    /// then on every triangle gets a triple — its mesh's UVs when its material is
-    /// textured, zeros otherwise, since nothing samples them.
-    fn place(
-        &mut self,
-        placed: &Placed,
-        tris: &[[u32; 3]],
-        flip_winding: bool,
-        mat: u32,
-        obj_index: u32,
-    ) -> usize {
-        // The flip to right-handed space reverses the winding once; a mirroring transform
-        // (negative determinant) reverses it again.
-        fn wind<T: Copy>(flip_winding: bool, v: [T; 3]) -> [T; 3] {
-            if flip_winding {
-                v
-            } else {
-                [v[0], v[2], v[1]]
-            }
-        }
-        let position = |t: &[u32; 3]| wind(flip_winding, t.map(|i| placed.positions[i as usize]));
-        let normal = |t: &[u32; 3]| wind(flip_winding, t.map(|i| placed.normals[i as usize]));
-        let textured = self.soup.materials[mat as usize].albedo_map.is_some();
-        let soup = &mut self.soup;
-        let start = soup.triangles.len();
-        if textured && soup.uvs.len() < start {
-            soup.uvs.resize(start, [Vec2::ZERO; 3]);
-        }
-        let uvs_on = textured || !soup.uvs.is_empty();
-        // A mesh without UVs (or with fewer than positions) samples texel (0, 0).
-        let mesh_uvs = if textured && placed.uvs.len() == placed.positions.len() {
-            placed.uvs
+/// Append sub-mesh `tris` of the mesh whose vertices start at `base` to the soup; how many
+/// triangles it kept (degenerate ones are dropped and counted). Large sub-meshes are
+/// gathered on all threads; degenerate triangles are found afterwards and squeezed out in
+/// order, since they are rare.
+fn place_triangles(
+    soup: &mut Soup,
+    base: u32,
+    tris: &[[u32; 3]],
+    flip_winding: bool,
+    mat: u32,
+    obj_index: u32,
+) -> usize {
+    // The flip to right-handed space reverses the winding once; a mirroring transform
+    // (negative determinant) reverses it again.
+    let index = |t: &[u32; 3]| {
+        let t = t.map(|i| base + i);
+        if flip_winding {
+            t
         } else {
-            &[]
-        };
-        let uv = |t: &[u32; 3]| {
-            if mesh_uvs.is_empty() {
-                [Vec2::ZERO; 3]
-            } else {
-                wind(flip_winding, t.map(|i| mesh_uvs[i as usize]))
-            }
-        };
-        let n = tris.len();
-        let dropped = if n < PARALLEL_MIN {
-            soup.triangles.extend(tris.iter().map(position));
-            soup.normals.extend(tris.iter().map(normal));
-            if uvs_on {
-                soup.uvs.extend(tris.iter().map(uv));
-            }
-            soup.triangles[start..]
-                .iter()
-                .filter(|p| degenerate(**p))
-                .count()
-        } else {
-            soup.triangles
-                .par_extend(tris.par_iter().with_min_len(PARALLEL_MIN / 2).map(position));
-            soup.normals
-                .par_extend(tris.par_iter().with_min_len(PARALLEL_MIN / 2).map(normal));
-            if uvs_on {
-                soup.uvs
-                    .par_extend(tris.par_iter().with_min_len(PARALLEL_MIN / 2).map(uv));
-            }
-            soup.triangles[start..]
-                .par_iter()
-                .with_min_len(PARALLEL_MIN / 2)
-                .filter(|p| degenerate(**p))
-                .count()
-        };
-        if dropped > 0 {
-            let mut kept = start;
-            for i in start..start + n {
-                if !degenerate(soup.triangles[i]) {
-                    soup.triangles[kept] = soup.triangles[i];
-                    soup.normals[kept] = soup.normals[i];
-                    if uvs_on {
-                        soup.uvs[kept] = soup.uvs[i];
-                    }
-                    kept += 1;
-                }
-            }
-            soup.triangles.truncate(kept);
-            soup.normals.truncate(kept);
-            if uvs_on {
-                soup.uvs.truncate(kept);
-            }
-            soup.dropped_degenerate += dropped as u64;
+            [t[0], t[2], t[1]]
         }
-        let kept = n - dropped;
-        soup.tri_material.extend(std::iter::repeat_n(mat, kept));
-        soup.tri_object.extend(std::iter::repeat_n(obj_index, kept));
-        kept
+    };
+    let start = soup.triangles.len();
+    let n = tris.len();
+    let Soup {
+        positions,
+        triangles,
+        ..
+    } = soup;
+    let bad = |t: &[u32; 3]| degenerate(t.map(|i| positions[i as usize]));
+    let dropped = if n < PARALLEL_MIN {
+        triangles.extend(tris.iter().map(index));
+        triangles[start..].iter().filter(|t| bad(t)).count()
+    } else {
+        triangles.par_extend(tris.par_iter().with_min_len(PARALLEL_MIN / 2).map(index));
+        triangles[start..]
+            .par_iter()
+            .with_min_len(PARALLEL_MIN / 2)
+            .filter(|t| bad(t))
+            .count()
+    };
+    if dropped > 0 {
+        let mut kept = start;
+        for i in start..start + n {
+            if !bad(&triangles[i]) {
+                triangles[kept] = triangles[i];
+                kept += 1;
+            }
+        }
+        triangles.truncate(kept);
+        soup.dropped_degenerate += dropped as u64;
     }
+    let kept = n - dropped;
+    soup.tri_material.extend(std::iter::repeat_n(mat, kept));
+    soup.tri_object.extend(std::iter::repeat_n(obj_index, kept));
+    kept
 }
 
 /// Zero area, repeated or collinear vertices (up to float noise): |e1 × e2| ≤ 10⁻⁹·|e1|·|e2|,

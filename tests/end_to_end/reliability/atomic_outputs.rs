@@ -18,8 +18,7 @@ fn big_soup(path: &Path, n: usize) {
     for t in 0..n {
         let c = Vec3::new(f(t * 12), f(t * 12 + 1), f(t * 12 + 2)) * 100.0;
         let v = |k: usize| c + Vec3::new(f(t * 12 + k), f(t * 12 + k + 1), f(t * 12 + k + 2)) - 0.5;
-        soup.triangles.push([v(3), v(6), v(9)]);
-        soup.normals.push([Vec3::Z; 3]);
+        soup.push_triangle([v(3), v(6), v(9)], [Vec3::Z; 3], None);
         soup.tri_material.push(0);
         soup.tri_object.push(0);
     }

@@ -34,8 +34,7 @@ fn quad(soup: &mut Soup, corners: [Vec3; 4], material: u32, object: u32) {
         .cross(corners[2] - corners[0])
         .normalize();
     for t in [[0, 1, 2], [0, 2, 3]] {
-        soup.triangles.push(t.map(|i| corners[i]));
-        soup.normals.push([n; 3]);
+        soup.push_triangle(t.map(|i| corners[i]), [n; 3], None);
         soup.tri_material.push(material);
         soup.tri_object.push(object);
     }
@@ -167,8 +166,7 @@ pub fn mesh_on_mirror(path: &Path) -> Result<Scene> {
             soup.dropped_degenerate += 1;
             continue;
         }
-        soup.triangles.push(t);
-        soup.normals.push([n.normalize(); 3]);
+        soup.push_triangle(t, [n.normalize(); 3], None);
         soup.tri_material.push(1);
         soup.tri_object.push(1);
     }
@@ -255,9 +253,7 @@ pub fn checkerboard() -> Scene {
     // One texture repeat every 4 m.
     let uv = corners.map(|c| Vec2::new(c.x, c.z) / 4.0);
     for t in [[0, 1, 2], [0, 2, 3]] {
-        soup.triangles.push(t.map(|i| corners[i]));
-        soup.uvs.push(t.map(|i| uv[i]));
-        soup.normals.push([Vec3::Y; 3]);
+        soup.push_triangle(t.map(|i| corners[i]), [Vec3::Y; 3], Some(t.map(|i| uv[i])));
         soup.tri_material.push(0);
         soup.tri_object.push(0);
     }
@@ -295,9 +291,9 @@ pub fn with_checker(scene: &Scene) -> Scene {
         });
     }
     soup.uvs = soup
-        .triangles
+        .positions
         .iter()
-        .map(|t| t.map(|p| Vec2::new(p.x, p.z) / 2.0))
+        .map(|p| Vec2::new(p.x, p.z) / 2.0)
         .collect();
     Scene {
         name: format!("{}-textured", scene.name),
@@ -332,8 +328,7 @@ pub fn tiny() -> Scene {
         Vec3::new(0.0, 1.2, 0.0),
         Vec3::new(0.5, 0.5, 0.0),
     ];
-    soup.triangles.push(t);
-    soup.normals.push([Vec3::NEG_Z; 3]);
+    soup.push_triangle(t, [Vec3::NEG_Z; 3], None);
     soup.tri_material.push(1);
     soup.tri_object.push(1);
     soup.lights = vec![point_light("key", Vec3::new(0.3, 2.0, -1.5), 4.0, 0.5)];

@@ -130,7 +130,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 fn sah_tree(scene: &Scene) -> (KdFile, f64) {
     let t = Instant::now();
     let kd = kdtree::build(
-        &scene.soup.triangles,
+        &scene.soup.triangle_positions(),
         &BuildParams::default(),
         scene.soup.geometry_hash,
     );
@@ -140,7 +140,7 @@ fn sah_tree(scene: &Scene) -> (KdFile, f64) {
 fn median_tree(scene: &Scene) -> (KdFile, f64) {
     let t = Instant::now();
     let kd = kdtree::build_median(
-        &scene.soup.triangles,
+        &scene.soup.triangle_positions(),
         &BuildParams::default(),
         scene.soup.geometry_hash,
     );
@@ -322,7 +322,7 @@ fn intersectors(
     kd: &formats::KdFile,
     cfg: &Config,
 ) -> Result<Intersector> {
-    let plain = crate::plain::PlainAccel::new(&scene.soup.triangles, kd)
+    let plain = crate::plain::PlainAccel::new(&scene.soup.triangle_positions(), kd)
         .map_err(anyhow::Error::msg)
         .with_context(|| format!("scene {}: the textbook traversal", scene.name))?;
     let camera = render::CameraModel::new(&scene.soup.camera, cfg.width, cfg.height)

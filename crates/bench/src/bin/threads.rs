@@ -43,7 +43,7 @@ fn run() -> Result<()> {
     ensure!(a.pairs > 0, "--pairs must be at least 1");
     let soup = unity::convert(&a.scene, &unity::Options::default())
         .with_context(|| format!("{}: cannot convert the scene", a.scene.display()))?;
-    let accel = Accel::build(&soup.triangles, &BuildParams::default());
+    let accel = Accel::build(&soup.triangle_positions(), &BuildParams::default());
     let opts = |threads| RenderOptions {
         width: a.width,
         height: a.height,

@@ -25,7 +25,7 @@ fn reference_against_itself_has_zero_error() {
         reference_spp: 16,
         ..tiny_config()
     };
-    let accel = Accel::build(&scene.soup.triangles, &BuildParams::default());
+    let accel = Accel::build(&scene.soup.triangle_positions(), &BuildParams::default());
     let (a, rays, _) = sweep::reference(&scene, &accel, &cfg).unwrap();
     assert_eq!(rays.camera, 32 * 24 * 16);
     // Rendered twice: the renderer is deterministic per seed, so the images are equal.
@@ -45,7 +45,7 @@ fn reference_against_itself_has_zero_error() {
 fn error_shrinks_as_spp_grows() {
     let scene = scenes::tiny();
     let cfg = tiny_config();
-    let accel = Accel::build(&scene.soup.triangles, &BuildParams::default());
+    let accel = Accel::build(&scene.soup.triangle_positions(), &BuildParams::default());
     let (reference, _, _) = sweep::reference(&scene, &accel, &cfg).unwrap();
     let base = sweep::defaults(&cfg);
     let errors: Vec<_> = [1, 4, 16, 64]

@@ -192,7 +192,7 @@ fn run(cli: Cli) -> Result<()> {
         }
         (None, None) => unreachable!("checked above"),
     };
-    let kd = kdtree::build(&soup.triangles, &params, soup.geometry_hash);
+    let kd = kdtree::build(&soup.triangle_positions(), &params, soup.geometry_hash);
     // Atomic (temp file + rename): concurrent builders of one cache entry both succeed.
     kd.write(&path)?;
     report(&cli, &soup, &kd, &path, cache, start)

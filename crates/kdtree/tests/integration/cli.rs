@@ -19,11 +19,10 @@ fn raycast() -> Command {
 fn make_soup(dir: &Path, tris: Vec<[Vec3; 3]>) -> PathBuf {
     let mut soup = Soup::empty();
     let n = tris.len();
-    soup.normals = tris
-        .iter()
-        .map(|t| [(t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero(); 3])
-        .collect();
-    soup.triangles = tris;
+    for t in tris {
+        let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
+        soup.push_triangle(t, [n; 3], None);
+    }
     soup.tri_material = vec![0; n];
     soup.tri_object = vec![0; n];
     soup.materials = vec![Material::unity_default()];

@@ -58,9 +58,8 @@ impl SceneBuilder {
         let corner = [a, Vec2::new(b.x, a.y), b, Vec2::new(a.x, b.y)];
         let p = [o, o + u, o + u + v, o + v];
         for t in [[0, 1, 2], [0, 2, 3]] {
-            self.soup.triangles.push(t.map(|i| p[i]));
-            self.soup.uvs.push(t.map(|i| corner[i]));
-            self.soup.normals.push([n; 3]);
+            self.soup
+                .push_triangle(t.map(|i| p[i]), [n; 3], Some(t.map(|i| corner[i])));
             self.soup.tri_material.push(material);
             self.soup.tri_object.push(obj);
         }
@@ -102,9 +101,7 @@ impl SceneBuilder {
         for (o, u, v) in faces {
             let n = u.cross(v).normalize();
             for t in [[o, o + u, o + u + v], [o, o + u + v, o + v]] {
-                self.soup.triangles.push(t);
-                self.soup.uvs.push([Vec2::ZERO; 3]);
-                self.soup.normals.push([n; 3]);
+                self.soup.push_triangle(t, [n; 3], Some([Vec2::ZERO; 3]));
                 self.soup.tri_material.push(material);
                 self.soup.tri_object.push(obj);
             }
@@ -129,7 +126,7 @@ impl SceneBuilder {
         self.soup.seal();
         self.soup.validate().expect("test scene is valid");
         let kd = kdtree::build(
-            &self.soup.triangles,
+            &self.soup.triangle_positions(),
             &formats::BuildParams::default(),
             self.soup.geometry_hash,
         );

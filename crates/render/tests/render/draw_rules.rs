@@ -278,9 +278,8 @@ fn box_over_floor(cull: Cull, open_top: bool, sun: Vec3) -> render::Rendered {
     if open_top {
         // The builder writes bottom, top, −Z, +Z, −X, +X, two triangles each.
         let top = first + 2..first + 4;
+        // Their vertices stay, unused.
         s.soup.triangles.drain(top.clone());
-        s.soup.uvs.drain(top.clone());
-        s.soup.normals.drain(top.clone());
         s.soup.tri_material.drain(top.clone());
         s.soup.tri_object.drain(top);
     }

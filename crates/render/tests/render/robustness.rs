@@ -46,8 +46,7 @@ fn spawned_rays_never_rehit_their_own_triangle() {
             let mut b = SceneBuilder::new();
             let m = b.diffuse(Vec3::ONE);
             b.soup.objects.push(formats::Object::new("tri", "test"));
-            b.soup.triangles.push(tri);
-            b.soup.normals.push([ng; 3]);
+            b.soup.push_triangle(tri, [ng; 3], None);
             b.soup.tri_material.push(m);
             b.soup.tri_object.push(0);
             let (soup, kd) = b.build();

@@ -65,7 +65,7 @@ fn unity2soup_json_summary_and_soup_file() {
         .filter(|l| l.starts_with("v "))
         .take(3)
         .collect();
-    let t = soup.triangles[0];
+    let t = soup.corners(0);
     assert_eq!(v[0], format!("v {} {} {}", t[0].x, t[0].y, t[0].z));
     assert_eq!(v[2], format!("v {} {} {}", t[2].x, t[2].y, t[2].z));
 }

@@ -77,7 +77,7 @@ fn obj_at_identity_keeps_its_file_coordinates_and_winding() {
     let soup = convert(&scene);
     let v = |x, y, z| Vec3::new(x, y, z);
     assert_eq!(
-        soup.triangles,
+        soup.triangle_positions(),
         vec![
             [v(1., 2., 3.), v(4., 2., 3.), v(1., 5., 3.)],
             [v(10., 0., -1.), v(11., 0., -1.), v(11., 1., -1.)],
@@ -85,7 +85,7 @@ fn obj_at_identity_keeps_its_file_coordinates_and_winding() {
         ],
         "exactly the file's positions, in file order and winding"
     );
-    assert!(soup.normals.iter().flatten().all(|n| *n == Vec3::Z));
+    assert!(soup.normals.iter().all(|n| *n == Vec3::Z));
     assert_eq!(soup.objects.len(), 1);
     assert_eq!(soup.objects[0].name, "Model");
     assert_eq!(soup.objects[0].source, "Assets/m.obj#default");
@@ -105,8 +105,13 @@ fn object_at_unity_plus_x_is_right_of_the_camera() {
     let cam = &soup.camera;
     assert_eq!(cam.forward, Vec3::Z);
     assert_eq!(cam.up, Vec3::Y);
-    let centre =
-        soup.triangles.iter().flatten().copied().sum::<Vec3>() / (soup.triangles.len() * 3) as f32;
+    let centre = soup
+        .triangle_positions()
+        .iter()
+        .flatten()
+        .copied()
+        .sum::<Vec3>()
+        / (soup.triangles.len() * 3) as f32;
     assert!(
         close(centre, Vec3::new(-3.0, 0.0, 10.0), 1e-4),
         "soup x is negated: {centre}"
@@ -160,14 +165,14 @@ fn primitives_have_unity_dimensions() {
         if tris > 0 {
             assert_eq!(soup.triangles.len(), tris, "{name}");
         }
-        let (blo, bhi) = bounds(soup.triangles.iter().flatten().copied());
+        let (blo, bhi) = bounds(soup.triangle_positions().iter().flatten().copied());
         assert!(
             close(blo, lo, 1e-5) && close(bhi, hi, 1e-5),
             "{name}: {blo} {bhi}"
         );
         assert_eq!(soup.objects[0].source, format!("builtin:{name}"));
         // Every triangle's winding agrees with its shading normals (front = CCW).
-        for (t, n) in soup.triangles.iter().zip(&soup.normals) {
+        for (t, n) in soup.triangle_positions().iter().zip(corner_normals(&soup)) {
             let g = (t[1] - t[0]).cross(t[2] - t[0]);
             assert!(
                 g.dot(n[0] + n[1] + n[2]) > 0.0,
@@ -180,7 +185,7 @@ fn primitives_have_unity_dimensions() {
         let mut sc = Scene::default();
         sc.primitive("P", &Tf::at(0.0, 0.0, 0.0), 0, id);
         let soup = convert_scene(&sc.text);
-        let t = soup.triangles[0];
+        let t = soup.corners(0);
         (t[1] - t[0]).cross(t[2] - t[0]).normalize()
     };
     assert!(close(facing(PLANE), Vec3::Y, 1e-6));
@@ -205,7 +210,12 @@ fn negative_scale_mirrors_and_keeps_faces_outward() {
         CUBE,
     );
     let soup = convert_scene(&sc.text);
-    for (i, (t, n)) in soup.triangles.iter().zip(&soup.normals).enumerate() {
+    for (i, (t, n)) in soup
+        .triangle_positions()
+        .iter()
+        .zip(corner_normals(&soup))
+        .enumerate()
+    {
         let g = (t[1] - t[0]).cross(t[2] - t[0]).normalize();
         assert!(
             g.dot(n[0]) > 0.99,
@@ -263,9 +273,9 @@ fn parented_rotated_scaled_hierarchy() {
     );
     let soup = convert_scene(&sc.text);
     assert_eq!(soup.objects[0].name, "Parent/Child");
+    let tris = soup.triangle_positions();
     let pts = |o: u32| {
-        soup.triangles
-            .iter()
+        tris.iter()
             .zip(&soup.tri_object)
             .filter(move |(_, &ob)| ob == o)
             .flat_map(|(t, _)| t.iter().copied())
@@ -368,7 +378,7 @@ fn legacy_table_resolves_sub_meshes_by_name() {
     );
     let soup = convert_beside_two_groups(&sc.text);
     assert_eq!(soup.triangles.len(), 1);
-    assert_eq!(soup.triangles[0][0], Vec3::new(5.0, 0.0, 0.0));
+    assert_eq!(soup.corners(0)[0], Vec3::new(5.0, 0.0, 0.0));
     assert_eq!(soup.objects[0].source, "Assets/two.obj#B");
     // The material GUID is unknown: Unity's default, with a warning that names it.
     assert_eq!(soup.materials[0].name, "Default-Material");
@@ -408,7 +418,7 @@ fn file_ids_generation_2_resolves_hashed_ids() {
     assert_eq!(soup.objects.len(), 1);
     assert_eq!(soup.objects[0].source, "Assets/two.obj#B");
     assert_eq!(soup.triangles.len(), 1);
-    assert_eq!(soup.triangles[0][0], Vec3::new(5.0, 0.0, 0.0));
+    assert_eq!(soup.corners(0)[0], Vec3::new(5.0, 0.0, 0.0));
     assert!(soup
         .warnings
         .iter()
@@ -447,7 +457,7 @@ fn prefab_instance_of_an_obj_model_applies_modifications() {
     let names: Vec<_> = soup.objects.iter().map(|o| o.name.as_str()).collect();
     assert_eq!(names, ["two/A", "two/Child"]);
     // Group A's triangle (0,0,0),(1,0,0),(0,1,0) moved by Unity +10 in x → soup −10.
-    let t = soup.triangles[0];
+    let t = soup.corners(0);
     assert!(
         close(t[0], Vec3::new(-10.0, 0.0, 0.0), 1e-6)
             && close(t[1], Vec3::new(-9.0, 0.0, 0.0), 1e-6),
@@ -456,7 +466,12 @@ fn prefab_instance_of_an_obj_model_applies_modifications() {
     assert_eq!(soup.materials[soup.tri_material[0] as usize].name, "Blue");
     assert_eq!(soup.materials[soup.tri_material[0] as usize].color, Vec3::Z);
     // The Cube under the stripped root: Unity (10, 3, 0) → soup (−10, 3, 0).
-    let cube: Vec3 = soup.triangles[1..].iter().flatten().copied().sum::<Vec3>() / (12.0 * 3.0);
+    let cube: Vec3 = soup.triangle_positions()[1..]
+        .iter()
+        .flatten()
+        .copied()
+        .sum::<Vec3>()
+        / (12.0 * 3.0);
     assert!(close(cube, Vec3::new(-10.0, 3.0, 0.0), 1e-5), "{cube}");
 }
 
@@ -545,10 +560,10 @@ fn uvs_follow_their_corners_past_dropped_triangles() {
     }
     let soup = convert(&scene);
     assert_eq!((soup.triangles.len(), soup.dropped_degenerate), (1, 2));
-    assert_eq!(soup.uvs.len(), 1);
+    assert_eq!(soup.uvs.len(), soup.positions.len());
     assert!(soup.materials[0].albedo_map.is_some());
     // The soup keeps the OBJ's x (Unity negates it, the soup negates it back).
-    for (p, uv) in soup.triangles[0].iter().zip(soup.uvs[0]) {
+    for (p, uv) in soup.corners(0).iter().zip(soup.corner_uvs(0)) {
         let want = match (p.x, p.y) {
             (0.0, 0.0) => glam::Vec2::new(0.0, 0.0),
             (1.0, 0.0) => glam::Vec2::new(0.25, 0.0),
@@ -607,7 +622,13 @@ fn nested_prefabs_apply_overrides_outermost_last() {
     assert_eq!(soup.objects.len(), 1);
     assert_eq!(soup.objects[0].name, "Outer/Base/Box");
     // Box: (2, 5, 0) under Outer at (10, 0, 0) → Unity (12, 5, 0) → soup (−12, 5, 0).
-    let c = soup.triangles.iter().flatten().copied().sum::<Vec3>() / 36.0;
+    let c = soup
+        .triangle_positions()
+        .iter()
+        .flatten()
+        .copied()
+        .sum::<Vec3>()
+        / 36.0;
     assert!(close(c, Vec3::new(-12.0, 5.0, 0.0), 1e-5), "{c}");
 }
 
@@ -621,7 +642,7 @@ fn children_of_a_missing_prefab_keep_its_placement() {
     sc.raw(&format!("--- !u!1001 &700\nPrefab:\n  m_Modification:\n    m_TransformParent: {{fileID: 0}}\n    m_Modifications:\n    - target: {{fileID: 400000, guid: {g}, type: 3}}\n      propertyPath: m_LocalPosition.x\n      value: 4\n      objectReference: {{fileID: 0}}\n    - target: {{fileID: 400000, guid: {g}, type: 3}}\n      propertyPath: m_LocalScale.x\n      value: 2\n      objectReference: {{fileID: 0}}\n    - target: {{fileID: 400000, guid: {g}, type: 3}}\n      propertyPath: m_LocalScale.y\n      value: 2\n      objectReference: {{fileID: 0}}\n    - target: {{fileID: 400000, guid: {g}, type: 3}}\n      propertyPath: m_LocalScale.z\n      value: 2\n      objectReference: {{fileID: 0}}\n  m_ParentPrefab: {{fileID: 100100000, guid: {g}, type: 3}}\n  m_IsPrefabParent: 0\n--- !u!4 &701 stripped\nTransform:\n  m_PrefabParentObject: {{fileID: 400000, guid: {g}, type: 3}}\n  m_PrefabInternal: {{fileID: 700}}\n"));
     sc.primitive("Child", &Tf::at(1.0, 0.0, 0.0), 701, CUBE);
     let soup = convert_scene(&sc.text);
-    let (lo, hi) = bounds(soup.triangles.iter().flatten().copied());
+    let (lo, hi) = bounds(soup.triangle_positions().iter().flatten().copied());
     assert!(
         close(lo, Vec3::new(-7.0, -1.0, -1.0), 1e-5) && close(hi, Vec3::new(-5.0, 1.0, 1.0), 1e-5),
         "{lo} {hi}"
@@ -657,9 +678,9 @@ fn unity5_forms_recttransform_hex_floats_and_model_scale() {
     assert_eq!(soup.objects[0].name, "Old");
     // File vertex (1, 2, 3) → scaled 0.5 → Unity (−0.5, 1, 1.5) + (3, 0, 0) → soup (−2.5, 1, 1.5).
     assert!(
-        close(soup.triangles[0][0], Vec3::new(-2.5, 1.0, 1.5), 1e-6),
+        close(soup.corners(0)[0], Vec3::new(-2.5, 1.0, 1.5), 1e-6),
         "{}",
-        soup.triangles[0][0]
+        soup.corners(0)[0]
     );
 }
 

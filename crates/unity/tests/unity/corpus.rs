@@ -324,7 +324,7 @@ fn object_bounds(soup: &formats::Soup, name: &str) -> (Vec3, Vec3) {
             )
         });
     bounds(
-        soup.triangles
+        soup.triangle_positions()
             .iter()
             .zip(&soup.tri_object)
             .filter(|(_, &o)| o as usize == idx)

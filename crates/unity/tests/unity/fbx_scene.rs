@@ -60,11 +60,11 @@ fn object_points(soup: &formats::Soup, name: &str) -> Vec<Vec3> {
         .iter()
         .position(|o| o.name == name)
         .unwrap_or_else(|| panic!("no {name}: {:?}", soup.objects));
-    soup.triangles
-        .iter()
+    soup.triangle_positions()
+        .into_iter()
         .zip(&soup.tri_object)
         .filter(|(_, &o)| o as usize == i)
-        .flat_map(|(t, _)| *t)
+        .flat_map(|(t, _)| t)
         .collect()
 }
 
@@ -124,11 +124,12 @@ fn fbx_instance_at_the_identity_keeps_the_files_coordinates_and_front() {
         assert!(has_point(&tri, p), "{p} not in {tri:?}");
     }
     let i = soup.objects.iter().position(|o| o.name == "m/Tri").unwrap();
-    let t = soup.triangles[soup
-        .tri_object
-        .iter()
-        .position(|&o| o as usize == i)
-        .unwrap()];
+    let t = soup.corners(
+        soup.tri_object
+            .iter()
+            .position(|&o| o as usize == i)
+            .unwrap(),
+    );
     let n = (t[1] - t[0]).cross(t[2] - t[0]);
     assert!(n.dot(Vec3::ONE) > 0.0, "front faces (1, 1, 1): {t:?}");
     // The quad: y = 2, x and z in [0, 1].

@@ -168,6 +168,13 @@ pub fn convert_scene(text: &str) -> formats::Soup {
     convert(&root.join("Assets/s.unity"))
 }
 
+/// The shading normals at each triangle's corners, in soup order.
+pub fn corner_normals(soup: &formats::Soup) -> Vec<[glam::Vec3; 3]> {
+    (0..soup.triangle_count())
+        .map(|t| soup.corner_normals(t))
+        .collect()
+}
+
 pub fn bounds(pts: impl Iterator<Item = glam::Vec3>) -> (glam::Vec3, glam::Vec3) {
     pts.fold(
         (glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN)),

@@ -257,7 +257,7 @@ const QUADRANT_TEXELS: [u8; 16] = [
 fn assert_quad_uvs(soup: &formats::Soup, triangles: std::ops::Range<usize>) {
     for t in triangles {
         for k in 0..3 {
-            let (p, uv) = (soup.triangles[t][k], soup.uvs[t][k]);
+            let (p, uv) = (soup.corners(t)[k], soup.corner_uvs(t)[k]);
             assert_eq!(
                 [uv.x, uv.y],
                 [0.5 - p.x, p.y + 0.5],
@@ -284,7 +284,7 @@ fn quadrant_texture_point_filtered_upright_on_the_quad() {
     assert_eq!(map.texture, 0);
     assert_eq!(map.tiling, formats::texture::Tiling::default());
     assert_eq!((m.alpha, m.opacity), (formats::Alpha::Opaque, 1.0));
-    assert_eq!(soup.uvs.len(), 2);
+    assert_eq!((soup.positions.len(), soup.uvs.len()), (4, 4));
     assert_quad_uvs(&soup, 0..2);
     // The soup survives its own reader's validation.
     let dir = tempfile::tempdir().unwrap();
@@ -333,15 +333,14 @@ fn cutout_quad_before_a_plain_wall() {
         [255, 200, 0, 0, 255, 200, 0, 255, 255, 200, 0, 0, 255, 200, 0, 255]
     );
     // The wall comes first and is untextured: its corners are zero, the Quad's are its own.
-    assert_eq!(soup.uvs.len(), soup.triangles.len());
+    assert_eq!(soup.uvs.len(), soup.positions.len());
     let quad: Vec<usize> = (0..soup.triangles.len())
         .filter(|&i| soup.tri_material[i] as usize == cut)
         .collect();
     assert_eq!(quad, vec![2, 3]);
-    assert!(soup.uvs[..2]
-        .iter()
-        .flatten()
-        .all(|uv| *uv == glam::Vec2::ZERO));
+    assert!((0..2)
+        .flat_map(|t| soup.corner_uvs(t))
+        .all(|uv| uv == glam::Vec2::ZERO));
     assert_quad_uvs(&soup, 2..4);
     let wall = &soup.materials[soup.tri_material[0] as usize];
     assert_eq!(
@@ -454,7 +453,7 @@ fn corpus_model_textures_are_found_and_shared() {
         .find(|m| m.name == "Material_Main_Transparent")
         .unwrap();
     assert_eq!(glass.alpha, formats::Alpha::Blend);
-    assert_eq!(soup.uvs.len(), soup.triangles.len());
+    assert_eq!(soup.uvs.len(), soup.positions.len());
 
     let soup = unity::convert(
         &root.join("Pjaerr__GDSJam-Reflection/Assets/Scenes/Tutorial.unity"),
