@@ -64,6 +64,8 @@ pub(crate) struct Emitter<'g, 'p> {
     pub(crate) lod_camera: Option<(Vec3, formats::Projection)>,
     /// Renderers not drawn by Unity's own rules, one line each for `--list`.
     pub(crate) skipped: Vec<String>,
+    /// The meshes drawn so far, placed into the soup at the end.
+    pub(crate) placements: crate::renderer::Placements,
 }
 
 /// What [`emit`] produces.
@@ -100,6 +102,7 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
         camera_mask: crate::layer::EVERYTHING,
         lod_camera: None,
         skipped: Vec::new(),
+        placements: Default::default(),
     };
     e.soup.warnings = g.warnings.clone();
     for (i, o) in g.objs.iter().enumerate() {
@@ -163,6 +166,8 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
     {
         e.soup.environment.ambient = ambient;
     }
+    let placements = std::mem::take(&mut e.placements);
+    placements.fill(&mut e.soup, &mut e.material_origins);
     e.soup.seal();
     Ok(Emitted {
         soup: e.soup,

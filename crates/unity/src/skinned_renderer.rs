@@ -34,10 +34,10 @@ impl Emitter<'_, '_> {
             }
         };
         match posed {
-            Some(m) => self.draw(go, &m, source, Mat4::IDENTITY, smr),
+            Some(m) => self.draw(go, std::sync::Arc::new(m), source, Mat4::IDENTITY, smr),
             None => {
                 let world = self.checked_world(go)?;
-                self.draw(go, &mesh, source, world, smr)
+                self.draw(go, mesh, source, world, smr)
             }
         }
     }

@@ -535,6 +535,25 @@ fn degenerate_triangles_are_dropped_and_counted() {
     assert_eq!(soup.dropped_degenerate, 2);
 }
 
+/// An object whose triangles are all degenerate is dropped, and the objects after it are
+/// renumbered so that object indices stay dense.
+#[test]
+fn an_object_of_degenerate_triangles_is_dropped_and_the_next_renumbered() {
+    let obj = "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\nf 3 2 1\n";
+    let mut sc = model_scene("Flat");
+    sc.primitive("Box", &Tf::at(5.0, 0.0, 0.0), 0, CUBE);
+    let (_d, scene) = obj_project("Assets/d.obj", obj, "Assets/s.unity", &sc.text);
+    let report = unity::convert_report(&scene, &unity::Options::default()).unwrap();
+    let soup = &report.soup;
+    assert_eq!(soup.dropped_degenerate, 2);
+    let names: Vec<&str> = soup.objects.iter().map(|o| o.name.as_str()).collect();
+    assert_eq!(names, ["Box"]);
+    assert_eq!(report.material_origins.len(), 1);
+    assert_eq!(soup.triangles.len(), 12);
+    assert!(soup.tri_object.iter().all(|&o| o == 0));
+    soup.validate().unwrap();
+}
+
 /// UVs follow the positions through the winding flip and the squeezing out of degenerate
 /// triangles: each kept corner keeps its own vertex's UV.
 #[test]

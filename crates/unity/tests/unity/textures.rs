@@ -332,15 +332,24 @@ fn cutout_quad_before_a_plain_wall() {
         t.texels,
         [255, 200, 0, 0, 255, 200, 0, 255, 255, 200, 0, 0, 255, 200, 0, 255]
     );
-    // The wall comes first and is untextured: its corners are zero, the Quad's are its own.
+    // The wall comes first and is untextured; once a material is textured, every vertex
+    // carries its mesh's UVs, the wall's too.
     assert_eq!(soup.uvs.len(), soup.positions.len());
     let quad: Vec<usize> = (0..soup.triangles.len())
         .filter(|&i| soup.tri_material[i] as usize == cut)
         .collect();
     assert_eq!(quad, vec![2, 3]);
-    assert!((0..2)
+    let mut wall_uvs: Vec<[f32; 2]> = (0..2)
         .flat_map(|t| soup.corner_uvs(t))
-        .all(|uv| uv == glam::Vec2::ZERO));
+        .map(|uv| [uv.x, uv.y])
+        .collect();
+    wall_uvs.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    wall_uvs.dedup();
+    assert_eq!(
+        wall_uvs,
+        [[0.0, 0.0], [0.0, 1.0], [1.0, 0.0], [1.0, 1.0]],
+        "the wall Quad's own corners"
+    );
     assert_quad_uvs(&soup, 2..4);
     let wall = &soup.materials[soup.tri_material[0] as usize];
     assert_eq!(
