@@ -612,7 +612,7 @@ impl Importer {
         });
         Some(ModelMesh {
             name,
-            mesh,
+            mesh: Arc::new(mesh),
             materials,
             skin,
         })

@@ -94,7 +94,7 @@ impl Emitter<'_, '_> {
         let m = self
             .meshes
             .entry(key)
-            .or_insert_with(|| Some(Arc::new(mesh.mesh.clone())))
+            .or_insert_with(|| Some(mesh.mesh.clone()))
             .clone()
             .ok_or("mesh missing")?;
         Ok((m, format!("{rel}#{}", mesh.name)))

@@ -9,6 +9,7 @@
 
 use crate::mesh::Mesh;
 use glam::{Quat, Vec3};
+use std::sync::Arc;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct ModelNode {
@@ -30,8 +31,9 @@ pub struct ModelNode {
 pub struct ModelMesh {
     /// The Mesh asset's name (what `Type:Mesh-><name>` hashes).
     pub name: String,
-    /// Vertices in the node's frame, Unity space.
-    pub mesh: Mesh,
+    /// Vertices in the node's frame, Unity space. Shared: every object drawing it
+    /// reads this one copy.
+    pub mesh: Arc<Mesh>,
     /// The model's own material name for each sub-mesh (`""` when the file names none).
     pub materials: Vec<String>,
     /// Skinning data when the mesh is deformed by bones.
@@ -80,7 +82,8 @@ impl Model {
             n.translation *= s;
         }
         for m in &mut self.meshes {
-            m.mesh = std::mem::take(&mut m.mesh).scaled(s);
+            let mesh = Arc::make_mut(&mut m.mesh);
+            *mesh = std::mem::take(mesh).scaled(s);
         }
     }
 

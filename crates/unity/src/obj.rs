@@ -84,7 +84,7 @@ impl ObjModel {
             .iter()
             .map(|g| ModelMesh {
                 name: g.name.clone(),
-                mesh: g.mesh.clone(),
+                mesh: std::sync::Arc::new(g.mesh.clone()),
                 materials: g.materials.clone(),
                 skin: None,
             })
