@@ -24,7 +24,7 @@ const TUBE: u32 = 64;
 pub const TRIANGLES_PER_MODEL: usize = PARTS * 2 * (RING * TUBE) as usize;
 // The default scene (16 models) is the million-triangle test.
 const _: () = assert!(16 * TRIANGLES_PER_MODEL >= 1_000_000);
-/// Prefab instances of each model.
+/// Prefab instances of each model, unless told otherwise.
 pub const INSTANCES: usize = 2;
 /// Grid spacing of the instances (a model spans about 5 m).
 const SPACING: f32 = 7.0;
@@ -123,8 +123,9 @@ pub fn model_file(k: usize, compress: bool) -> Vec<u8> {
     })
 }
 
-/// The project with `models` (at least 1) distinct FBX models, compressed or raw.
-pub fn project(models: usize, compress: bool) -> Project {
+/// The project with `models` (at least 1) distinct FBX models, compressed or raw, each
+/// placed `instances` times (at least 1).
+pub fn project(models: usize, instances: usize, compress: bool) -> Project {
     let models = models.max(1);
     let mut p = Project::new(NAME);
     let floor = p.add_asset(
@@ -138,7 +139,7 @@ pub fn project(models: usize, compress: bool) -> Project {
             p.add_binary_asset(&path, model_file(k, compress), meta::model)
         })
         .collect();
-    let count = models * INSTANCES;
+    let count = models * instances.max(1);
     let side = (count as f32).sqrt().ceil() as usize;
     let width = SPACING * side as f32;
     let centre = |i: usize| (i as f32 - (side as f32 - 1.0) / 2.0) * SPACING;
@@ -236,8 +237,17 @@ mod tests {
     }
 
     #[test]
+    fn instances_say_how_often_each_model_is_placed() {
+        for (models, instances) in [(2, 1), (3, 4)] {
+            let p = project(models, instances, false);
+            let scene = String::from_utf8(p.files[SCENE_PATH].clone()).unwrap();
+            assert_eq!(scene.matches("--- !u!1001 &").count(), models * instances);
+        }
+    }
+
+    #[test]
     fn scene_places_each_model_twice_as_a_prefab_with_a_camera_and_a_sun() {
-        let p = project(3, false);
+        let p = project(3, INSTANCES, false);
         let scene = String::from_utf8(p.files[SCENE_PATH].clone()).unwrap();
         assert_eq!(scene.matches("--- !u!1001 &").count(), 3 * INSTANCES);
         assert_eq!(scene.matches("--- !u!20 &").count(), 1);

@@ -20,13 +20,17 @@ struct Args {
     #[arg(long, value_name = "SIDE", conflicts_with = "only")]
     large: Option<usize>,
     /// Write only the FBX scale-test project `fbxlarge`: MODELS distinct binary FBX
-    /// models of 65,536 triangles, each placed twice (16 gives 1,048,576 triangles in
-    /// the files).
+    /// models of 65,536 triangles, each placed twice unless `--instances` says otherwise
+    /// (16 gives 1,048,576 triangles in the files).
     #[arg(long, value_name = "MODELS", conflicts_with_all = ["only", "large"])]
     fbx: Option<usize>,
     /// With `--fbx`: deflate the models' arrays, as exporters write them.
     #[arg(long, requires = "fbx")]
     deflate: bool,
+    /// With `--fbx`: place each model this many times (1: every triangle of the scene is
+    /// read from a file).
+    #[arg(long, requires = "fbx", default_value_t = scenegen::fbx_scene::INSTANCES)]
+    instances: usize,
 }
 
 fn main() {
@@ -40,7 +44,11 @@ fn run() -> Result<()> {
     let args = Args::parse();
     let projects: Vec<_> = match (args.large, args.fbx) {
         (Some(side), _) => vec![scenegen::baseline::large(side)],
-        (None, Some(models)) => vec![scenegen::fbx_scene::project(models, args.deflate)],
+        (None, Some(models)) => vec![scenegen::fbx_scene::project(
+            models,
+            args.instances,
+            args.deflate,
+        )],
         (None, None) => scenegen::all_projects()
             .into_iter()
             .filter(|p| args.only.as_deref().is_none_or(|o| o == p.name))
