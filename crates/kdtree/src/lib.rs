@@ -25,6 +25,7 @@ pub mod triangle;
 use aabb::Aabb;
 use formats::{BuildParams, KdFile, KdNode, Soup};
 use glam::Vec3;
+use rayon::prelude::*;
 
 pub use build::events::MAX_TRIANGLES;
 pub use build::median::build_median;
@@ -112,7 +113,7 @@ impl Accel {
     /// `count` triangles, the corners of each given by `corners`.
     fn assemble(
         count: usize,
-        corners: impl Fn(usize) -> [Vec3; 3],
+        corners: impl Fn(usize) -> [Vec3; 3] + Sync,
         kd: &KdFile,
     ) -> Result<Accel, AccelError> {
         kd.validate()
@@ -273,7 +274,7 @@ pub struct Renumbered {
 /// soup indices).
 pub fn renumber(
     count: usize,
-    corners: impl Fn(usize) -> [Vec3; 3],
+    corners: impl Fn(usize) -> [Vec3; 3] + Sync,
     leaf_tris: &[u32],
 ) -> Renumbered {
     let mut slot = vec![u32::MAX; count];
@@ -289,8 +290,11 @@ pub fn renumber(
             *s
         })
         .collect();
+    // The numbering is sequential by nature; gathering the corners in the new order (a
+    // read from anywhere in the soup per triangle) is not.
     let tris = soup_index
-        .iter()
+        .par_iter()
+        .with_min_len(1 << 14)
         .map(|&p| corners(p as usize).map(|v| v.to_array()))
         .collect();
     Renumbered {
