@@ -329,20 +329,23 @@ fn geometry_hash_depends_on_positions_only() {
     );
 }
 
+/// `sample_soup` edited by `edit` (its geometry hash recomputed) is refused on read with a
+/// message containing `want`.
+fn refused(edit: &dyn Fn(&mut Soup), want: &str) {
+    let p = Path::new("edited.soup");
+    let mut s = sample_soup();
+    edit(&mut s);
+    s.seal();
+    let msg = Soup::from_bytes(&s.to_bytes(p).unwrap(), p)
+        .unwrap_err()
+        .to_string();
+    assert!(msg.contains(want), "{want}: {msg}");
+}
+
 /// Every index a reader follows is checked on read: a triangle naming a vertex past the
 /// end, or a vertex without its normal.
 #[test]
 fn triangles_naming_missing_vertices_are_corrupt() {
-    let p = Path::new("idx.soup");
-    let refused = |edit: &dyn Fn(&mut Soup), want: &str| {
-        let mut s = sample_soup();
-        edit(&mut s);
-        s.seal();
-        let msg = Soup::from_bytes(&s.to_bytes(p).unwrap(), p)
-            .unwrap_err()
-            .to_string();
-        assert!(msg.contains(want), "{want}: {msg}");
-    };
     refused(
         &|s| s.triangles[1][2] = 5,
         "triangle 1 names vertices [3, 1, 5] of 5",
@@ -494,15 +497,6 @@ fn an_object_on_layer_32_is_corrupt() {
 /// Each texture cross-reference a lookup would index or divide by is checked on read.
 #[test]
 fn bad_texture_references_are_corrupt() {
-    let p = Path::new("tex.soup");
-    let refused = |edit: &dyn Fn(&mut Soup), want: &str| {
-        let mut s = sample_soup();
-        edit(&mut s);
-        let msg = Soup::from_bytes(&s.to_bytes(p).unwrap(), p)
-            .unwrap_err()
-            .to_string();
-        assert!(msg.contains(want), "{want}: {msg}");
-    };
     refused(&|s| s.uvs.pop().map(drop).unwrap(), "5 vertices but 4 UVs");
     refused(&|s| s.uvs.clear(), "(a material has a texture)");
     refused(&|s| s.uvs[4].y = f32::NAN, "vertex 4 has a non-finite UV");
@@ -524,6 +518,7 @@ fn bad_texture_references_are_corrupt() {
     let mut s = sample_soup();
     s.materials[0].albedo_map = None;
     s.uvs.clear();
+    let p = Path::new("tex.soup");
     assert_eq!(Soup::from_bytes(&s.to_bytes(p).unwrap(), p).unwrap(), s);
 }
 

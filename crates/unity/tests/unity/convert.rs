@@ -105,13 +105,7 @@ fn object_at_unity_plus_x_is_right_of_the_camera() {
     let cam = &soup.camera;
     assert_eq!(cam.forward, Vec3::Z);
     assert_eq!(cam.up, Vec3::Y);
-    let centre = soup
-        .triangle_positions()
-        .iter()
-        .flatten()
-        .copied()
-        .sum::<Vec3>()
-        / (soup.triangles.len() * 3) as f32;
+    let centre = corner_mean(&soup);
     assert!(
         close(centre, Vec3::new(-3.0, 0.0, 10.0), 1e-4),
         "soup x is negated: {centre}"
@@ -641,13 +635,7 @@ fn nested_prefabs_apply_overrides_outermost_last() {
     assert_eq!(soup.objects.len(), 1);
     assert_eq!(soup.objects[0].name, "Outer/Base/Box");
     // Box: (2, 5, 0) under Outer at (10, 0, 0) → Unity (12, 5, 0) → soup (−12, 5, 0).
-    let c = soup
-        .triangle_positions()
-        .iter()
-        .flatten()
-        .copied()
-        .sum::<Vec3>()
-        / 36.0;
+    let c = corner_mean(&soup);
     assert!(close(c, Vec3::new(-12.0, 5.0, 0.0), 1e-5), "{c}");
 }
 

@@ -175,6 +175,12 @@ pub fn corner_normals(soup: &formats::Soup) -> Vec<[glam::Vec3; 3]> {
         .collect()
 }
 
+/// The mean of every triangle's corners.
+pub fn corner_mean(soup: &formats::Soup) -> glam::Vec3 {
+    let corners = soup.triangle_positions();
+    corners.iter().flatten().copied().sum::<glam::Vec3>() / (corners.len() * 3) as f32
+}
+
 pub fn bounds(pts: impl Iterator<Item = glam::Vec3>) -> (glam::Vec3, glam::Vec3) {
     pts.fold(
         (glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN)),
