@@ -228,6 +228,45 @@ fn truncated_foreign_old_and_corrupt_files_are_named_errors() {
     }
 }
 
+/// Files of a mebibyte and more are mapped rather than read: the same tree comes back, and
+/// a flipped byte, a cut-off end or stray bytes are the same named errors as in memory.
+#[test]
+fn large_files_read_through_a_mapping_as_small_ones_do() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("big.kd");
+    let mut k = sample_kd();
+    // Two leaves listing 150,000 triangles each: 1.2 MB of leaf lists.
+    k.leaf_tris = (0..300_000u32).map(|i| i % 2).collect();
+    k.nodes = vec![
+        KdNode::interior(0, 0.5, 2),
+        KdNode::leaf(150_000, 0),
+        KdNode::leaf(150_000, 150_000),
+    ];
+    k.write(&path).unwrap();
+    let len = std::fs::metadata(&path).unwrap().len();
+    assert!(len > 1 << 20, "{len} bytes: below the mapping threshold");
+    assert_eq!(KdFile::read(&path).unwrap(), k);
+    let good = std::fs::read(&path).unwrap();
+    let cases: [(Vec<u8>, &str); 3] = [
+        (
+            {
+                let mut b = good.clone();
+                b[good.len() / 2] ^= 1;
+                b
+            },
+            "checksum",
+        ),
+        (good[..good.len() - 4].to_vec(), "truncated"),
+        ([&good[..], &[0u8; 3]].concat(), "3 stray bytes"),
+    ];
+    for (bytes, want) in cases {
+        std::fs::write(&path, &bytes).unwrap();
+        let msg = KdFile::read(&path).unwrap_err().to_string();
+        assert!(msg.starts_with(&path.display().to_string()), "{msg}");
+        assert!(msg.contains(want), "{msg} should mention {want}");
+    }
+}
+
 #[test]
 fn a_length_field_claiming_a_trillion_elements_fails_fast() {
     // A valid frame whose payload claims 10^12 triangles: the checksum is recomputed so
