@@ -150,6 +150,20 @@ fn max3(a: f32, b: f32, c: f32) -> f32 {
     a.abs().max(b.abs()).max(c.abs())
 }
 
+/// [`max3`] on four lanes, with `f32::max`'s answer where a lane is NaN (the other value),
+/// which a plain vector maximum does not give.
+#[inline(always)]
+fn max3_4(a: Vec4, b: Vec4, c: Vec4) -> Vec4 {
+    let max = |x: Vec4, y: Vec4| {
+        Vec4::select(
+            x.is_nan_mask(),
+            y,
+            Vec4::select(y.is_nan_mask(), x, x.max(y)),
+        )
+    };
+    max(max(a.abs(), b.abs()), c.abs())
+}
+
 /// γₙ = n·u / (1 − n·u), u = 2⁻²⁴: Higham's bound on n roundings.
 const fn gamma(n: i32) -> f32 {
     let u = f32::EPSILON * 0.5;
@@ -304,10 +318,10 @@ fn gather4(tri: [&[[f32; 3]; 3]; 4]) -> [[Vec4; 3]; 3] {
     }
 }
 
-/// [`intersect_along`] for four triangles at once: the edge functions on four-lane vectors
-/// (glam's `Vec4`, SSE on x86_64), the rest lane by lane with masks instead of early
-/// returns. Written lane by lane, the edge functions' compares were not vectorised (200
-/// instructions a ray on the bunny's surface rays). Each lane's arithmetic is the
+/// [`intersect_along`] for four triangles at once, on four-lane vectors (glam's `Vec4`, SSE
+/// on x86_64) with masks instead of early returns; only the rare bound on a very near
+/// hit's rounding is worked out lane by lane. Written lane by lane, the compiler left the
+/// compares scalar (200 instructions a ray on the bunny's surface rays). Each lane's arithmetic is the
 /// scalar test's, in the same order, so each lane's answer has the same bits as
 /// `intersect_along` on that triangle (lanes that miss compute values nobody reads); a
 /// group with an edge function exactly zero is handed to the scalar test whole, for its
@@ -362,50 +376,49 @@ pub fn intersect4_along<const KZ: usize>(
     if outside == 0b1111 {
         return out;
     }
-    let inside: [bool; 4] = std::array::from_fn(|l| outside >> l & 1 == 0);
-    let (az, bz, cz) = (az.to_array(), bz.to_array(), cz.to_array());
-    let (ax, ay, bx, by, cx, cy) = (
-        ax.to_array(),
-        ay.to_array(),
-        bx.to_array(),
-        by.to_array(),
-        cx.to_array(),
-        cy.to_array(),
-    );
-    let (u, v, w) = (u.to_array(), v.to_array(), w.to_array());
-    // `finish`, lane by lane, with its early returns as masks.
-    let mut near = [false; 4];
-    let mut max_z = [0f32; 4];
-    let mut inv = [0f32; 4];
-    for l in 0..4 {
-        let det = u[l] + v[l] + w[l];
-        let (zu, zv, zw) = (sz * az[l], sz * bz[l], sz * cz[l]);
-        let tt = u[l] * zu + v[l] * zv + w[l] * zw;
-        let negative = det < 0.0;
-        let tt = if negative { -tt } else { tt };
-        let adet = if negative { -det } else { det };
-        let t = tt / adet;
-        inv[l] = 1.0 / det;
-        max_z[l] = max3(zu, zv, zw);
-        near[l] = t < max_z[l] * (1.0 / 1024.0);
-        out.hit[l] = inside[l]
-            & (det != 0.0)
-            & !det.is_nan()
-            & (tt >= tmin * adet)
-            & (tt <= tmax * adet)
-            & (t >= tmin)
-            & (t <= tmax);
-        out.t[l] = t;
-        out.u[l] = v[l] * inv[l];
-        out.v[l] = w[l] * inv[l];
-        out.front[l] = faces_front(det, sz);
-    }
-    for l in 0..4 {
-        if out.hit[l] && near[l] {
+    // `finish` on four lanes, its early returns as masks.
+    let det = u + v + w;
+    let (zu, zv, zw) = (sz * az, sz * bz, sz * cz);
+    let tt = u * zu + v * zv + w * zw;
+    let negative = det.cmplt(z);
+    let tt = Vec4::select(negative, -tt, tt);
+    let adet = Vec4::select(negative, -det, det);
+    let t = tt / adet;
+    let inv = Vec4::ONE / det;
+    let max_z = max3_4(zu, zv, zw);
+    let near = t.cmplt(max_z * (1.0 / 1024.0));
+    let (tmin4, tmax4) = (Vec4::splat(tmin), Vec4::splat(tmax));
+    let hit = det.cmpne(z)
+        & !det.is_nan_mask()
+        & tt.cmpge(tmin4 * adet)
+        & tt.cmple(tmax4 * adet)
+        & t.cmpge(tmin4)
+        & t.cmple(tmax4);
+    let mut hit = hit.bitmask() & !outside;
+    // `faces_front`: the determinant's sign folded with the dominant axis's.
+    let front = if sz < 0.0 {
+        negative.bitmask()
+    } else {
+        !negative.bitmask()
+    };
+    let (t, inv) = (t.to_array(), inv.to_array());
+    let near_hits = hit & near.bitmask();
+    if near_hits != 0 {
+        let (max_z, uvw) = (max_z.to_array(), [u, v, w].map(|x| x.to_array()));
+        let [ax, ay, bx, by, cx, cy] = [ax, ay, bx, by, cx, cy].map(|x| x.to_array());
+        for l in (0..4).filter(|l| near_hits >> l & 1 != 0) {
             let xy = [max3(ax[l], bx[l], cx[l]), max3(ay[l], by[l], cy[l])];
-            out.hit[l] = out.t[l] > t_error([u[l], v[l], w[l]], max_z[l], xy, inv[l]);
+            let e = [uvw[0][l], uvw[1][l], uvw[2][l]];
+            if !(t[l] > t_error(e, max_z[l], xy, inv[l])) {
+                hit &= !(1 << l);
+            }
         }
     }
+    out.hit = std::array::from_fn(|l| hit >> l & 1 != 0);
+    out.front = std::array::from_fn(|l| front >> l & 1 != 0);
+    out.t = t;
+    out.u = (v * Vec4::from(inv)).to_array();
+    out.v = (w * Vec4::from(inv)).to_array();
     out
 }
 
@@ -465,6 +478,40 @@ mod tests {
             }
         }
         assert_eq!(checked, 12);
+    }
+
+    /// The four-lane maximum answers as `max3` in every lane, NaN and infinities included
+    /// (a plain vector maximum would pass a NaN in its second operand through).
+    #[test]
+    fn four_lane_max3_is_max3_lane_by_lane() {
+        let values = [
+            0.0,
+            -0.0,
+            1.5,
+            -2.0,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+            3e38,
+        ];
+        for &a in &values {
+            for &b in &values {
+                for &c in &values {
+                    let four = max3_4(Vec4::splat(a), Vec4::new(b, c, a, b), Vec4::new(c, a, b, c));
+                    let want = [max3(a, b, c), max3(a, c, a), max3(a, a, b), max3(a, b, c)];
+                    let got = four.to_array();
+                    for l in 0..4 {
+                        assert!(
+                            got[l].to_bits() == want[l].to_bits()
+                                || (got[l].is_nan() && want[l].is_nan()),
+                            "{a} {b} {c} lane {l}: {} against {}",
+                            got[l],
+                            want[l]
+                        );
+                    }
+                }
+            }
+        }
     }
 
     #[test]
