@@ -56,7 +56,7 @@ impl PlainAccel {
             tris,
             soup_index,
             leaf_tris,
-        } = kdtree::renumber(triangles.len(), |t| triangles[t], &kd.leaf_tris);
+        } = kdtree::renumber(triangles.len(), |t| triangles[t], kd.leaf_tris.clone());
         Ok(PlainAccel {
             tris,
             soup_index,

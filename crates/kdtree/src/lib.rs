@@ -80,8 +80,10 @@ pub struct Accel {
 }
 
 impl Accel {
-    /// Pair a soup with its tree; refuses a tree built from other geometry.
-    pub fn new(soup: &Soup, kd: &KdFile) -> Result<Accel, AccelError> {
+    /// Pair a soup with its tree; refuses a tree built from other geometry. The tree's
+    /// arrays become the accelerator's (its leaf lists renumbered in place), so a large
+    /// scene's nodes and lists are not held twice.
+    pub fn new(soup: &Soup, kd: KdFile) -> Result<Accel, AccelError> {
         if soup.geometry_hash != kd.geometry_hash {
             return Err(AccelError::HashMismatch {
                 tree: formats::hex(&kd.geometry_hash),
@@ -100,13 +102,13 @@ impl Accel {
                 soup: formats::hex(&hash),
             });
         }
-        Self::assemble(triangles.len(), |t| triangles[t], kd)
+        Self::assemble(triangles.len(), |t| triangles[t], kd.clone())
     }
 
     /// Build a tree with `params` and wrap it (tests, benchmarks, tools).
     pub fn build(triangles: &[[Vec3; 3]], params: &BuildParams) -> Accel {
         let kd = build(triangles, params, formats::soup::geometry_hash(triangles));
-        Self::assemble(triangles.len(), |t| triangles[t], &kd)
+        Self::assemble(triangles.len(), |t| triangles[t], kd)
             .expect("a freshly built tree fits its triangles")
     }
 
@@ -114,7 +116,7 @@ impl Accel {
     fn assemble(
         count: usize,
         corners: impl Fn(usize) -> [Vec3; 3] + Sync,
-        kd: &KdFile,
+        kd: KdFile,
     ) -> Result<Accel, AccelError> {
         kd.validate()
             .map_err(|detail| AccelError::Corrupt { detail })?;
@@ -131,20 +133,21 @@ impl Accel {
         if height > max {
             return Err(AccelError::TooDeep { depth: height, max });
         }
+        let bounds = kd.bounds;
         let Renumbered {
             tris,
             soup_index,
             leaf_tris,
-        } = renumber(count, corners, &kd.leaf_tris);
+        } = renumber(count, corners, kd.leaf_tris);
         Ok(Accel {
             tris,
             soup_index,
-            nodes: kd.nodes.clone(),
+            nodes: kd.nodes,
             leaf_tris,
             input_triangles: count,
             bounds: Aabb {
-                lo: kd.bounds[0].to_array(),
-                hi: kd.bounds[1].to_array(),
+                lo: bounds[0].to_array(),
+                hi: bounds[1].to_array(),
             },
         })
     }
@@ -271,25 +274,22 @@ pub struct Renumbered {
 }
 
 /// Renumber `triangles` by their first appearance in `leaf_tris` (a tree's leaf lists in
-/// soup indices).
+/// soup indices, renumbered in place).
 pub fn renumber(
     count: usize,
     corners: impl Fn(usize) -> [Vec3; 3] + Sync,
-    leaf_tris: &[u32],
+    mut leaf_tris: Vec<u32>,
 ) -> Renumbered {
     let mut slot = vec![u32::MAX; count];
     let mut soup_index = Vec::with_capacity(count);
-    let leaf_tris = leaf_tris
-        .iter()
-        .map(|&p| {
-            let s = &mut slot[p as usize];
-            if *s == u32::MAX {
-                *s = soup_index.len() as u32;
-                soup_index.push(p);
-            }
-            *s
-        })
-        .collect();
+    for p in &mut leaf_tris {
+        let s = &mut slot[*p as usize];
+        if *s == u32::MAX {
+            *s = soup_index.len() as u32;
+            soup_index.push(*p);
+        }
+        *p = *s;
+    }
     // The numbering is sequential by nature; gathering the corners in the new order (a
     // read from anywhere in the soup per triangle) is not.
     let tris = soup_index

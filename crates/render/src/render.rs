@@ -50,7 +50,7 @@ pub fn render_scene(
     opts: &RenderOptions,
 ) -> Result<(Rendered, Plan), RenderError> {
     opts.validate()?;
-    let accel = Accel::new(soup, kd)?;
+    let accel = Accel::new(soup, kd.clone())?;
     let plan = Plan::derive(soup, opts);
     let out = render(soup, &accel, &plan, opts, None)?;
     Ok((out, plan))

@@ -186,7 +186,7 @@ pub fn reference(
 /// Measure one scene. `log` receives one line per finished point.
 pub fn measure(scene: &Scene, cfg: &Config, log: &dyn Fn(&str)) -> Result<SceneResult> {
     let (kd, sah_build) = sah_tree(scene);
-    let accel = Accel::new(&scene.soup, &kd)
+    let accel = Accel::new(&scene.soup, kd.clone())
         .with_context(|| format!("scene {}: SAH tree does not fit", scene.name))?;
     let (w, h) = (cfg.width as usize, cfg.height as usize);
     let (reference, reference_rays, reference_seconds) = reference(scene, &accel, cfg)?;
@@ -291,7 +291,7 @@ pub fn measure(scene: &Scene, cfg: &Config, log: &dyn Fn(&str)) -> Result<SceneR
     let b = Some(sah_build);
     point("tree", "SAH".into(), true, &accel, &base, b, None)?;
     let (mkd, median_build) = median_tree(scene);
-    let maccel = Accel::new(&scene.soup, &mkd)
+    let maccel = Accel::new(&scene.soup, mkd)
         .with_context(|| format!("scene {}: median tree does not fit", scene.name))?;
     let b = Some(median_build);
     point("tree", "median".into(), false, &maccel, &base, b, None)?;

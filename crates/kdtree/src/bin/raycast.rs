@@ -43,7 +43,7 @@ fn run(cli: Cli) -> Result<()> {
     }
     let soup = Soup::read(&cli.soup)?;
     let kd = KdFile::read(&cli.kd)?;
-    let accel = Accel::new(&soup, &kd)
+    let accel = Accel::new(&soup, kd)
         .with_context(|| format!("{} does not fit {}", cli.kd.display(), cli.soup.display()))?;
     let input = rays::read_rays(&cli.rays)?;
     let start = Instant::now();

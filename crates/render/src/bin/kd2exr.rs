@@ -221,7 +221,8 @@ fn run(a: RenderArgs) -> Result<()> {
         .context("the soup's envelope header")?;
     drop(soup_bytes);
     let kd = KdFile::read(&kd_path)?;
-    let accel = kdtree::Accel::new(&soup, &kd)
+    let params = kd.params;
+    let accel = kdtree::Accel::new(&soup, kd)
         .with_context(|| format!("{} and {}", soup_path.display(), kd_path.display()))?;
     let load_seconds = t_load.elapsed().as_secs_f64();
 
@@ -253,7 +254,7 @@ fn run(a: RenderArgs) -> Result<()> {
     }
 
     let mut attrs = render::header_attributes(&plan, &opts, out.seconds, &soup.geometry_hash);
-    attrs.extend(render::source_attributes(&soup_digest, &kd.params));
+    attrs.extend(render::source_attributes(&soup_digest, &params));
     // The EXR's compression and the PNG's are independent: one thread each (the EXR also
     // spreads its blocks over whatever threads are free).
     let t_write = Instant::now();

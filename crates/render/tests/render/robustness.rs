@@ -50,7 +50,7 @@ fn spawned_rays_never_rehit_their_own_triangle() {
             b.soup.tri_material.push(m);
             b.soup.tri_object.push(0);
             let (soup, kd) = b.build();
-            let accel = Accel::new(&soup, &kd).unwrap();
+            let accel = Accel::new(&soup, kd).unwrap();
             let mut spawned = 0;
             for _ in 0..2500 {
                 // Aim a primary ray at a random interior point, from a random side.
