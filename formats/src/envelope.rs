@@ -384,8 +384,9 @@ pub fn read_file(path: &Path) -> Result<FileBytes, FormatError> {
     // unitrace never changes an artifact in place: every writer writes a temporary file
     // and renames (or exchanges) it over the old name, which leaves the mapped file (the
     // old inode) as it was. Another program truncating the very file we map would stop
-    // this process with SIGBUS; rewriting it in place would at worst make the checksum
-    // or the decoder refuse it, as for any corrupt file.
+    // this process with SIGBUS, and one rewriting it in place while it is read could hand
+    // the decoder bytes that changed after the checksum was verified; nothing of ours
+    // does either.
     let map = unsafe { memmap2::MmapOptions::new().map(&file) }.map_err(io)?;
     Ok(FileBytes::Mapped(map))
 }

@@ -401,6 +401,8 @@ pub fn intersect4_along<const KZ: usize>(
     } else {
         !negative.bitmask()
     };
+    out.u = (v * inv).to_array();
+    out.v = (w * inv).to_array();
     let (t, inv) = (t.to_array(), inv.to_array());
     let near_hits = hit & near.bitmask();
     if near_hits != 0 {
@@ -417,8 +419,6 @@ pub fn intersect4_along<const KZ: usize>(
     out.hit = std::array::from_fn(|l| hit >> l & 1 != 0);
     out.front = std::array::from_fn(|l| front >> l & 1 != 0);
     out.t = t;
-    out.u = (v * Vec4::from(inv)).to_array();
-    out.v = (w * Vec4::from(inv)).to_array();
     out
 }
 
