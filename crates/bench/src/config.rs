@@ -14,6 +14,9 @@ pub struct Config {
     /// Primary rays: an `image` × `image` camera.
     pub image: u32,
     pub random_rays: usize,
+    /// Rays per packet query in the packet columns: 4, 8 or 16 (the k-d tree traces a
+    /// packet of 8 or 16 as two or four of 4; Embree with `rtcIntersect8` / `16`).
+    pub packet: usize,
     /// Timed runs per measurement (the median is reported).
     pub runs: usize,
     /// Thread counts to measure (rayon pool sizes, and Embree build threads).
@@ -40,6 +43,7 @@ impl Config {
             generated: 5_100_000,
             image: 512,
             random_rays: 262_144,
+            packet: 4,
             runs: 3,
             threads: vec![1, 2],
             brute_max_triangles: 20_000,

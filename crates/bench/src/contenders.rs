@@ -40,13 +40,18 @@ impl Found {
 pub(crate) trait Tracer: Sync {
     fn closest(&self, ray: &Ray) -> Found;
     fn occluded(&self, ray: &Ray) -> bool;
-    /// Four rays at once, through the contender's packet query where it has one.
-    fn closest4(&self, rays: &[Ray; 4]) -> [Found; 4] {
-        rays.each_ref().map(|r| self.closest(r))
+    /// A packet of 4, 8 or 16 rays (neighbouring pixels, or their shadow rays) at once,
+    /// answers into `out`, through the contender's widest packet query that fits.
+    fn closest_packet(&self, rays: &[Ray], out: &mut [Found]) {
+        for (o, r) in out.iter_mut().zip(rays) {
+            *o = self.closest(r);
+        }
     }
-    /// Four any-hit rays at once, likewise.
-    fn occluded4(&self, rays: &[Ray; 4]) -> [bool; 4] {
-        rays.each_ref().map(|r| self.occluded(r))
+    /// Any-hit packets, likewise.
+    fn occluded_packet(&self, rays: &[Ray], out: &mut [bool]) {
+        for (o, r) in out.iter_mut().zip(rays) {
+            *o = self.occluded(r);
+        }
     }
 }
 
@@ -68,13 +73,24 @@ impl Tracer for Accel {
     fn occluded(&self, ray: &Ray) -> bool {
         Accel::occluded(self, ray)
     }
+    /// Four-ray packets, the widest the tree has: a packet of 8 or 16 is 2 or 4 of them.
     #[inline]
-    fn closest4(&self, rays: &[Ray; 4]) -> [Found; 4] {
-        self.intersect4(rays).map(found_kd)
+    fn closest_packet(&self, rays: &[Ray], out: &mut [Found]) {
+        for (o, r) in out.chunks_mut(4).zip(rays.chunks(4)) {
+            match <&[Ray; 4]>::try_from(r) {
+                Ok(four) => o.copy_from_slice(&self.intersect4(four).map(found_kd)),
+                Err(_) => o.iter_mut().zip(r).for_each(|(o, r)| *o = self.closest(r)),
+            }
+        }
     }
     #[inline]
-    fn occluded4(&self, rays: &[Ray; 4]) -> [bool; 4] {
-        Accel::occluded4(self, rays)
+    fn occluded_packet(&self, rays: &[Ray], out: &mut [bool]) {
+        for (o, r) in out.chunks_mut(4).zip(rays.chunks(4)) {
+            match <&[Ray; 4]>::try_from(r) {
+                Ok(four) => o.copy_from_slice(&Accel::occluded4(self, four)),
+                Err(_) => o.iter_mut().zip(r).for_each(|(o, r)| *o = self.occluded(r)),
+            }
+        }
     }
 }
 
@@ -88,13 +104,35 @@ impl Tracer for crate::embree::EmbreeScene {
     fn occluded(&self, ray: &Ray) -> bool {
         crate::embree::EmbreeScene::occluded(self, ray)
     }
+    /// `rtcIntersect4`, `8` or `16`, by the packet's size.
     #[inline]
-    fn closest4(&self, rays: &[Ray; 4]) -> [Found; 4] {
-        self.intersect4(rays).map(found)
+    fn closest_packet(&self, rays: &[Ray], out: &mut [Found]) {
+        if let Ok(p) = <&[Ray; 16]>::try_from(rays) {
+            out.copy_from_slice(&self.intersect_n(p).map(found));
+        } else if let Ok(p) = <&[Ray; 8]>::try_from(rays) {
+            out.copy_from_slice(&self.intersect_n(p).map(found));
+        } else if let Ok(p) = <&[Ray; 4]>::try_from(rays) {
+            out.copy_from_slice(&self.intersect_n(p).map(found));
+        } else {
+            out.iter_mut()
+                .zip(rays)
+                .for_each(|(o, r)| *o = self.closest(r));
+        }
     }
+    /// `rtcOccluded4`, `8` or `16`, by the packet's size.
     #[inline]
-    fn occluded4(&self, rays: &[Ray; 4]) -> [bool; 4] {
-        crate::embree::EmbreeScene::occluded4(self, rays)
+    fn occluded_packet(&self, rays: &[Ray], out: &mut [bool]) {
+        if let Ok(p) = <&[Ray; 16]>::try_from(rays) {
+            out.copy_from_slice(&self.occluded_n(p));
+        } else if let Ok(p) = <&[Ray; 8]>::try_from(rays) {
+            out.copy_from_slice(&self.occluded_n(p));
+        } else if let Ok(p) = <&[Ray; 4]>::try_from(rays) {
+            out.copy_from_slice(&self.occluded_n(p));
+        } else {
+            out.iter_mut()
+                .zip(rays)
+                .for_each(|(o, r)| *o = self.occluded(r));
+        }
     }
 }
 

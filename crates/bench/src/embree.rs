@@ -3,7 +3,8 @@
 //!
 //! Only what the benchmark needs is declared: a device, one scene holding one triangle
 //! geometry (vertices unshared, three per triangle, so Embree's `primID` is the soup's
-//! triangle index), and the single-ray queries `rtcIntersect1` / `rtcOccluded1`.
+//! triangle index), the single-ray queries `rtcIntersect1` / `rtcOccluded1` and the packet
+//! queries `rtcIntersectN` / `rtcOccludedN` for N = 4, 8, 16.
 //! The struct layouts mirror `/usr/include/embree3/rtcore_ray.h` and `rtcore_common.h`
 //! for this build (`RTC_MAX_INSTANCE_LEVEL_COUNT 1`, `RTC_MIN_WIDTH 0`); the compile-time
 //! asserts below pin their sizes and alignments.
@@ -93,40 +94,44 @@ struct RtcRayHit {
     hit: RtcHit,
 }
 
-/// `struct RTCRay4`: lane-major arrays (192 bytes, 16-byte aligned).
-#[repr(C, align(16))]
+/// `struct RTCRayN` for N = 4, 8, 16: lane-major arrays, 48·N bytes, no padding.
+#[repr(C)]
 #[derive(Clone, Copy)]
-struct RtcRay4 {
-    org: [[f32; 4]; 3],
-    tnear: [f32; 4],
-    dir: [[f32; 4]; 3],
-    time: [f32; 4],
-    tfar: [f32; 4],
-    mask: [u32; 4],
-    id: [u32; 4],
-    flags: [u32; 4],
+struct RtcRayN<const N: usize> {
+    org: [[f32; N]; 3],
+    tnear: [f32; N],
+    dir: [[f32; N]; 3],
+    time: [f32; N],
+    tfar: [f32; N],
+    mask: [u32; N],
+    id: [u32; N],
+    flags: [u32; N],
 }
 
-/// `struct RTCRayHit4`: `RTCRay4` then `RTCHit4`, lane-major arrays (320 bytes, 16-byte
-/// aligned; one instance level).
-#[repr(C, align(16))]
-struct RtcRayHit4 {
-    ray: RtcRay4,
-    ng: [[f32; 4]; 3],
-    u: [f32; 4],
-    v: [f32; 4],
-    prim_id: [u32; 4],
-    geom_id: [u32; 4],
-    inst_id: [u32; 4],
+/// `struct RTCRayHitN`: `RTCRayN` then `RTCHitN`, lane-major arrays (80·N bytes; one
+/// instance level).
+#[repr(C)]
+struct RtcRayHitN<const N: usize> {
+    ray: RtcRayN<N>,
+    ng: [[f32; N]; 3],
+    u: [f32; N],
+    v: [f32; N],
+    prim_id: [u32; N],
+    geom_id: [u32; N],
+    inst_id: [u32; N],
 }
 
-/// The `valid` mask of a packet call: −1 for an active lane, 16-byte aligned.
-#[repr(C, align(16))]
-struct Valid4([i32; 4]);
+/// A packet's structs and its `valid` mask start at 16, 32 or 64 bytes for N = 4, 8, 16;
+/// 64 serves all three. The structs inside hold only 4-byte fields, so the wrapper adds no
+/// padding between them.
+#[repr(C, align(64))]
+struct Aligned<T>(T);
 
 const _: () = {
-    assert!(std::mem::size_of::<RtcRayHit4>() == 320);
-    assert!(std::mem::size_of::<RtcRay4>() == 192);
+    assert!(std::mem::size_of::<RtcRayHitN<4>>() == 320);
+    assert!(std::mem::size_of::<RtcRayN<4>>() == 192);
+    assert!(std::mem::size_of::<RtcRayHitN<16>>() == 1280);
+    assert!(std::mem::size_of::<RtcRayN<16>>() == 768);
     assert!(std::mem::size_of::<RtcIntersectContext>() == 24);
     assert!(std::mem::size_of::<RtcRay>() == 48);
     assert!(std::mem::align_of::<RtcRay>() == 16);
@@ -134,6 +139,9 @@ const _: () = {
     assert!(std::mem::size_of::<RtcRayHit>() == 80);
     assert!(std::mem::align_of::<RtcRayHit>() == 16);
 };
+
+/// `rtcIntersectN` / `rtcOccludedN`: valid mask, scene, context, the N-lane packet.
+type PacketFn = unsafe extern "C" fn(*const i32, RtcScene, *mut RtcIntersectContext, *mut c_void);
 
 type MemoryMonitor = unsafe extern "C" fn(ptr: *mut c_void, bytes: isize, post: bool) -> bool;
 
@@ -168,16 +176,40 @@ extern "C" {
     fn rtcIntersect1(scene: RtcScene, context: *mut RtcIntersectContext, rayhit: *mut RtcRayHit);
     fn rtcOccluded1(scene: RtcScene, context: *mut RtcIntersectContext, ray: *mut RtcRay);
     fn rtcIntersect4(
-        valid: *const Valid4,
+        valid: *const i32,
         scene: RtcScene,
         context: *mut RtcIntersectContext,
-        rayhit: *mut RtcRayHit4,
+        rayhit: *mut c_void,
+    );
+    fn rtcIntersect8(
+        valid: *const i32,
+        scene: RtcScene,
+        context: *mut RtcIntersectContext,
+        rayhit: *mut c_void,
+    );
+    fn rtcIntersect16(
+        valid: *const i32,
+        scene: RtcScene,
+        context: *mut RtcIntersectContext,
+        rayhit: *mut c_void,
     );
     fn rtcOccluded4(
-        valid: *const Valid4,
+        valid: *const i32,
         scene: RtcScene,
         context: *mut RtcIntersectContext,
-        ray: *mut RtcRay4,
+        ray: *mut c_void,
+    );
+    fn rtcOccluded8(
+        valid: *const i32,
+        scene: RtcScene,
+        context: *mut RtcIntersectContext,
+        ray: *mut c_void,
+    );
+    fn rtcOccluded16(
+        valid: *const i32,
+        scene: RtcScene,
+        context: *mut RtcIntersectContext,
+        ray: *mut c_void,
     );
 }
 
@@ -413,10 +445,10 @@ impl EmbreeScene {
         ))
     }
 
-    /// Four rays lane by lane, as the packet calls take them.
-    fn rtc_ray4(rays: &[Ray; 4]) -> RtcRay4 {
+    /// N rays lane by lane, as the packet calls take them.
+    fn rtc_ray_n<const N: usize>(rays: &[Ray; N]) -> RtcRayN<N> {
         let lane = |f: &dyn Fn(&Ray) -> f32| rays.each_ref().map(f);
-        RtcRay4 {
+        RtcRayN {
             org: [
                 lane(&|r| r.origin.x),
                 lane(&|r| r.origin.y),
@@ -424,11 +456,11 @@ impl EmbreeScene {
             ],
             tnear: lane(&|r| r.tmin),
             dir: [lane(&|r| r.dir.x), lane(&|r| r.dir.y), lane(&|r| r.dir.z)],
-            time: [0.0; 4],
+            time: [0.0; N],
             tfar: lane(&|r| r.tmax),
-            mask: [u32::MAX; 4],
-            id: [0; 4],
-            flags: [0; 4],
+            mask: [u32::MAX; N],
+            id: [0; N],
+            flags: [0; N],
         }
     }
 
@@ -440,22 +472,54 @@ impl EmbreeScene {
         }
     }
 
-    /// [`EmbreeScene::intersect`] on four rays with one `rtcIntersect4` call.
-    #[inline]
-    pub fn intersect4(&self, rays: &[Ray; 4]) -> [Option<(f32, u32, f32, f32)>; 4] {
-        let mut rh = RtcRayHit4 {
-            ray: Self::rtc_ray4(rays),
-            ng: [[0.0; 4]; 3],
-            u: [0.0; 4],
-            v: [0.0; 4],
-            prim_id: [RTC_INVALID_GEOMETRY_ID; 4],
-            geom_id: [RTC_INVALID_GEOMETRY_ID; 4],
-            inst_id: [RTC_INVALID_GEOMETRY_ID; 4],
+    /// Calls the N-lane one of `calls` (the 4-, 8- and 16-lane functions) on `packet`,
+    /// all lanes valid, with the coherent context.
+    ///
+    /// # Safety
+    /// `packet` points to the N-lane struct the call takes, aligned to 64 bytes.
+    ///
+    /// # Panics
+    /// For N other than 4, 8 or 16.
+    unsafe fn packet_call<const N: usize>(&self, calls: [PacketFn; 3], packet: *mut c_void) {
+        let call = match N {
+            4 => calls[0],
+            8 => calls[1],
+            16 => calls[2],
+            _ => panic!("Embree has no packets of {N} rays"),
         };
-        let valid = Valid4([-1; 4]);
+        let valid = Aligned([-1i32; N]);
         let mut ctx = Self::coherent_context();
-        // SAFETY: committed scene; valid, ctx and rh are valid and 16-byte aligned.
-        unsafe { rtcIntersect4(&valid, self.scene, &mut ctx, &mut rh) };
+        // SAFETY: committed scene; `valid` holds N lanes aligned to 64 bytes, `ctx` is
+        // initialised, `packet` is the caller's N-lane struct and `call` takes N lanes.
+        unsafe { call(valid.0.as_ptr(), self.scene, &mut ctx, packet) }
+    }
+
+    /// [`EmbreeScene::intersect`] on N = 4, 8 or 16 rays with one `rtcIntersectN` call.
+    ///
+    /// # Panics
+    /// For any other N.
+    #[inline]
+    pub fn intersect_n<const N: usize>(
+        &self,
+        rays: &[Ray; N],
+    ) -> [Option<(f32, u32, f32, f32)>; N] {
+        let mut rh = Aligned(RtcRayHitN {
+            ray: Self::rtc_ray_n(rays),
+            ng: [[0.0; N]; 3],
+            u: [0.0; N],
+            v: [0.0; N],
+            prim_id: [RTC_INVALID_GEOMETRY_ID; N],
+            geom_id: [RTC_INVALID_GEOMETRY_ID; N],
+            inst_id: [RTC_INVALID_GEOMETRY_ID; N],
+        });
+        // SAFETY: `rh` is an `RTCRayHitN` of N lanes (size pinned above), 64-byte aligned.
+        unsafe {
+            self.packet_call::<N>(
+                [rtcIntersect4, rtcIntersect8, rtcIntersect16],
+                (&mut rh.0 as *mut RtcRayHitN<N>).cast(),
+            )
+        };
+        let rh = rh.0;
         std::array::from_fn(|l| {
             (rh.geom_id[l] != RTC_INVALID_GEOMETRY_ID).then_some((
                 rh.ray.tfar[l],
@@ -466,15 +530,21 @@ impl EmbreeScene {
         })
     }
 
-    /// [`EmbreeScene::occluded`] on four rays with one `rtcOccluded4` call.
+    /// [`EmbreeScene::occluded`] on N = 4, 8 or 16 rays with one `rtcOccludedN` call.
+    ///
+    /// # Panics
+    /// For any other N.
     #[inline]
-    pub fn occluded4(&self, rays: &[Ray; 4]) -> [bool; 4] {
-        let mut r = Self::rtc_ray4(rays);
-        let valid = Valid4([-1; 4]);
-        let mut ctx = Self::coherent_context();
-        // SAFETY: committed scene; valid, ctx and r are valid and 16-byte aligned.
-        unsafe { rtcOccluded4(&valid, self.scene, &mut ctx, &mut r) };
-        r.tfar.map(|t| t == f32::NEG_INFINITY)
+    pub fn occluded_n<const N: usize>(&self, rays: &[Ray; N]) -> [bool; N] {
+        let mut r = Aligned(Self::rtc_ray_n(rays));
+        // SAFETY: `r` is an `RTCRayN` of N lanes (size pinned above), 64-byte aligned.
+        unsafe {
+            self.packet_call::<N>(
+                [rtcOccluded4, rtcOccluded8, rtcOccluded16],
+                (&mut r.0 as *mut RtcRayN<N>).cast(),
+            )
+        };
+        r.0.tfar.map(|t| t == f32::NEG_INFINITY)
     }
 
     /// Whether anything blocks the ray in [tmin, tmax] (Embree sets tfar to −inf).
@@ -548,22 +618,32 @@ mod tests {
     }
 
     #[test]
-    fn a_packet_of_four_gets_the_single_answers_lane_by_lane() {
+    fn packets_of_four_eight_and_sixteen_get_the_single_answers_lane_by_lane() {
         let s = EmbreeScene::new(&quad()).unwrap();
-        let rays = [
+        let four = [
             Ray::new(Vec3::new(0.75, 0.25, 0.0), Vec3::Z, 0.0, f32::INFINITY),
             Ray::new(Vec3::new(0.1, 0.1, 0.0), Vec3::Z, 3.0, 10.0),
             Ray::new(Vec3::new(0.1, 0.1, 0.0), Vec3::Z, 0.0, 1.5),
             Ray::new(Vec3::new(0.25, 0.75, 0.0), Vec3::Z, 0.0, f32::INFINITY),
         ];
-        let got = s.intersect4(&rays);
+        let got = s.intersect_n(&four);
         assert_eq!(
             got.map(|h| h.map(|h| h.1)),
             [Some(0), Some(2), None, Some(1)]
         );
-        for (r, g) in rays.iter().zip(got) {
+        assert_eq!(s.occluded_n(&four), [true, true, false, true]);
+        // Wider packets: the same four rays in a different order per group of four.
+        let eight: [Ray; 8] = std::array::from_fn(|l| four[(l + l / 4) % 4]);
+        let sixteen: [Ray; 16] = std::array::from_fn(|l| four[(l + l / 4) % 4]);
+        for (r, g) in eight.iter().zip(s.intersect_n(&eight)) {
             assert_eq!(g, s.intersect(r));
         }
-        assert_eq!(s.occluded4(&rays), [true, true, false, true]);
+        for (r, g) in sixteen.iter().zip(s.intersect_n(&sixteen)) {
+            assert_eq!(g, s.intersect(r));
+        }
+        for (r, o) in sixteen.iter().zip(s.occluded_n(&sixteen)) {
+            assert_eq!(o, s.occluded(r));
+        }
+        assert_eq!(s.occluded_n(&eight).iter().filter(|&&o| o).count(), 6);
     }
 }

@@ -32,11 +32,23 @@ pub fn header(cfg: &Config) -> Vec<String> {
         ),
         format!(
             "rays: primary {0}×{0} camera (the soup's when it has one, else a 45° view framing the bounds); \
-             primary ×4: the same rays in 2×2 pixel blocks, one packet query per block (k-d tree `intersect4`, Embree `rtcIntersect4`); \
+             primary ×{2}: the same rays in {3} pixel blocks, one packet query per block (k-d tree `intersect4` {4}, Embree `rtcIntersect{2}`); \
              shadow rays from every primary hit of the k-d tree to a light above the scene (any-hit); \
-             shadow ×4: those of the primary ×4 hits, in block order, four per packet query (k-d tree `occluded4`, Embree `rtcOccluded4`); \
+             shadow ×{2}: those of the primary ×{2} hits, in block order, one packet query per block (k-d tree `occluded4` {4}, Embree `rtcOccluded{2}`); \
              {1} random rays (origins uniform in the bounds, directions uniform on the sphere)",
-            cfg.image, cfg.random_rays
+            cfg.image,
+            cfg.random_rays,
+            cfg.packet,
+            match cfg.packet {
+                4 => "2×2",
+                8 => "4×2 (two 2×2)",
+                _ => "4×4 (four 2×2)",
+            },
+            match cfg.packet {
+                4 => "once per block",
+                8 => "on each 2×2 half",
+                _ => "on each 2×2 quarter",
+            },
         ),
         format!(
             "timing: median of {} runs (traversal runs go round-robin over the contenders); threads {:?} (rayon pools of that size; Embree builds on a device of that many threads); \
@@ -54,9 +66,10 @@ pub fn header(cfg: &Config) -> Vec<String> {
             .map(|d| d.version())
             .unwrap_or_else(|e| format!("unavailable ({e})"));
         h.push(format!(
-            "Embree {version}: build quality {}, scene flags none, rtcIntersect1 / rtcOccluded1 with the incoherent context flag, rtcIntersect4 / rtcOccluded4 with the coherent one for primary ×4 and shadow ×4; \
+            "Embree {version}: build quality {}, scene flags none, rtcIntersect1 / rtcOccluded1 with the incoherent context flag, rtcIntersect{p} / rtcOccluded{p} with the coherent one for primary ×{p} and shadow ×{p}; \
              build time includes filling its vertex and index buffers; bytes/tri from its memory monitor",
-            cfg.embree_quality.name()
+            cfg.embree_quality.name(),
+            p = cfg.packet,
         ));
     }
     #[cfg(not(feature = "embree"))]

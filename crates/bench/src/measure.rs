@@ -78,21 +78,30 @@ where
     out
 }
 
-/// [`trace`] four rays per call: `four` on each run of four consecutive rays, `one` on the
-/// one to three left at the end. Answers in ray order.
-pub fn trace4<R, T>(
+/// [`trace`] `packet` rays per call: `many` on each run of `packet` consecutive rays
+/// (and on the shorter run left at the end), answers into its slice, in ray order.
+pub fn trace_packets<R, T>(
     pool: &rayon::ThreadPool,
     rays: &[R],
-    four: impl Fn(&[R; 4]) -> [T; 4] + Sync,
-    one: impl Fn(&R) -> T,
+    packet: usize,
+    many: impl Fn(&[R], &mut [T]) + Sync,
 ) -> Vec<T>
 where
     R: Sync,
     T: Send + Copy + Default,
 {
-    let (packets, rest) = rays.as_chunks::<4>();
-    let mut out: Vec<T> = trace(pool, packets, four).into_iter().flatten().collect();
-    out.extend(rest.iter().map(one));
+    // Whole packets per parallel task, so no packet is split between two.
+    let chunk = CHUNK.next_multiple_of(packet.max(1));
+    let mut out = vec![T::default(); rays.len()];
+    pool.install(|| {
+        out.par_chunks_mut(chunk)
+            .zip(rays.par_chunks(chunk))
+            .for_each(|(o, r)| {
+                for (o, r) in o.chunks_mut(packet.max(1)).zip(r.chunks(packet.max(1))) {
+                    many(r, o);
+                }
+            })
+    });
     out
 }
 
@@ -112,6 +121,23 @@ mod tests {
         let input: Vec<u32> = (0..10_000).collect();
         let out = trace(&p, &input, |x| x * 2);
         assert!(out.iter().enumerate().all(|(i, &v)| v == 2 * i as u32));
+    }
+
+    #[test]
+    fn packets_keep_ray_order_and_hand_over_whole_runs() {
+        let p = pool(2).unwrap();
+        let input: Vec<u32> = (0..1000).collect();
+        for packet in [4, 8, 16] {
+            let out = trace_packets(&p, &input, packet, |r, o| {
+                // Every run but the last has exactly `packet` rays and starts at a multiple.
+                assert!(r.len() == packet || r[0] as usize == 1000 / packet * packet);
+                assert_eq!(r[0] as usize % packet, 0);
+                for (o, x) in o.iter_mut().zip(r) {
+                    *o = x * 3;
+                }
+            });
+            assert!(out.iter().enumerate().all(|(i, &v)| v == 3 * i as u32));
+        }
     }
 
     #[test]

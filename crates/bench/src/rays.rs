@@ -56,23 +56,38 @@ pub fn primary(view: &View, size: u32) -> Vec<Ray> {
     out
 }
 
-/// `primary`'s rays (a `size` × `size` image, row by row) reordered into 2×2 pixel blocks,
-/// the four rays of a block in a row: the packets a renderer would form. An odd last row
-/// or column stays in row order at the end.
-pub fn in_blocks(primary: &[Ray], size: u32) -> Vec<Ray> {
+/// `primary`'s rays (a `size` × `size` image, row by row) reordered into packets of
+/// `packet` neighbouring pixels, as a renderer would form them: 2×2 blocks for 4, 4×2 for
+/// 8, 4×4 for 16, each made of 2×2 blocks in a row (so that a four-wide tracer sees the same
+/// 2×2 packets inside every wider one). Pixels outside the whole blocks (the last rows or
+/// columns) stay in row order at the end.
+///
+/// # Panics
+/// When `packet` is not 4, 8 or 16.
+pub fn in_blocks(primary: &[Ray], size: u32, packet: usize) -> Vec<Ray> {
+    let (bw, bh) = match packet {
+        4 => (2, 2),
+        8 => (4, 2),
+        16 => (4, 4),
+        _ => panic!("packets are 4, 8 or 16 rays, not {packet}"),
+    };
     let n = size as usize;
-    let even = n & !1;
+    let (ew, eh) = (n / bw * bw, n / bh * bh);
     let mut out = Vec::with_capacity(primary.len());
-    for y in (0..even).step_by(2) {
-        for x in (0..even).step_by(2) {
-            for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
-                out.push(primary[(y + dy) * n + x + dx]);
+    for by in (0..eh).step_by(bh) {
+        for bx in (0..ew).step_by(bw) {
+            for sy in (0..bh).step_by(2) {
+                for sx in (0..bw).step_by(2) {
+                    for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                        out.push(primary[(by + sy + dy) * n + bx + sx + dx]);
+                    }
+                }
             }
         }
     }
     for y in 0..n {
         for x in 0..n {
-            if y >= even || x >= even {
+            if y >= eh || x >= ew {
                 out.push(primary[y * n + x]);
             }
         }
@@ -252,14 +267,34 @@ mod tests {
     #[test]
     fn blocks_hold_each_ray_once_in_2x2_order() {
         let v = framing([Vec3::splat(-1.0), Vec3::splat(1.0)]);
-        let rays = primary(&v, 3);
-        let blocks = in_blocks(&rays, 3);
-        // Pixel index of each reordered ray: the 2×2 block, then the odd column and row.
-        let order: Vec<usize> = blocks
-            .iter()
-            .map(|b| rays.iter().position(|r| r.dir == b.dir).unwrap())
-            .collect();
-        assert_eq!(order, [0, 1, 3, 4, 2, 5, 6, 7, 8]);
+        // Pixel index of each reordered ray.
+        let order = |size: u32, packet: usize| -> Vec<usize> {
+            let rays = primary(&v, size);
+            in_blocks(&rays, size, packet)
+                .iter()
+                .map(|b| rays.iter().position(|r| r.dir == b.dir).unwrap())
+                .collect()
+        };
+        // The 2×2 block, then the odd column and row.
+        assert_eq!(order(3, 4), [0, 1, 3, 4, 2, 5, 6, 7, 8]);
+        // 5×5 in 4×2 blocks: two blocks of two 2×2 each, then column 4 and row 4.
+        let wide = [
+            0, 1, 5, 6, 2, 3, 7, 8, 10, 11, 15, 16, 12, 13, 17, 18, 4, 9, 14, 19, 20, 21, 22, 23,
+            24,
+        ];
+        assert_eq!(order(5, 8), wide);
+        // One 4×4 block holds the same four 2×2 blocks in the same order.
+        assert_eq!(order(5, 16), wide);
+        // 6×6 in 4×4 blocks: one block; columns 4–5 of rows 0–3 and rows 4–5 follow.
+        let o = order(6, 16);
+        assert_eq!(
+            &o[..16],
+            [0, 1, 6, 7, 2, 3, 8, 9, 12, 13, 18, 19, 14, 15, 20, 21]
+        );
+        assert_eq!(&o[16..20], [4, 5, 10, 11]);
+        let mut all = o.clone();
+        all.sort();
+        assert_eq!(all, (0..36).collect::<Vec<_>>());
     }
 
     #[test]

@@ -42,7 +42,7 @@ fn targets(r: &Report, out: &mut String) {
     let mut rows = vec![];
     for s in &r.scenes {
         // Every ray kind at or above Embree's single-ray speed: the row shows the slowest.
-        let worst = Kind::ALL
+        let worst = Kind::all(r.config.packet)
             .iter()
             .filter_map(|&kind| ratio(s, 1, kind).map(|x| (x, kind)))
             .min_by(|a, b| a.0.total_cmp(&b.0));
@@ -148,11 +148,11 @@ fn traversal(r: &Report, out: &mut String) {
          trace the same rays as any-hit queries.\n\n\
          | scene | contender | threads |",
     );
-    for k in Kind::ALL {
+    for k in Kind::all(r.config.packet) {
         let _ = write!(out, " {} |", k.name());
     }
     out.push_str("\n|---|---|---:|");
-    for _ in Kind::ALL {
+    for _ in Kind::all(r.config.packet) {
         out.push_str("---:|");
     }
     out.push('\n');
@@ -160,8 +160,10 @@ fn traversal(r: &Report, out: &mut String) {
         let contenders = [KDTREE, MEDIAN, EMBREE, BRUTE];
         for who in contenders {
             for &t in &r.config.threads {
-                let cells: Vec<Option<&TraceRow>> =
-                    Kind::ALL.iter().map(|&k| trace(s, who, t, k)).collect();
+                let cells: Vec<Option<&TraceRow>> = Kind::all(r.config.packet)
+                    .iter()
+                    .map(|&k| trace(s, who, t, k))
+                    .collect();
                 if cells.iter().all(Option::is_none) {
                     continue;
                 }
@@ -173,7 +175,10 @@ fn traversal(r: &Report, out: &mut String) {
             }
         }
         for &t in &r.config.threads {
-            let cells: Vec<Option<f64>> = Kind::ALL.iter().map(|&k| ratio(s, t, k)).collect();
+            let cells: Vec<Option<f64>> = Kind::all(r.config.packet)
+                .iter()
+                .map(|&k| ratio(s, t, k))
+                .collect();
             if cells.iter().all(Option::is_none) {
                 continue;
             }
@@ -240,11 +245,11 @@ fn agreement(r: &Report, out: &mut String) {
          column counts how often it sides with each (both on ties, neither when all three differ).\n\n\
          | scene | contender |",
     );
-    for k in Kind::ALL {
+    for k in Kind::all(r.config.packet) {
         let _ = write!(out, " {} differ |", k.name());
     }
     out.push_str(" agreement | verdict | brute force sides with kdtree / other, of |\n|---|---|");
-    for _ in Kind::ALL {
+    for _ in Kind::all(r.config.packet) {
         out.push_str("---:|");
     }
     out.push_str("---:|:---:|---:|\n");
@@ -269,7 +274,10 @@ fn agreement(r: &Report, out: &mut String) {
                     kdtree_right: a.kdtree_right + b.kdtree_right,
                     other_right: a.other_right + b.other_right,
                 });
-            let cells: Vec<String> = Kind::ALL.iter().map(|&k| cell(k)).collect();
+            let cells: Vec<String> = Kind::all(r.config.packet)
+                .iter()
+                .map(|&k| cell(k))
+                .collect();
             let _ = writeln!(
                 out,
                 "| {} | {who} | {} | {:.4}% | {} | {} |",

@@ -6,11 +6,11 @@ use crate::config::Config;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Kind {
     Primary,
-    /// The same camera rays in 2×2 pixel blocks, each block one packet query.
-    PrimaryPackets,
+    /// The same camera rays in blocks of 4, 8 or 16 pixels, each block one packet query.
+    PrimaryPackets(usize),
     Shadow,
-    /// Shadow rays from the primary ×4 hits, in their order, four per packet query.
-    ShadowPackets,
+    /// Shadow rays from the packets' primary hits, in their order, one packet per block.
+    ShadowPackets(usize),
     Random,
     /// From random surface points toward the light, closest hit.
     SurfaceLight,
@@ -23,23 +23,30 @@ pub enum Kind {
 }
 
 impl Kind {
-    pub const ALL: [Kind; 9] = [
-        Kind::Primary,
-        Kind::PrimaryPackets,
-        Kind::Shadow,
-        Kind::ShadowPackets,
-        Kind::Random,
-        Kind::SurfaceLight,
-        Kind::SurfaceLightAny,
-        Kind::SurfaceHemisphere,
-        Kind::SurfaceHemisphereAny,
-    ];
+    /// Every ray set, the packet ones in packets of `packet` rays.
+    pub fn all(packet: usize) -> [Kind; 9] {
+        [
+            Kind::Primary,
+            Kind::PrimaryPackets(packet),
+            Kind::Shadow,
+            Kind::ShadowPackets(packet),
+            Kind::Random,
+            Kind::SurfaceLight,
+            Kind::SurfaceLightAny,
+            Kind::SurfaceHemisphere,
+            Kind::SurfaceHemisphereAny,
+        ]
+    }
     pub fn name(self) -> &'static str {
         match self {
             Kind::Primary => "primary",
-            Kind::PrimaryPackets => "primary ×4",
+            Kind::PrimaryPackets(4) => "primary ×4",
+            Kind::PrimaryPackets(8) => "primary ×8",
+            Kind::PrimaryPackets(_) => "primary ×16",
             Kind::Shadow => "shadow",
-            Kind::ShadowPackets => "shadow ×4",
+            Kind::ShadowPackets(4) => "shadow ×4",
+            Kind::ShadowPackets(8) => "shadow ×8",
+            Kind::ShadowPackets(_) => "shadow ×16",
             Kind::Random => "random",
             Kind::SurfaceLight => "surface→light",
             Kind::SurfaceLightAny => "surface→light any",
@@ -51,7 +58,10 @@ impl Kind {
     pub fn any_hit(self) -> bool {
         matches!(
             self,
-            Kind::Shadow | Kind::ShadowPackets | Kind::SurfaceLightAny | Kind::SurfaceHemisphereAny
+            Kind::Shadow
+                | Kind::ShadowPackets(_)
+                | Kind::SurfaceLightAny
+                | Kind::SurfaceHemisphereAny
         )
     }
 }

@@ -9,7 +9,7 @@ use crate::contenders::EMBREE;
 use crate::contenders::{Brute, Tracer, BRUTE, KDTREE, MEDIAN};
 use crate::error::BenchError;
 use crate::header::{header, load_average};
-use crate::measure::{median, pool, process_cpu_seconds, timed, trace, trace4};
+use crate::measure::{median, pool, process_cpu_seconds, timed, trace, trace_packets};
 use crate::rays::{self, View};
 use crate::results::{BuildRow, Kind, Report, Role, SceneResult, TraceRow, WorkRow};
 use crate::scenes::{self, Scene};
@@ -40,24 +40,21 @@ impl Bench<'_> {
             for _ in 0..self.cfg.runs.max(1) {
                 for (c, (_, tracer)) in who.iter().enumerate() {
                     let start = Instant::now();
-                    let a = if kind == Kind::ShadowPackets {
-                        Answers::Occluded(trace4(
-                            pool,
-                            rays,
-                            |p| tracer.occluded4(p),
-                            |r| tracer.occluded(r),
-                        ))
-                    } else if kind.any_hit() {
-                        Answers::Occluded(trace(pool, rays, |r| tracer.occluded(r)))
-                    } else if kind == Kind::PrimaryPackets {
-                        Answers::Closest(trace4(
-                            pool,
-                            rays,
-                            |p| tracer.closest4(p),
-                            |r| tracer.closest(r),
-                        ))
-                    } else {
-                        Answers::Closest(trace(pool, rays, |r| tracer.closest(r)))
+                    let a = match kind {
+                        Kind::ShadowPackets(n) => {
+                            Answers::Occluded(trace_packets(pool, rays, n, |p, o| {
+                                tracer.occluded_packet(p, o)
+                            }))
+                        }
+                        Kind::PrimaryPackets(n) => {
+                            Answers::Closest(trace_packets(pool, rays, n, |p, o| {
+                                tracer.closest_packet(p, o)
+                            }))
+                        }
+                        _ if kind.any_hit() => {
+                            Answers::Occluded(trace(pool, rays, |r| tracer.occluded(r)))
+                        }
+                        _ => Answers::Closest(trace(pool, rays, |r| tracer.closest(r))),
                     };
                     times[c].push(start.elapsed().as_secs_f64());
                     answers[c] = Some(a);
@@ -255,7 +252,7 @@ fn run_scene(
     let bounds = scenes::bounds(tris);
     let view: View = scene.view.unwrap_or_else(|| rays::framing(bounds));
     let primary = rays::primary(&view, cfg.image);
-    let primary_blocks = rays::in_blocks(&primary, cfg.image);
+    let primary_blocks = rays::in_blocks(&primary, cfg.image, cfg.packet);
     let random = rays::random(bounds, cfg.random_rays, 0x5EED ^ n as u64);
     let brute = (n <= cfg.brute_max_triangles).then_some(Brute(tris));
     let light = rays::light_above(bounds);
@@ -267,12 +264,12 @@ fn run_scene(
     });
 
     let (mut shadow, mut shadow_blocks) = (vec![], vec![]);
-    for kind in Kind::ALL {
+    for kind in Kind::all(cfg.packet) {
         let set: &[Ray] = match kind {
             Kind::Primary => &primary,
-            Kind::PrimaryPackets => &primary_blocks,
+            Kind::PrimaryPackets(_) => &primary_blocks,
             Kind::Shadow => &shadow,
-            Kind::ShadowPackets => &shadow_blocks,
+            Kind::ShadowPackets(_) => &shadow_blocks,
             Kind::Random => &random,
             Kind::SurfaceLight | Kind::SurfaceLightAny => &surface_light,
             Kind::SurfaceHemisphere | Kind::SurfaceHemisphereAny => &surface_hemisphere,
@@ -319,8 +316,10 @@ fn run_scene(
             b.agree(BRUTE, kind, set, &reference, &answers[0], Some(&idx), None);
         }
         // Shadow rays start at the k-d tree's primary hits, in the order of their set (so
-        // from 2×2 pixel blocks for the packets).
-        if let (Kind::Primary | Kind::PrimaryPackets, Answers::Closest(hits)) = (kind, &reference) {
+        // block by block for the packets).
+        if let (Kind::Primary | Kind::PrimaryPackets(_), Answers::Closest(hits)) =
+            (kind, &reference)
+        {
             let hits: Vec<_> = hits
                 .iter()
                 .map(|h| h.is_hit().then_some((h.prim, h.u, h.v)))

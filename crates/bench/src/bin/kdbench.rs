@@ -2,10 +2,12 @@
 //!
 //! ```text
 //! kdbench [--baseline out/baseline.soup] [--meshes DIR] [--out reports/bench.md] [--quick]
+//!         [--packet 4|8|16]
 //! ```
 
 use anyhow::{Context, Result};
 use bench::{report, run, Config};
+use clap::builder::TypedValueParser;
 use clap::Parser;
 use std::path::PathBuf;
 
@@ -30,6 +32,10 @@ struct Args {
     /// Number of random rays.
     #[arg(long, default_value_t = 262_144)]
     random_rays: usize,
+    /// Rays per packet in the ×N columns: 4, 8 or 16 (Embree's `rtcIntersect4/8/16`; the
+    /// k-d tree traces 8 or 16 as two or four packets of 4).
+    #[arg(long, default_value_t = 4, value_parser = clap::builder::PossibleValuesParser::new(["4", "8", "16"]).map(packet_size))]
+    packet: usize,
     /// Timed runs per measurement (the median is reported).
     #[arg(long, default_value_t = 3)]
     runs: usize,
@@ -46,6 +52,15 @@ struct Args {
     #[cfg(feature = "embree")]
     #[arg(long, default_value = "high", value_parser = ["low", "medium", "high"])]
     embree_quality: String,
+}
+
+/// A `--packet` value clap has already checked to be 4, 8 or 16.
+fn packet_size(s: String) -> usize {
+    match s.as_str() {
+        "8" => 8,
+        "16" => 16,
+        _ => 4,
+    }
 }
 
 /// The corpus meshes next to the repository (`<repo>/../shared/corpus/meshes`).
@@ -75,6 +90,7 @@ fn real_main(args: Args) -> Result<()> {
             generated: args.generated,
             image: args.image,
             random_rays: args.random_rays,
+            packet: args.packet,
             runs: args.runs,
             ..Config::full()
         }

@@ -61,7 +61,7 @@ fn quick_run_has_every_row_and_the_contenders_agree() {
     // Trace rows: every contender, brute force too (the scene is small), × 2 × every kind.
     let mut all = contenders.clone();
     all.push(BRUTE);
-    let kinds = Kind::ALL.len();
+    let kinds = Kind::all(cfg.packet).len();
     assert_eq!(kinds, 9);
     assert_eq!(s.traces.len(), all.len() * 2 * kinds);
     let rays = |who: &str, kind: Kind| {
@@ -72,7 +72,7 @@ fn quick_run_has_every_row_and_the_contenders_agree() {
             .rays
     };
     assert_eq!(rays(KDTREE, Kind::Primary), 48 * 48);
-    assert_eq!(rays(KDTREE, Kind::PrimaryPackets), 48 * 48);
+    assert_eq!(rays(KDTREE, Kind::PrimaryPackets(4)), 48 * 48);
     assert_eq!(rays(KDTREE, Kind::Random), 2048);
     // Shadow rays start at primary hits: most of a framed view hits the scene.
     let shadow = rays(KDTREE, Kind::Shadow);
@@ -81,9 +81,9 @@ fn quick_run_has_every_row_and_the_contenders_agree() {
         "{shadow} shadow rays"
     );
     // The same hits in block order: the same number of shadow rays.
-    assert_eq!(rays(KDTREE, Kind::ShadowPackets), shadow);
+    assert_eq!(rays(KDTREE, Kind::ShadowPackets(4)), shadow);
     assert_eq!(rays(BRUTE, Kind::Primary), 512);
-    assert_eq!(rays(BRUTE, Kind::PrimaryPackets), 512);
+    assert_eq!(rays(BRUTE, Kind::PrimaryPackets(4)), 512);
     for k in [
         Kind::SurfaceLight,
         Kind::SurfaceLightAny,
@@ -154,4 +154,31 @@ fn a_missing_baseline_is_skipped_with_a_note() {
     assert_eq!(report.notes.len(), 1);
     assert!(report.notes[0].starts_with("SKIPPED: baseline soup /nonexistent/baseline.soup"));
     assert_eq!(lines, report.notes);
+}
+
+#[test]
+fn quick_run_in_packets_of_sixteen_traces_every_ray_and_agrees() {
+    let cfg = Config {
+        runs: 1,
+        packet: 16,
+        threads: vec![1],
+        ..Config::quick()
+    };
+    let report = run(&cfg, &mut quiet()).unwrap();
+    let s = &report.scenes[0];
+    let rays = |kind: Kind| {
+        s.traces
+            .iter()
+            .find(|r| r.contender == KDTREE && r.kind == kind)
+            .unwrap()
+            .rays
+    };
+    assert_eq!(rays(Kind::PrimaryPackets(16)), 48 * 48);
+    assert_eq!(rays(Kind::ShadowPackets(16)), rays(Kind::Shadow));
+    assert!(s.traces.iter().all(|r| r.kind != Kind::PrimaryPackets(4)));
+    // Every contender, Embree's `rtcIntersect16` included, answers as the k-d tree does.
+    assert!(report.all_agree());
+    let md = report::markdown(&report);
+    assert!(md.contains(" primary ×16 | shadow | shadow ×16 |"), "{md}");
+    assert!(md.contains("primary ×16: the same rays in 4×4 (four 2×2) pixel blocks"));
 }
