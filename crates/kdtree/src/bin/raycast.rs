@@ -91,11 +91,6 @@ fn run(cli: Cli) -> Result<()> {
     Ok(())
 }
 
-/// Large arrays on transparent huge pages: fewer page faults and TLB misses on large scenes
-/// (see the `hugealloc` crate).
-#[global_allocator]
-static ALLOC: hugealloc::HugePages = hugealloc::HugePages;
-
 fn main() {
     let cli = Cli::parse();
     if let Err(e) = run(cli) {

@@ -107,11 +107,6 @@ struct RenderArgs {
     texture_filter: TextureFilter,
 }
 
-/// Large arrays on transparent huge pages: fewer page faults and TLB misses on large scenes
-/// (see the `hugealloc` crate).
-#[global_allocator]
-static ALLOC: hugealloc::HugePages = hugealloc::HugePages;
-
 fn main() {
     let cli = Cli::parse();
     let result = match cli.command {

@@ -29,11 +29,6 @@ struct Args {
     list: bool,
 }
 
-/// Large arrays on transparent huge pages: fewer page faults and TLB misses on large scenes
-/// (see the `hugealloc` crate).
-#[global_allocator]
-static ALLOC: hugealloc::HugePages = hugealloc::HugePages;
-
 fn main() {
     let report = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
