@@ -90,14 +90,15 @@ where
     R: Sync,
     T: Send + Copy + Default,
 {
+    let packet = packet.max(1);
     // Whole packets per parallel task, so no packet is split between two.
-    let chunk = CHUNK.next_multiple_of(packet.max(1));
+    let chunk = CHUNK.next_multiple_of(packet);
     let mut out = vec![T::default(); rays.len()];
     pool.install(|| {
         out.par_chunks_mut(chunk)
             .zip(rays.par_chunks(chunk))
             .for_each(|(o, r)| {
-                for (o, r) in o.chunks_mut(packet.max(1)).zip(r.chunks(packet.max(1))) {
+                for (o, r) in o.chunks_mut(packet).zip(r.chunks(packet)) {
                     many(r, o);
                 }
             })
