@@ -457,6 +457,32 @@ mod tree_tests {
         );
     }
 
+    /// Triangles with a NaN or infinite vertex are left out of the tree, wherever they
+    /// lie in the soup; every other triangle is in it.
+    #[test]
+    fn non_finite_triangles_are_left_out() {
+        let mut tris = testkit::sphere(Vec3::ZERO, 1.0, 120, 300); // 72,000: binned in parallel
+        let bad = [0, 17, 40_000, tris.len() - 1];
+        for (k, &i) in bad.iter().enumerate() {
+            tris[i][k % 3] = [Vec3::NAN, Vec3::INFINITY, Vec3::NEG_INFINITY][k % 3];
+        }
+        let kd = build(
+            &tris,
+            &BuildParams::default(),
+            formats::soup::geometry_hash(&tris),
+        );
+        let mut held: Vec<u32> = kd.leaf_tris.clone();
+        held.sort_unstable();
+        held.dedup();
+        let want: Vec<u32> = (0..tris.len() as u32)
+            .filter(|i| !bad.contains(&(*i as usize)))
+            .collect();
+        assert_eq!(held, want);
+        let a = Accel::from_triangles(&tris, &kd).unwrap();
+        let r = Ray::new(Vec3::new(0.0, 0.0, -5.0), Vec3::Z, 0.0, f32::INFINITY);
+        assert!((a.intersect(&r).unwrap().t - 4.0).abs() < 0.01);
+    }
+
     #[test]
     fn empty_soup_builds_and_misses() {
         let kd = build(

@@ -356,6 +356,9 @@ fn side(r: &Ref, s: &Split, split_key: u32) -> u8 {
 /// Split a cell's references into its children's: each child keeps its side's references
 /// in the parent's order, then the straddlers that reach into it, clipped to it (perfect
 /// splits). A straddler whose box crosses the plane may still miss one child entirely.
+///
+/// Each child's list is allocated once at its final size (kept plus straddlers bound it),
+/// so no list grows by copying itself into fresh pages.
 pub(super) fn split(
     ctx: &Ctx,
     mut refs: Vec<Ref>,
@@ -364,31 +367,34 @@ pub(super) fn split(
 ) -> [(Vec<Ref>, Aabb); 2] {
     let (cell_b, cell_a) = cell.split(s.axis, s.pos);
     let key = events::ordered(s.pos);
-    let clip = |t: u32| {
+    let clip = |&Ref { tri: t, .. }: &Ref| {
         let tri = &ctx.tris[t as usize];
         (
             clip::clipped_bounds(tri, &cell_b).map(|b| Ref { tri: t, b }),
             clip::clipped_bounds(tri, &cell_a).map(|b| Ref { tri: t, b }),
         )
     };
-    let (mut below, mut above, straddlers);
-    if refs.len() >= PARALLEL_MIN {
+    let (mut below, mut above, straddlers) = if refs.len() >= PARALLEL_MIN {
         let sides: Vec<u8> = refs.par_iter().map(|r| side(r, s, key)).collect();
-        let pick = |want: u8| {
-            refs.par_iter()
-                .zip(&sides)
-                .filter(move |(_, &x)| x == want)
-                .map(|(r, _)| *r)
-        };
-        below = pick(BELOW).collect::<Vec<_>>();
-        above = pick(ABOVE).collect::<Vec<_>>();
-        straddlers = pick(BOTH).map(|r| r.tri).collect::<Vec<_>>();
+        let counts: Vec<[usize; 4]> = sides
+            .par_chunks(CHUNK)
+            .map(|c| {
+                let mut n = [0; 4];
+                for &x in c {
+                    n[x as usize] += 1;
+                }
+                n
+            })
+            .collect();
+        let n_both: usize = counts.iter().map(|n| n[BOTH as usize]).sum();
+        let pick = |want: u8, room: usize| pick(&refs, &sides, &counts, want, room);
+        (pick(BELOW, n_both), pick(ABOVE, n_both), pick(BOTH, 0))
     } else {
         // The below child compacts into the parent's list (it never needs more room: the
-        // kept and the straddlers of one side are at most all of the parent), so only the
-        // other side allocates.
-        above = Vec::new();
-        let mut strad = Vec::new();
+        // kept and the straddlers of one side are at most all of the parent); the above
+        // child's list gets that much room at once.
+        let mut above = Vec::with_capacity(refs.len());
+        let mut straddlers = Vec::new();
         let mut kept = 0;
         for i in 0..refs.len() {
             let r = refs[i];
@@ -398,21 +404,53 @@ pub(super) fn split(
                     kept += 1;
                 }
                 ABOVE => above.push(r),
-                _ => strad.push(r.tri),
+                _ => straddlers.push(r),
             }
         }
         refs.truncate(kept);
-        below = refs;
-        straddlers = strad;
-    }
+        (refs, above, straddlers)
+    };
     let clipped: Vec<(Option<Ref>, Option<Ref>)> = if straddlers.len() > 4096 {
-        straddlers.par_iter().map(|&t| clip(t)).collect()
+        straddlers.par_iter().map(clip).collect()
     } else {
-        straddlers.iter().map(|&t| clip(t)).collect()
+        straddlers.iter().map(clip).collect()
     };
     below.extend(clipped.iter().filter_map(|c| c.0));
     above.extend(clipped.iter().filter_map(|c| c.1));
     [(below, cell_b), (above, cell_a)]
+}
+
+/// The references on side `want`, in order, in a list with room for `extra` more: every
+/// chunk of `CHUNK` references writes its part of the list in parallel, at the place the
+/// counts before it (`counts`, per chunk and side) give it.
+fn pick(refs: &[Ref], sides: &[u8], counts: &[[usize; 4]], want: u8, extra: usize) -> Vec<Ref> {
+    let total: usize = counts.iter().map(|n| n[want as usize]).sum();
+    let mut out = Vec::with_capacity(total + extra);
+    let mut rest = &mut out.spare_capacity_mut()[..total];
+    let mut parts = Vec::with_capacity(counts.len());
+    for n in counts {
+        let (part, tail) = rest.split_at_mut(n[want as usize]);
+        parts.push(part);
+        rest = tail;
+    }
+    refs.par_chunks(CHUNK)
+        .zip(sides.par_chunks(CHUNK))
+        .zip(parts)
+        .for_each(|((refs, sides), part)| {
+            let mut k = 0;
+            for (r, &x) in refs.iter().zip(sides) {
+                if x == want {
+                    part[k].write(*r);
+                    k += 1;
+                }
+            }
+            // Checked once per chunk: it is what makes `set_len` below sound.
+            assert_eq!(k, part.len(), "a chunk's count differs from its sides");
+        });
+    // SAFETY: the parts tile the first `total` slots, and each chunk filled its part
+    // (asserted above), so all `total` are initialised.
+    unsafe { out.set_len(total) };
+    out
 }
 
 /// Hand a cell over to the event builder: its triangles in reference order and each
@@ -437,6 +475,7 @@ pub(super) fn to_work(refs: Vec<Ref>, cell: Aabb) -> Work {
 #[cfg(test)]
 mod tests {
     use super::super::build_with;
+    use super::PARALLEL_MIN;
     use crate::testkit::{self as meshes, Rng};
     use formats::BuildParams;
     use glam::Vec3;
@@ -483,6 +522,21 @@ mod tests {
         ] {
             same_tree(&tris, &params).unwrap();
         }
+    }
+
+    /// Cells of at least `PARALLEL_MIN` references split on both threads, each chunk
+    /// writing its part of the children's lists: the same tree as the event builder's.
+    #[test]
+    fn large_cells_split_on_both_threads_into_the_same_tree() {
+        let mut tris = meshes::sphere(Vec3::new(0.2, 0.4, -0.1), 3.0, 200, 300);
+        tris.extend(meshes::grid(90, 30.0, -3.5));
+        assert!(tris.len() >= 2 * PARALLEL_MIN, "{}", tris.len());
+        let params = BuildParams::default();
+        let events = build_with(&tris, &params, [0; 32], usize::MAX);
+        let binned = build_with(&tris, &params, [0; 32], 0);
+        assert_eq!(binned.nodes, events.nodes);
+        assert_eq!(binned.leaf_tris, events.leaf_tris);
+        assert!(binned.nodes.len() > 20_000, "{}", binned.nodes.len());
     }
 
     #[test]

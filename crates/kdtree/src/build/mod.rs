@@ -197,14 +197,25 @@ fn build_with(
         max_depth: depth_bound(params, n),
         event_max,
     };
-    let refs: Vec<Ref> = (0..n as u32)
-        .into_par_iter()
-        .filter(|&i| triangles[i as usize].iter().all(|v| v.is_finite()))
-        .map(|tri| Ref {
-            tri,
-            b: Aabb::of_triangle(&triangles[tri as usize]),
+    // Written in place at their final size (a filtered parallel collect would gather
+    // pieces and copy them into fresh pages); the rare non-finite triangles are marked,
+    // then dropped.
+    const NON_FINITE: u32 = u32::MAX;
+    let mut refs: Vec<Ref> = triangles
+        .par_iter()
+        .enumerate()
+        .map(|(i, t)| Ref {
+            tri: if t.iter().all(|v| v.is_finite()) {
+                i as u32
+            } else {
+                NON_FINITE
+            },
+            b: Aabb::of_triangle(t),
         })
         .collect();
+    if refs.par_iter().any(|r| r.tri == NON_FINITE) {
+        refs.retain(|r| r.tri != NON_FINITE);
+    }
     let cell = refs
         .par_iter()
         .map(|r| r.b)
