@@ -213,13 +213,17 @@ fn build_with(
             b: Aabb::of_triangle(t),
         })
         .collect();
-    if refs.par_iter().any(|r| r.tri == NON_FINITE) {
+    // One pass finds the bounds of the finite ones and whether any are to be dropped.
+    let (cell, non_finite) = refs
+        .par_iter()
+        .map(|r| match r.tri {
+            NON_FINITE => (Aabb::EMPTY, true),
+            _ => (r.b, false),
+        })
+        .reduce(|| (Aabb::EMPTY, false), |a, b| (a.0.union(&b.0), a.1 | b.1));
+    if non_finite {
         refs.retain(|r| r.tri != NON_FINITE);
     }
-    let cell = refs
-        .par_iter()
-        .map(|r| r.b)
-        .reduce(|| Aabb::EMPTY, |a, b| a.union(&b));
     let tree = if refs.is_empty() {
         Subtree {
             nodes: vec![KdNode::leaf(0, 0)],
