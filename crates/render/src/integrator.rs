@@ -742,45 +742,66 @@ impl<'a> Integrator<'a> {
     /// otherwise. Cut-out holes are tested at full resolution: a shadow ray has no pixel
     /// footprint, and the full-size image gives the hole's true shape.
     fn transmittance(&self, surf: &Surface, dir: Vec3, dist: f32, counts: &mut RayCounts) -> f32 {
-        let origin = surf.spawn(dir);
-        let p = surf.p;
-        let ray = if dist.is_infinite() {
-            Ray {
-                origin,
-                dir,
-                tmin: SPAWN_TMIN,
-                tmax: f32::INFINITY,
-            }
-        } else {
-            // Re-measure from the spawned origin; stop short of the light by a relative margin.
-            let target = p + dir * dist;
-            let to = target - origin;
-            let d = to.length();
-            Ray {
-                origin,
-                dir: to / d,
-                tmin: SPAWN_TMIN,
-                tmax: d * SHADOW_TMAX_FRACTION,
-            }
-        };
+        let ray = shadow_ray(surf.spawn(dir), surf.p, dir, dist);
         if !self.shadow_filter {
             return if self.accel.occluded(&ray) { 0.0 } else { 1.0 };
         }
         if !self.alpha {
-            let blocked = self.accel.occluded_filtered(&ray, |hit, front| {
-                let prim = hit.prim as usize;
-                if self.casts(prim, front) {
-                    return true;
-                }
-                counts.shadow_pass_through += 1;
-                // Entering a closed piece: the face it leaves by casts (see `solid`).
-                let solid = self.solids.blocks(prim, &ray);
-                counts.shadow_solid += solid as u64;
-                solid
-            });
+            let blocked = self
+                .accel
+                .occluded_filtered(&ray, |hit, front| self.blocks(&ray, hit, front, counts));
             return if blocked { 0.0 } else { 1.0 };
         }
         self.transmittance_alpha(&ray, counts)
+    }
+
+    /// [`Integrator::transmittance`] of four shadow rays that leave one point towards one
+    /// light (a soft shadow's samples), traced as one packet: the same four answers and
+    /// counts, bit for bit. Lanes not in `live` trace nothing and answer 0.
+    fn transmittance4(
+        &self,
+        rays: &[Ray; LANES],
+        live: [bool; LANES],
+        counts: &mut RayCounts,
+    ) -> [f32; LANES] {
+        // A lane that is not live gets an empty interval: the packet never visits it.
+        let rays = std::array::from_fn(|l| {
+            if live[l] {
+                rays[l]
+            } else {
+                Ray {
+                    tmin: 1.0,
+                    tmax: 0.0,
+                    ..rays[l]
+                }
+            }
+        });
+        if self.alpha {
+            let t = self.transmittance_alpha4(&rays, counts);
+            return std::array::from_fn(|l| if live[l] { t[l] } else { 0.0 });
+        }
+        let blocked = if !self.shadow_filter {
+            self.accel.occluded4(&rays)
+        } else {
+            self.accel.occluded4_filtered(&rays, |l, hit, front| {
+                self.blocks(&rays[l], hit, front, counts)
+            })
+        };
+        std::array::from_fn(|l| if live[l] && !blocked[l] { 1.0 } else { 0.0 })
+    }
+
+    /// Whether a hit stops an opaque scene's shadow ray: a face that casts, or the face a
+    /// closed piece is left by (see `solid`); the faces it passes are counted.
+    #[inline(always)]
+    fn blocks(&self, ray: &Ray, hit: &Hit, front: bool, counts: &mut RayCounts) -> bool {
+        let prim = hit.prim as usize;
+        if self.casts(prim, front) {
+            return true;
+        }
+        counts.shadow_pass_through += 1;
+        let solid = self.solids.blocks(prim, ray);
+        counts.shadow_solid += solid as u64;
+        solid
     }
 
     /// [`Integrator::transmittance`] through cut-out holes and blended casters, out of
@@ -790,33 +811,61 @@ impl<'a> Integrator<'a> {
         let mut share = 1.0f32;
         let mut seen = Seen::new();
         let blocked = self.accel.occluded_filtered(ray, |hit, front| {
-            let prim = hit.prim as usize;
-            if !self.casts(prim, front) {
-                counts.shadow_pass_through += 1;
-                return false;
-            }
-            let s = &self.surfacing[self.soup.tri_material[prim] as usize];
-            match s.alpha {
-                AlphaUse::Opaque => true,
-                AlphaUse::Cutout { cutoff } => {
-                    let hole = self.alpha_at(s, prim, hit, ray.dir, 0.0, counts) < cutoff;
-                    counts.shadow_pass_through += hole as u64;
-                    !hole
-                }
-                AlphaUse::Blend => {
-                    if !seen.first(self.soup.tri_object[prim], hit.t) {
-                        return false;
-                    }
-                    counts.shadow_blend += 1;
-                    share *= 1.0 - self.alpha_at(s, prim, hit, ray.dir, 0.0, counts);
-                    share <= 0.0
-                }
-            }
+            self.stops(ray, hit, front, &mut share, &mut seen, counts)
         });
         if blocked {
             0.0
         } else {
             share
+        }
+    }
+
+    /// [`Integrator::transmittance_alpha`] on four rays, one packet, each lane with its own
+    /// share and blended points.
+    #[inline(never)]
+    fn transmittance_alpha4(&self, rays: &[Ray; LANES], counts: &mut RayCounts) -> [f32; LANES] {
+        let mut share = [1.0f32; LANES];
+        let mut seen: [Seen; LANES] = std::array::from_fn(|_| Seen::new());
+        let blocked = self.accel.occluded4_filtered(rays, |l, hit, front| {
+            self.stops(&rays[l], hit, front, &mut share[l], &mut seen[l], counts)
+        });
+        std::array::from_fn(|l| if blocked[l] { 0.0 } else { share[l] })
+    }
+
+    /// Whether a hit ends a shadow ray through cut-out and blended casters: an opaque
+    /// caster, a cut-out's solid texel, or blended layers that leave no light (`share`, the
+    /// light left, is attenuated by each blended object once per surface point, `seen`).
+    #[inline(always)]
+    fn stops(
+        &self,
+        ray: &Ray,
+        hit: &Hit,
+        front: bool,
+        share: &mut f32,
+        seen: &mut Seen,
+        counts: &mut RayCounts,
+    ) -> bool {
+        let prim = hit.prim as usize;
+        if !self.casts(prim, front) {
+            counts.shadow_pass_through += 1;
+            return false;
+        }
+        let s = &self.surfacing[self.soup.tri_material[prim] as usize];
+        match s.alpha {
+            AlphaUse::Opaque => true,
+            AlphaUse::Cutout { cutoff } => {
+                let hole = self.alpha_at(s, prim, hit, ray.dir, 0.0, counts) < cutoff;
+                counts.shadow_pass_through += hole as u64;
+                !hole
+            }
+            AlphaUse::Blend => {
+                if !seen.first(self.soup.tri_object[prim], hit.t) {
+                    return false;
+                }
+                counts.shadow_blend += 1;
+                *share *= 1.0 - self.alpha_at(s, prim, hit, ray.dir, 0.0, counts);
+                *share <= 0.0
+            }
         }
     }
 
@@ -835,39 +884,303 @@ impl<'a> Integrator<'a> {
         let n = self.soft_samples;
         let rotation = rng.next_f32() * std::f32::consts::TAU;
         let (t, b) = basis(inc.dir);
+        // A spawned origin depends on the side of the surface a ray leaves by, not on its
+        // direction: two origins serve every sample.
+        let above = surf.spawn(surf.ng);
+        let below = surf.spawn(-surf.ng);
+        let cos_half = cone_cos_half(light);
         let mut visible = 0.0f32;
-        for i in 0..n {
-            let (dx, dy) = disc_sample(i, n, rng.next_f32(), rotation);
-            counts.soft_shadow += 1;
-            visible += match light.kind {
-                LightKind::Directional => {
-                    // Uniform over the spherical cap, stratified by the disc's area strata.
-                    let half = (light.shadow_radius * 0.5)
-                        .to_radians()
-                        .min(std::f32::consts::FRAC_PI_2);
-                    let r2 = dx * dx + dy * dy;
-                    let cos_t = 1.0 - r2 * (1.0 - half.cos());
-                    let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
-                    let r = r2.sqrt();
-                    let (c, s) = if r > 0.0 {
-                        (dx / r, dy / r)
-                    } else {
-                        (1.0, 0.0)
-                    };
-                    let dir = (t * (c * sin_t) + b * (s * sin_t) + inc.dir * cos_t).normalize();
-                    self.transmittance(surf, dir, f32::INFINITY, counts)
-                }
-                LightKind::Point | LightKind::Spot { .. } => {
-                    let q = light.position + (t * dx + b * dy) * light.shadow_radius;
-                    let to = q - surf.p;
-                    let dist = to.length();
-                    if dist <= 0.0 {
-                        continue;
-                    }
-                    self.transmittance(surf, to / dist, dist, counts)
-                }
-            };
+        // The samples leave one point towards one light, so four at a time share their walk
+        // through the tree. Tracing draws nothing from `rng`: the samples are the same as
+        // when each was traced before the next was drawn, and so are their sum and counts.
+        let mut first = 0;
+        while first < n {
+            let mut rays = [Ray::new(surf.p, inc.dir, 0.0, 0.0); LANES];
+            let mut live = [false; LANES];
+            for (l, i) in (first..n.min(first + LANES as u32)).enumerate() {
+                let (dx, dy) = disc_sample(i, n, rng.next_f32(), rotation);
+                counts.soft_shadow += 1;
+                let Some((dir, dist)) =
+                    soft_sample(light, surf.p, inc.dir, (t, b), cos_half, dx, dy)
+                else {
+                    continue;
+                };
+                let origin = if dir.dot(surf.ng) < 0.0 { below } else { above };
+                rays[l] = shadow_ray(origin, surf.p, dir, dist);
+                live[l] = true;
+            }
+            // Lanes that are not live answer 0, which leaves the sum as it was.
+            for v in self.transmittance4(&rays, live, counts) {
+                visible += v;
+            }
+            first += LANES as u32;
         }
         visible / n as f32
+    }
+}
+
+/// The cosine of the half angle of a directional light's soft-shadow cone (its
+/// `shadow_radius` is the cone's angular diameter in degrees, at most a hemisphere).
+fn cone_cos_half(light: &Light) -> f32 {
+    (light.shadow_radius * 0.5)
+        .to_radians()
+        .min(std::f32::consts::FRAC_PI_2)
+        .cos()
+}
+
+/// Direction and distance of one soft-shadow sample from `p`, for the point (dx, dy) of
+/// the unit disc: a cone of angular diameter `shadow_radius` degrees around `towards`
+/// (directional; `cos_half` is the cosine of its half angle), or a point of the disc of
+/// radius `shadow_radius` spanned by `tb` around the light (point, spot). None when that
+/// point is `p` itself.
+fn soft_sample(
+    light: &Light,
+    p: Vec3,
+    towards: Vec3,
+    (t, b): (Vec3, Vec3),
+    cos_half: f32,
+    dx: f32,
+    dy: f32,
+) -> Option<(Vec3, f32)> {
+    match light.kind {
+        LightKind::Directional => {
+            // Uniform over the spherical cap, stratified by the disc's area strata.
+            let r2 = dx * dx + dy * dy;
+            let cos_t = 1.0 - r2 * (1.0 - cos_half);
+            let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+            let r = r2.sqrt();
+            let (c, s) = if r > 0.0 {
+                (dx / r, dy / r)
+            } else {
+                (1.0, 0.0)
+            };
+            let dir = (t * (c * sin_t) + b * (s * sin_t) + towards * cos_t).normalize();
+            Some((dir, f32::INFINITY))
+        }
+        LightKind::Point | LightKind::Spot { .. } => {
+            let q = light.position + (t * dx + b * dy) * light.shadow_radius;
+            let to = q - p;
+            let dist = to.length();
+            // Written so that a NaN distance is traced (and refused by the traversal), as
+            // every other non-finite ray is.
+            if dist <= 0.0 {
+                None
+            } else {
+                Some((to / dist, dist))
+            }
+        }
+    }
+}
+
+/// The shadow ray from `origin` (spawned off the surface point `p` towards `dir`) along
+/// unit `dir` towards a light `dist` away from `p` (`dist` infinite: a directional light,
+/// the ray is unbounded), re-aimed and re-measured from the spawned origin and stopped
+/// short of the light by a relative margin.
+fn shadow_ray(origin: Vec3, p: Vec3, dir: Vec3, dist: f32) -> Ray {
+    if dist.is_infinite() {
+        return Ray {
+            origin,
+            dir,
+            tmin: SPAWN_TMIN,
+            tmax: f32::INFINITY,
+        };
+    }
+    let to = p + dir * dist - origin;
+    let d = to.length();
+    Ray {
+        origin,
+        dir: to / d,
+        tmin: SPAWN_TMIN,
+        tmax: d * SHADOW_TMAX_FRACTION,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::RenderOptions;
+    use formats::{Alpha, Cull, Material, Object, Shadows};
+
+    fn material(cull: Cull, alpha: Alpha, opacity: f32) -> Material {
+        Material {
+            name: "m".into(),
+            source: "test".into(),
+            color: Vec3::splat(0.5),
+            metallic: 0.0,
+            smoothness: 0.0,
+            reflectivity: None,
+            emission: Vec3::ZERO,
+            cull,
+            albedo_map: None,
+            opacity,
+            alpha,
+        }
+    }
+
+    fn light(kind: LightKind, position: Vec3, direction: Vec3, shadow_radius: f32) -> Light {
+        Light {
+            name: "l".into(),
+            kind,
+            position,
+            direction,
+            color: Vec3::ONE,
+            intensity: 1.0,
+            range: 50.0,
+            shadows: Shadows::Soft,
+            shadow_radius,
+            culling_mask: u32::MAX,
+        }
+    }
+
+    /// A floor under a one-sided occluder, a closed one-sided box and, with `blend`, a
+    /// half-transparent pane: casters that the shadow filter passes, solids and blending.
+    fn scene(blend: bool) -> (Soup, Accel) {
+        let mut soup = Soup::empty();
+        soup.materials = vec![
+            material(Cull::None, Alpha::Opaque, 1.0),
+            material(Cull::Back, Alpha::Opaque, 1.0),
+            material(Cull::None, Alpha::Blend, 0.5),
+        ];
+        let quad = |soup: &mut Soup, o: Vec3, u: Vec3, v: Vec3, m: u32| {
+            let obj = soup.objects.len() as u32;
+            soup.objects.push(Object::new("q", "test"));
+            let n = u.cross(v).normalize();
+            let p = [o, o + u, o + u + v, o + v];
+            for t in [[0, 1, 2], [0, 2, 3]] {
+                soup.push_triangle(t.map(|i| p[i]), [n; 3], None);
+                soup.tri_material.push(m);
+                soup.tri_object.push(obj);
+            }
+        };
+        quad(
+            &mut soup,
+            Vec3::new(-10.0, 0.0, -10.0),
+            Vec3::Z * 20.0,
+            Vec3::X * 20.0,
+            0,
+        );
+        // Faces down: its back faces the lights, and Unity's shadow pass culls it.
+        quad(
+            &mut soup,
+            Vec3::new(0.0, 2.0, -1.0),
+            Vec3::X * 1.5,
+            Vec3::Z * 2.0,
+            1,
+        );
+        // A closed box, faces outwards, one-sided.
+        let (lo, d) = (Vec3::new(-3.0, 0.5, -3.0), Vec3::ONE);
+        let (x, y, z) = (Vec3::X * d.x, Vec3::Y * d.y, Vec3::Z * d.z);
+        for (o, u, v) in [
+            (lo, x, z),
+            (lo + y, z, x),
+            (lo, y, x),
+            (lo + z, x, y),
+            (lo, z, y),
+            (lo + x, y, z),
+        ] {
+            quad(&mut soup, o, u, v, 1);
+        }
+        if blend {
+            quad(
+                &mut soup,
+                Vec3::new(1.5, 1.0, 1.0),
+                Vec3::Z * 1.5,
+                Vec3::X * 1.5,
+                2,
+            );
+        }
+        soup.lights = vec![
+            light(LightKind::Point, Vec3::new(3.0, 4.0, 0.5), -Vec3::Y, 0.7),
+            light(
+                LightKind::Directional,
+                Vec3::ZERO,
+                Vec3::new(-0.6, -0.8, 0.1),
+                12.0,
+            ),
+        ];
+        soup.seal();
+        soup.validate().expect("valid test scene");
+        let kd = kdtree::build(
+            &soup.triangle_positions(),
+            &formats::BuildParams::default(),
+            soup.geometry_hash,
+        );
+        let accel = Accel::new(&soup, kd).expect("tree fits");
+        (soup, accel)
+    }
+
+    /// Soft shadows traced four samples at a time give, point by point, the visibility,
+    /// the counts and the generator state of tracing each sample alone with the hard
+    /// shadows' query, bit for bit, for sample counts that fill four lanes, leave a tail
+    /// or use one lane, through filtered, solid and blended casters, from either side of a
+    /// surface.
+    #[test]
+    fn soft_samples_in_packets_equal_samples_alone() {
+        for blend in [false, true] {
+            let (soup, accel) = scene(blend);
+            let plan = Plan::derive(&soup, &RenderOptions::default());
+            assert!(plan.shadow_casting.enabled && plan.alpha.enabled == blend);
+            for n in [1, 3, 4, 9, 16] {
+                let it = Integrator::new(&soup, &accel, &plan, n, TextureFilter::Cone);
+                let (mut dark, mut penumbra, mut lit) = (0, 0, 0);
+                for (k, light) in soup.lights.iter().enumerate() {
+                    for i in 0..900 {
+                        let p = Vec3::new(
+                            -6.0 + (i % 30) as f32 * 0.4,
+                            0.0,
+                            -6.0 + (i / 30) as f32 * 0.4,
+                        );
+                        let floor = [p, p + Vec3::Z, p + Vec3::X];
+                        let surf = Surface {
+                            p,
+                            err: Vec3::ZERO,
+                            margin: intersector_margin(&floor),
+                            // Every other point is seen from below: its rays leave by
+                            // the other side.
+                            ng: if i % 2 == 0 { Vec3::Y } else { -Vec3::Y },
+                        };
+                        let Some(inc) = incident(light, p) else {
+                            continue;
+                        };
+                        let seed = (k * 1000 + i) as u64;
+                        let (mut rng_a, mut counts_a) = (Rng::new(seed), RayCounts::default());
+                        let packed =
+                            it.soft_visibility(&surf, light, &inc, &mut rng_a, &mut counts_a);
+
+                        let (mut rng_b, mut counts_b) = (Rng::new(seed), RayCounts::default());
+                        let rotation = rng_b.next_f32() * std::f32::consts::TAU;
+                        let tb = basis(inc.dir);
+                        let mut alone = 0.0f32;
+                        for s in 0..n {
+                            let (dx, dy) = disc_sample(s, n, rng_b.next_f32(), rotation);
+                            counts_b.soft_shadow += 1;
+                            let cos_half = cone_cos_half(light);
+                            if let Some((dir, dist)) =
+                                soft_sample(light, p, inc.dir, tb, cos_half, dx, dy)
+                            {
+                                alone += it.transmittance(&surf, dir, dist, &mut counts_b);
+                            }
+                        }
+                        let alone = alone / n as f32;
+                        assert_eq!(
+                            packed.to_bits(),
+                            alone.to_bits(),
+                            "n {n}, light {k}, point {p}"
+                        );
+                        assert_eq!(counts_a, counts_b, "n {n}, light {k}, point {p}");
+                        assert_eq!(rng_a.next_u32(), rng_b.next_u32());
+                        match packed {
+                            0.0 => dark += 1,
+                            1.0 => lit += 1,
+                            _ => penumbra += 1,
+                        }
+                    }
+                }
+                assert!(dark > 0 && lit > 0, "n {n}: {dark} dark, {lit} lit");
+                if n > 1 {
+                    assert!(penumbra > 20, "n {n}: {penumbra} penumbra points");
+                }
+            }
+        }
     }
 }
