@@ -28,6 +28,9 @@ pub struct RayCounts {
     pub blend_continuation: u64,
     /// Blended surfaces that attenuated a shadow ray (each triangle once per ray).
     pub shadow_blend: u64,
+    /// Soft-shadow samples (counted in `soft_shadow`) found blocked by the opaque caster
+    /// that blocked an earlier sample of the same point: one triangle test, no walk.
+    pub shadow_reuse: u64,
     /// Albedo lookups at shaded points.
     pub texture_lookups: u64,
     /// Alpha lookups: cut-out tests inside the traversals and blended surfaces' alpha where
@@ -49,6 +52,7 @@ impl RayCounts {
         self.shadow_solid += o.shadow_solid;
         self.blend_continuation += o.blend_continuation;
         self.shadow_blend += o.shadow_blend;
+        self.shadow_reuse += o.shadow_reuse;
         self.texture_lookups += o.texture_lookups;
         self.alpha_lookups += o.alpha_lookups;
         self.sanitized += o.sanitized;
@@ -70,6 +74,7 @@ pub struct SharedCounts {
     shadow_solid: AtomicU64,
     blend_continuation: AtomicU64,
     shadow_blend: AtomicU64,
+    shadow_reuse: AtomicU64,
     texture_lookups: AtomicU64,
     alpha_lookups: AtomicU64,
     sanitized: AtomicU64,
@@ -88,6 +93,7 @@ impl SharedCounts {
         self.blend_continuation
             .fetch_add(c.blend_continuation, Relaxed);
         self.shadow_blend.fetch_add(c.shadow_blend, Relaxed);
+        self.shadow_reuse.fetch_add(c.shadow_reuse, Relaxed);
         self.texture_lookups.fetch_add(c.texture_lookups, Relaxed);
         self.alpha_lookups.fetch_add(c.alpha_lookups, Relaxed);
         self.sanitized.fetch_add(c.sanitized, Relaxed);
@@ -103,6 +109,7 @@ impl SharedCounts {
             shadow_solid: self.shadow_solid.load(Relaxed),
             blend_continuation: self.blend_continuation.load(Relaxed),
             shadow_blend: self.shadow_blend.load(Relaxed),
+            shadow_reuse: self.shadow_reuse.load(Relaxed),
             texture_lookups: self.texture_lookups.load(Relaxed),
             alpha_lookups: self.alpha_lookups.load(Relaxed),
             sanitized: self.sanitized.load(Relaxed),
