@@ -757,8 +757,11 @@ impl<'a> Integrator<'a> {
     }
 
     /// [`Integrator::transmittance`] of four shadow rays that leave one point towards one
-    /// light (a soft shadow's samples), traced as one packet: the same four answers and
-    /// counts, bit for bit. Lanes not in `live` trace nothing and answer 0.
+    /// light (a soft shadow's samples), traced as one packet: the same four answers, bit
+    /// for bit. `blocker` is an opaque caster that stopped an earlier sample of the point:
+    /// a lane it stops is answered without a walk (so it counts no faces passed), and the
+    /// packet's own opaque blockers replace it. Lanes not in `live` trace nothing and
+    /// answer 0.
     fn transmittance4(
         &self,
         rays: &[Ray; LANES],
