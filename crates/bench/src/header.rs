@@ -35,6 +35,8 @@ pub fn header(cfg: &Config) -> Vec<String> {
              primary ×{2}: the same rays in {3} pixel blocks, one packet query per block (k-d tree `intersect4` {4}, Embree `rtcIntersect{2}`); \
              shadow rays from every primary hit of the k-d tree to a light above the scene (any-hit); \
              shadow ×{2}: those of the primary ×{2} hits, in block order, one packet query per block (k-d tree `occluded4` {4}, Embree `rtcOccluded{2}`); \
+             soft: from every {2}th primary hit facing the sun (toward that light), {2} soft-shadow samples within a {5}° cone, spawned as the renderer spawns them (any-hit); \
+             soft ×{2}: the same, one packet query per hit (k-d tree `occluded4` on each four, Embree `rtcOccluded{2}`); \
              {1} random rays (origins uniform in the bounds, directions uniform on the sphere)",
             cfg.image,
             cfg.random_rays,
@@ -49,6 +51,7 @@ pub fn header(cfg: &Config) -> Vec<String> {
                 8 => "on each 2×2 half",
                 _ => "on each 2×2 quarter",
             },
+            crate::rays::SUN_DEGREES,
         ),
         format!(
             "timing: median of {} runs (traversal runs go round-robin over the contenders); threads {:?} (rayon pools of that size; Embree builds on a device of that many threads); \

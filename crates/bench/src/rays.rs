@@ -136,6 +136,55 @@ pub fn shadow(
         .collect()
 }
 
+/// Angular diameter of the sun's disc in [`soft`], in degrees: a directional light's soft
+/// shadows in Unity default to a small cone, and the corpus scenes' lights are a degree or
+/// two.
+pub const SUN_DEGREES: f32 = 2.0;
+
+/// A soft shadow's samples as the renderer traces them: from every `per_point`-th primary
+/// hit (so the set has about as many rays as there are hits) whose surface, seen from the
+/// camera, faces the sun, `per_point` rays spawned as the renderer spawns them, uniform over
+/// a cone of [`SUN_DEGREES`] around unit `sun`, unbounded. A hit's samples are
+/// consecutive, so packets of `per_point` rays are one point's samples, as the renderer's
+/// are. `hits[i]` is the closest hit of `primary[i]`, as for [`shadow`].
+pub fn soft(
+    triangles: &[[Vec3; 3]],
+    primary: &[Ray],
+    hits: &[Option<(u32, f32, f32)>],
+    sun: Vec3,
+    per_point: usize,
+    seed: u64,
+) -> Vec<Ray> {
+    use render::offset::{hit_point, intersector_margin, offset_origin, SPAWN_TMIN};
+    let per_point = per_point.max(1);
+    let mut rng = Rng(seed);
+    let (a, b) = sun.any_orthonormal_pair();
+    let cos_half = (SUN_DEGREES * 0.5).to_radians().cos();
+    let mut out = Vec::new();
+    let lit = primary.iter().zip(hits).filter_map(|(r, h)| {
+        let (prim, u, v) = (*h)?;
+        let t = triangles.get(prim as usize)?;
+        let mut ng = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
+        if ng.dot(r.dir) > 0.0 {
+            ng = -ng;
+        }
+        (ng.dot(sun) > 0.0).then_some((t, u, v, ng))
+    });
+    for (t, u, v, ng) in lit.step_by(per_point) {
+        let (p, err) = hit_point(t, u, v);
+        let margin = intersector_margin(t);
+        for _ in 0..per_point {
+            let cos_t = 1.0 - rng.unit() * (1.0 - cos_half);
+            let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+            let phi = rng.unit() * std::f32::consts::TAU;
+            let dir = (a * (sin_t * phi.cos()) + b * (sin_t * phi.sin()) + sun * cos_t).normalize();
+            let o = offset_origin(p, err, margin, ng, dir);
+            out.push(Ray::new(o, dir, SPAWN_TMIN, f32::INFINITY));
+        }
+    }
+    out
+}
+
 /// Where a surface ray goes: to a point (a light; the interval ends just short of it, as
 /// the renderer's shadow rays do) or in a direction (unbounded).
 #[derive(Clone, Copy, Debug)]
@@ -347,6 +396,37 @@ mod tests {
             assert!((m.origin - (r.origin + r.dir * MOVED)).length() < 1e-6);
             assert!((m.tmax - (r.tmax - MOVED)).abs() < 1e-5);
         }
+    }
+
+    #[test]
+    fn soft_rays_leave_every_nth_lit_hit_in_groups_within_the_cone() {
+        // Normal −Y (X × Z); seen from above, so the lit side is +Y.
+        let tris = [[Vec3::ZERO, Vec3::X, Vec3::Z]];
+        let down = Ray::new(Vec3::new(0.2, 5.0, 0.2), -Vec3::Y, 0.0, f32::INFINITY);
+        let up = Ray::new(Vec3::new(0.2, -5.0, 0.2), Vec3::Y, 0.0, f32::INFINITY);
+        let sun = Vec3::new(0.3, 1.0, 0.1).normalize();
+        let hit = Some((0, 0.25, 0.25));
+        // Hits seen from below face away from the sun; misses make no rays.
+        let primary = [down, up, down, down, up, down, down, down];
+        let hits = [hit, hit, None, hit, hit, hit, hit, hit];
+        let rays = soft(&tris, &primary, &hits, sun, 2, 5);
+        // Five lit hits, every second one: three points, two samples each.
+        assert_eq!(rays.len(), 6);
+        let cos_half = (SUN_DEGREES * 0.5).to_radians().cos();
+        for pair in rays.chunks(2) {
+            assert_eq!(pair[0].origin, pair[1].origin);
+            for r in pair {
+                assert!(r.origin.y > 0.0 && r.origin.y < 1e-5, "{r:?}");
+                assert!((r.dir.length() - 1.0).abs() < 1e-5);
+                assert!(r.dir.dot(sun) >= cos_half - 1e-6, "{r:?}");
+                assert_eq!(
+                    (r.tmin, r.tmax),
+                    (render::offset::SPAWN_TMIN, f32::INFINITY)
+                );
+            }
+            assert_ne!(pair[0].dir, pair[1].dir);
+        }
+        assert_eq!(rays, soft(&tris, &primary, &hits, sun, 2, 5));
     }
 
     #[test]

@@ -145,7 +145,10 @@ fn traversal(r: &Report, out: &mut String) {
          kdtree ÷ Embree on the same rays with the same thread count. Surface rays leave \
          random points of random triangles (offset as the renderer offsets secondary rays) \
          toward the shadow rays' light or into the normal's hemisphere; \"any\" columns \
-         trace the same rays as any-hit queries.\n\n\
+         trace the same rays as any-hit queries. Soft rays are a soft shadow's samples as \
+         the renderer traces them: from every n-th primary hit that faces the sun (a \
+         direction toward the shadow rays' light), n per hit within a cone of 2°, n the \
+         packet size; the soft packet column traces each hit's samples as one packet.\n\n\
          | scene | contender | threads |",
     );
     for k in Kind::all(r.config.packet) {

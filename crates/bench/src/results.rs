@@ -11,6 +11,11 @@ pub enum Kind {
     Shadow,
     /// Shadow rays from the packets' primary hits, in their order, one packet per block.
     ShadowPackets(usize),
+    /// A soft shadow's samples as the renderer traces them: from primary hits, several per
+    /// hit toward a small cone around a sun direction, each traced alone.
+    Soft,
+    /// The same rays, one packet per hit (its samples share their origin).
+    SoftPackets(usize),
     Random,
     /// From random surface points toward the light, closest hit.
     SurfaceLight,
@@ -24,12 +29,14 @@ pub enum Kind {
 
 impl Kind {
     /// Every ray set, the packet ones in packets of `packet` rays.
-    pub fn all(packet: usize) -> [Kind; 9] {
+    pub fn all(packet: usize) -> [Kind; 11] {
         [
             Kind::Primary,
             Kind::PrimaryPackets(packet),
             Kind::Shadow,
             Kind::ShadowPackets(packet),
+            Kind::Soft,
+            Kind::SoftPackets(packet),
             Kind::Random,
             Kind::SurfaceLight,
             Kind::SurfaceLightAny,
@@ -47,6 +54,10 @@ impl Kind {
             Kind::ShadowPackets(4) => "shadow ×4",
             Kind::ShadowPackets(8) => "shadow ×8",
             Kind::ShadowPackets(_) => "shadow ×16",
+            Kind::Soft => "soft",
+            Kind::SoftPackets(4) => "soft ×4",
+            Kind::SoftPackets(8) => "soft ×8",
+            Kind::SoftPackets(_) => "soft ×16",
             Kind::Random => "random",
             Kind::SurfaceLight => "surface→light",
             Kind::SurfaceLightAny => "surface→light any",
@@ -60,6 +71,8 @@ impl Kind {
             self,
             Kind::Shadow
                 | Kind::ShadowPackets(_)
+                | Kind::Soft
+                | Kind::SoftPackets(_)
                 | Kind::SurfaceLightAny
                 | Kind::SurfaceHemisphereAny
         )

@@ -1,6 +1,6 @@
 //! The benchmark itself: for each scene, build every contender with 1 and 2 threads,
-//! trace the same primary, shadow, random and surface-origin rays with each, and check
-//! that they agree.
+//! trace the same primary, shadow, soft-shadow, random and surface-origin rays with each,
+//! and check that they agree.
 
 use crate::agreement::{self, subset_indices, Answers};
 use crate::config::Config;
@@ -41,7 +41,7 @@ impl Bench<'_> {
                 for (c, (_, tracer)) in who.iter().enumerate() {
                     let start = Instant::now();
                     let a = match kind {
-                        Kind::ShadowPackets(n) => {
+                        Kind::ShadowPackets(n) | Kind::SoftPackets(n) => {
                             Answers::Occluded(trace_packets(pool, rays, n, |p, o| {
                                 tracer.occluded_packet(p, o)
                             }))
@@ -263,13 +263,14 @@ fn run_scene(
         rays::Toward::Direction(rays::hemisphere(rng, ng))
     });
 
-    let (mut shadow, mut shadow_blocks) = (vec![], vec![]);
+    let (mut shadow, mut shadow_blocks, mut soft) = (vec![], vec![], vec![]);
     for kind in Kind::all(cfg.packet) {
         let set: &[Ray] = match kind {
             Kind::Primary => &primary,
             Kind::PrimaryPackets(_) => &primary_blocks,
             Kind::Shadow => &shadow,
             Kind::ShadowPackets(_) => &shadow_blocks,
+            Kind::Soft | Kind::SoftPackets(_) => &soft,
             Kind::Random => &random,
             Kind::SurfaceLight | Kind::SurfaceLightAny => &surface_light,
             Kind::SurfaceHemisphere | Kind::SurfaceHemisphereAny => &surface_hemisphere,
@@ -326,7 +327,12 @@ fn run_scene(
                 .collect();
             let rays = rays::shadow(tris, &hits, rays::light_above(bounds), bounds);
             match kind {
-                Kind::Primary => shadow = rays,
+                Kind::Primary => {
+                    let sun = (rays::light_above(bounds) - (bounds[0] + bounds[1]) * 0.5)
+                        .normalize_or(Vec3::Y);
+                    soft = rays::soft(tris, &primary, &hits, sun, cfg.packet, 0x50F7 ^ n as u64);
+                    shadow = rays;
+                }
                 _ => shadow_blocks = rays,
             }
         }

@@ -62,7 +62,7 @@ fn quick_run_has_every_row_and_the_contenders_agree() {
     let mut all = contenders.clone();
     all.push(BRUTE);
     let kinds = Kind::all(cfg.packet).len();
-    assert_eq!(kinds, 9);
+    assert_eq!(kinds, 11);
     assert_eq!(s.traces.len(), all.len() * 2 * kinds);
     let rays = |who: &str, kind: Kind| {
         s.traces
@@ -82,6 +82,14 @@ fn quick_run_has_every_row_and_the_contenders_agree() {
     );
     // The same hits in block order: the same number of shadow rays.
     assert_eq!(rays(KDTREE, Kind::ShadowPackets(4)), shadow);
+    // Four samples from every fourth hit that faces the sun: at most one per hit, whole
+    // groups of four, the same rays singly and in packets.
+    let soft = rays(KDTREE, Kind::Soft);
+    assert!(
+        soft > 0 && soft <= shadow + 3 && soft % 4 == 0,
+        "{soft} soft rays"
+    );
+    assert_eq!(rays(KDTREE, Kind::SoftPackets(4)), soft);
     assert_eq!(rays(BRUTE, Kind::Primary), 512);
     assert_eq!(rays(BRUTE, Kind::PrimaryPackets(4)), 512);
     for k in [
@@ -122,8 +130,9 @@ fn quick_run_has_every_row_and_the_contenders_agree() {
     assert!(md.contains(&format!("| {name} | kdtree median | 1 |")));
     assert!(md.contains(&format!("| {name} | brute force | 1 |")));
     assert!(md.contains(&format!(
-        "| {name} | brute force | 0 / 512 | 0 / 512 | 0 / {0} | 0 / {0} | 0 / 512 | 0 / 512 | 0 / 512 | 0 / 512 | 0 / 512 | 100.0000% | ok | – |",
-        shadow.min(512)
+        "| {name} | brute force | 0 / 512 | 0 / 512 | 0 / {0} | 0 / {0} | 0 / {1} | 0 / {1} | 0 / 512 | 0 / 512 | 0 / 512 | 0 / 512 | 0 / 512 | 100.0000% | ok | – |",
+        shadow.min(512),
+        soft.min(512)
     )));
     assert_eq!(
         md.contains(&format!("| {name} | **kdtree/Embree** | 1 |")),
