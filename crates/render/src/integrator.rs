@@ -1046,6 +1046,7 @@ fn shadow_ray(origin: Vec3, p: Vec3, dir: Vec3, dist: f32) -> Ray {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::solid::tests::box_faces;
     use crate::RenderOptions;
     use formats::{Alpha, Cull, Material, Object, Shadows};
 
@@ -1116,16 +1117,7 @@ mod tests {
             1,
         );
         // A closed box, faces outwards, one-sided.
-        let (lo, d) = (Vec3::new(-3.0, 0.5, -3.0), Vec3::ONE);
-        let (x, y, z) = (Vec3::X * d.x, Vec3::Y * d.y, Vec3::Z * d.z);
-        for (o, u, v) in [
-            (lo, x, z),
-            (lo + y, z, x),
-            (lo, y, x),
-            (lo + z, x, y),
-            (lo, z, y),
-            (lo + x, y, z),
-        ] {
+        for (o, u, v) in box_faces(Vec3::new(-3.0, 0.5, -3.0), Vec3::ONE) {
             quad(&mut soup, o, u, v, 1);
         }
         if blend {

@@ -273,9 +273,23 @@ fn padded(lo: Vec3, hi: Vec3) -> [Vec3; 2] {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use formats::{Material, Object};
+
+    /// The six faces of the box from `lo` spanning `d`, as (corner, u, v) quads whose
+    /// fronts (u × v) face outwards.
+    pub(crate) fn box_faces(lo: Vec3, d: Vec3) -> [(Vec3, Vec3, Vec3); 6] {
+        let (x, y, z) = (Vec3::X * d.x, Vec3::Y * d.y, Vec3::Z * d.z);
+        [
+            (lo, x, z),
+            (lo + y, z, x),
+            (lo, y, x),
+            (lo + z, x, y),
+            (lo, z, y),
+            (lo + x, y, z),
+        ]
+    }
 
     /// One object: a closed unit cube at `lo` (outward faces, welded corners) and, when
     /// `with_quad`, a lone quad beside it.
@@ -286,18 +300,9 @@ mod tests {
             cull: Cull::Back,
             ..Material::unity_default()
         });
-        let lo = Vec3::new(2.0, 0.0, 0.0);
-        let (x, y, z) = (Vec3::X, Vec3::Y, Vec3::Z);
-        let mut faces = vec![
-            (lo, x, z),
-            (lo + y, z, x),
-            (lo, y, x),
-            (lo + z, x, y),
-            (lo, z, y),
-            (lo + x, y, z),
-        ];
+        let mut faces = box_faces(Vec3::new(2.0, 0.0, 0.0), Vec3::ONE).to_vec();
         if with_quad {
-            faces.push((Vec3::new(-3.0, 0.0, 0.0), x, z));
+            faces.push((Vec3::new(-3.0, 0.0, 0.0), Vec3::X, Vec3::Z));
         }
         for (o, u, v) in faces {
             for t in [[o, o + u, o + u + v], [o, o + u + v, o + v]] {
