@@ -940,9 +940,8 @@ impl<'a> Integrator<'a> {
         let mut blocker = None;
         // The samples leave one point towards one light, so four at a time share their walk
         // through the tree. Tracing draws nothing from `rng`: the samples are the same as
-        // when each was traced before the next was drawn, and so are their sum and counts.
-        let mut first = 0;
-        while first < n {
+        // when each was traced before the next was drawn, and so is their sum.
+        for first in (0..n).step_by(LANES) {
             let mut rays = [Ray::new(surf.p, inc.dir, 0.0, 0.0); LANES];
             let mut live = [false; LANES];
             for (l, i) in (first..n.min(first + LANES as u32)).enumerate() {
@@ -961,7 +960,6 @@ impl<'a> Integrator<'a> {
             for v in self.transmittance4(&rays, live, &mut blocker, counts) {
                 visible += v;
             }
-            first += LANES as u32;
         }
         visible / n as f32
     }
