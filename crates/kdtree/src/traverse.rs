@@ -323,8 +323,9 @@ impl Tree<'_> {
         unsafe { self.tris.get_unchecked(p as usize) }
     }
 
-    /// The watertight test on a group of 1–4 leaf entries (short groups repeat their last
-    /// entry, which cannot change an answer); returns the entries lane by lane.
+    /// The watertight test on a group of 1–4 leaf entries; returns the entries lane by lane.
+    /// A short group repeats its last entry in the lanes beyond it, which report no hit, so
+    /// that no filter is asked twice about one triangle (a face passed would count twice).
     #[inline(always)]
     fn test4<const KZ: usize>(
         &self,
@@ -336,7 +337,8 @@ impl Tree<'_> {
         let last = group[group.len() - 1];
         let lanes: [u32; 4] = std::array::from_fn(|l| *group.get(l).unwrap_or(&last));
         let tris = lanes.map(|p| self.tri(p));
-        let hits = triangle::intersect4_along::<KZ>(&s.pre, tris, ray.tmin, tmax);
+        let mut hits = triangle::intersect4_along::<KZ>(&s.pre, tris, ray.tmin, tmax);
+        hits.hit[group.len()..].fill(false);
         (lanes, hits)
     }
 

@@ -228,3 +228,65 @@ fn shadow_rays_of_neighbouring_pixels_get_their_single_answers() {
         "{blocked} of {lanes} shadow rays blocked"
     );
 }
+
+/// Three triangles in one leaf, all passed by the filter: each ray is asked about each
+/// triangle once, alone and in a packet, closest hit and any hit. (A short four-wide group
+/// repeats its last triangle in its spare lane; that lane's hit must not be asked about
+/// again, or a face passed would count twice.)
+#[test]
+fn a_leaf_asks_about_each_triangle_once() {
+    let tris: Vec<[Vec3; 3]> = (1..=3)
+        .map(|z| {
+            let z = z as f32;
+            [
+                Vec3::new(-1.0, -1.0, z),
+                Vec3::new(2.0, -1.0, z),
+                Vec3::new(-1.0, 2.0, z),
+            ]
+        })
+        .collect();
+    let params = BuildParams {
+        leaf_size: 8,
+        ..BuildParams::default()
+    };
+    let accel = Accel::build(&tris, &params);
+    let rays: [Ray; LANES] = std::array::from_fn(|l| {
+        let o = Vec3::new(0.1 * l as f32, 0.05 * l as f32, 0.0);
+        Ray::new(o, Vec3::new(0.01, 0.02, 1.0), 0.0, f32::INFINITY)
+    });
+    let sorted = |mut asked: Vec<u32>| {
+        asked.sort_unstable();
+        asked
+    };
+    for ray in &rays {
+        let mut asked = vec![];
+        assert_eq!(
+            accel.intersect_filtered(ray, |h, _| {
+                asked.push(h.prim);
+                false
+            }),
+            None
+        );
+        assert_eq!(sorted(asked), [0, 1, 2], "closest hit, {ray:?}");
+        let mut asked = vec![];
+        assert!(!accel.occluded_filtered(ray, |h, _| {
+            asked.push(h.prim);
+            false
+        }));
+        assert_eq!(sorted(asked), [0, 1, 2], "any hit, {ray:?}");
+    }
+    let mut asked: [Vec<u32>; LANES] = Default::default();
+    let got = accel.intersect4_filtered(&rays, |l, h, _| {
+        asked[l].push(h.prim);
+        false
+    });
+    assert_eq!(got, [None; LANES]);
+    assert_eq!(asked.map(sorted), [[0, 1, 2]; LANES], "closest hit, packet");
+    let mut asked: [Vec<u32>; LANES] = Default::default();
+    let got = accel.occluded4_filtered(&rays, |l, h, _| {
+        asked[l].push(h.prim);
+        false
+    });
+    assert_eq!(got, [false; LANES]);
+    assert_eq!(asked.map(sorted), [[0, 1, 2]; LANES], "any hit, packet");
+}
