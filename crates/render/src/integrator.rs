@@ -796,13 +796,15 @@ impl<'a> Integrator<'a> {
             let t = self.transmittance_alpha4(&rays, blocker, counts);
             return std::array::from_fn(|l| if live[l] { t[l] } else { 0.0 });
         }
+        let mut casters = [None; LANES];
         let blocked = self.accel.occluded4_filtered(&rays, |l, hit, front| {
             let stops = !self.shadow_filter || self.blocks(&rays[l], hit, front, counts);
             if stops && self.opaque_caster(hit.prim, front) {
-                *blocker = Some(hit.prim);
+                casters[l] = Some(hit.prim);
             }
             stops
         });
+        keep_last(blocker, casters);
         std::array::from_fn(|l| if live[l] && !blocked[l] { 1.0 } else { 0.0 })
     }
 
@@ -869,13 +871,15 @@ impl<'a> Integrator<'a> {
     ) -> [f32; LANES] {
         let mut share = [1.0f32; LANES];
         let mut seen: [Seen; LANES] = std::array::from_fn(|_| Seen::new());
+        let mut casters = [None; LANES];
         let blocked = self.accel.occluded4_filtered(rays, |l, hit, front| {
             let stops = self.stops(&rays[l], hit, front, &mut share[l], &mut seen[l], counts);
             if stops && self.opaque_caster(hit.prim, front) {
-                *blocker = Some(hit.prim);
+                casters[l] = Some(hit.prim);
             }
             stops
         });
+        keep_last(blocker, casters);
         std::array::from_fn(|l| if blocked[l] { 0.0 } else { share[l] })
     }
 
@@ -972,6 +976,16 @@ fn cone_cos_half(light: &Light) -> f32 {
         .to_radians()
         .min(std::f32::consts::FRAC_PI_2)
         .cos()
+}
+
+/// The point's blocker after a packet: the opaque caster that stopped the packet's last
+/// sample stopped by one, else the one before. By lane, not by the order the walk met them
+/// in, so the blocker (and what later samples count) does not depend on how a leaf's
+/// triangles are tested.
+fn keep_last(blocker: &mut Option<u32>, casters: [Option<u32>; LANES]) {
+    if let Some(&prim) = casters.iter().rev().flatten().next() {
+        *blocker = Some(prim);
+    }
 }
 
 /// Direction and distance of one soft-shadow sample from `p`, for the point (dx, dy) of
@@ -1145,6 +1159,19 @@ mod tests {
         );
         let accel = Accel::new(&soup, kd).expect("tree fits");
         (soup, accel)
+    }
+
+    /// The blocker a packet hands on is its highest stopped lane's, whatever order its
+    /// lanes were stopped in; a packet with none keeps the one before.
+    #[test]
+    fn a_packet_hands_on_its_last_lane_blocker() {
+        let mut blocker = Some(7);
+        keep_last(&mut blocker, [None; LANES]);
+        assert_eq!(blocker, Some(7));
+        keep_last(&mut blocker, [Some(3), None, Some(9), None]);
+        assert_eq!(blocker, Some(9));
+        keep_last(&mut blocker, [Some(4), None, None, Some(2)]);
+        assert_eq!(blocker, Some(2));
     }
 
     /// Soft shadows traced four samples at a time, with the samples that the caster which
