@@ -4,18 +4,22 @@
 //! four times.
 //!
 //! Each lane sees exactly what its own single-ray walk would: the same cells in the same
-//! order over the same intervals, the same triangle tests against the same bounds, and the
-//! same questions to the filter. At a node a lane goes to the first child, the second or
-//! both by the single walk's rule, with the single walk's intervals; the packet goes where
-//! any of its lanes goes and carries a mask of the lanes that go there. A closest-hit lane
-//! skips a waiting cell that starts beyond its best hit, an any-hit lane leaves the walk at
-//! its first blocker, as in the single walks. The four answers are therefore the single
-//! queries' answers, bit for bit. Rays whose directions differ in sign on some axis or in
-//! their dominant axis would want the children in different orders: they are traced one by
-//! one.
+//! order over the same intervals, the same triangles with the same arithmetic, and the same
+//! questions to the filter in the same order. Where it takes no more tests than each lane's
+//! own groups of four triangles, a leaf's triangles are tested one at a time against all
+//! four rays (each read once, not once per lane); a closest-hit lane's bound is then its
+//! best hit after the previous triangle rather than after the previous group of four, which
+//! refuses earlier only hits that the exact comparison would refuse anyway. At a node a
+//! lane goes to the first child, the second or both by the single walk's rule, with the
+//! single walk's intervals; the packet goes where any of its lanes goes and carries a mask
+//! of the lanes that go there. A closest-hit lane skips a waiting cell that starts beyond
+//! its best hit, an any-hit lane leaves the walk at its first blocker, as in the single
+//! walks. The four answers are therefore the single queries' answers, bit for bit. Rays
+//! whose directions differ in sign on some axis or in their dominant axis would want the
+//! children in different orders: they are traced one by one.
 
-use crate::traverse::{setup, Setup, Tree, STACK};
-use crate::triangle::PAD;
+use crate::traverse::{candidate, keep_closer, setup, Setup, Tree, STACK};
+use crate::triangle::{self, RayPre4, PAD};
 use crate::Ray;
 use formats::{Hit, KdNode};
 use glam::Vec4;
@@ -49,6 +53,9 @@ struct Packet {
     o: [Vec4; 3],
     inv: [Vec4; 3],
     forward: [bool; 3],
+    pre: RayPre4,
+    tmin: [f32; LANES],
+    tmax: [f32; LANES],
 }
 
 /// How four rays go through the tree. Built and taken apart within one query, on the
@@ -90,6 +97,9 @@ impl Packet {
             o: axis(|s, a| s.o[a]),
             inv: axis(|s, a| s.inv[a]),
             forward: [lead.inv[0] > 0.0, lead.inv[1] > 0.0, lead.inv[2] > 0.0],
+            pre: RayPre4::new(s.map(|s| s.pre)),
+            tmin: rays.each_ref().map(|r| r.tmin),
+            tmax: rays.each_ref().map(|r| r.tmax),
             s,
             live,
         })
@@ -225,16 +235,35 @@ impl Tree<'_> {
                 &mut stack,
                 &mut sp,
             );
-            for l in lanes_of(mask) {
-                let mut accept_l = |h: &Hit, front: bool| accept(l, h, front);
-                self.leaf_closest::<KZ, _>(
-                    &p.s[l],
-                    &rays[l],
-                    leaf,
-                    &mut best[l],
-                    &mut best_t[l],
-                    &mut accept_l,
-                );
+            if shared(leaf, mask) {
+                for &i in leaf {
+                    let bound = best_t.map(triangle::widen);
+                    let hits =
+                        triangle::intersect_rays4_along::<KZ>(&p.pre, self.tri(i), p.tmin, bound);
+                    for l in hits.hit_lanes().filter(|l| mask >> l & 1 != 0) {
+                        let mut accept_l = |h: &Hit, front: bool| accept(l, h, front);
+                        let prim = self.soup_index(i);
+                        keep_closer(
+                            &mut best[l],
+                            &mut best_t[l],
+                            prim,
+                            hits.raw(l),
+                            &mut accept_l,
+                        );
+                    }
+                }
+            } else {
+                for l in lanes_of(mask) {
+                    let mut accept_l = |h: &Hit, front: bool| accept(l, h, front);
+                    self.leaf_closest::<KZ, _>(
+                        &p.s[l],
+                        &rays[l],
+                        leaf,
+                        &mut best[l],
+                        &mut best_t[l],
+                        &mut accept_l,
+                    );
+                }
             }
             loop {
                 if sp == 0 {
@@ -300,10 +329,29 @@ impl Tree<'_> {
                 &mut stack,
                 &mut sp,
             );
-            for l in lanes_of(mask) {
-                let mut blocks_l = |h: &Hit, front: bool| blocks(l, h, front);
-                if self.leaf_any::<KZ, _>(&p.s[l], &rays[l], leaf, &mut blocks_l) {
-                    blocked |= 1 << l;
+            if shared(leaf, mask) {
+                let mut open = mask;
+                for &i in leaf {
+                    let hits =
+                        triangle::intersect_rays4_along::<KZ>(&p.pre, self.tri(i), p.tmin, p.tmax);
+                    let wanted = open;
+                    for l in hits.hit_lanes().filter(|l| wanted >> l & 1 != 0) {
+                        let h = hits.raw(l);
+                        if blocks(l, &candidate(self.soup_index(i), h), h.front) {
+                            open &= !(1 << l);
+                        }
+                    }
+                    if open == 0 {
+                        break;
+                    }
+                }
+                blocked |= mask & !open;
+            } else {
+                for l in lanes_of(mask) {
+                    let mut blocks_l = |h: &Hit, front: bool| blocks(l, h, front);
+                    if self.leaf_any::<KZ, _>(&p.s[l], &rays[l], leaf, &mut blocks_l) {
+                        blocked |= 1 << l;
+                    }
                 }
             }
             if blocked == p.live {
@@ -323,6 +371,13 @@ impl Tree<'_> {
             }
         }
     }
+}
+
+/// Whether the lanes in `mask` test `leaf` together, each triangle against all four rays
+/// at once, rather than each lane its four-triangle groups: when that is no more tests.
+#[inline(always)]
+fn shared(leaf: &[u32], mask: u8) -> bool {
+    leaf.len() <= mask.count_ones() as usize * leaf.len().div_ceil(4)
 }
 
 /// `traverse::pad_up` on four lanes.

@@ -316,7 +316,7 @@ impl Tree<'_> {
     }
 
     #[inline(always)]
-    fn tri(&self, p: u32) -> &[[f32; 3]; 3] {
+    pub(crate) fn tri(&self, p: u32) -> &[[f32; 3]; 3] {
         debug_assert!((p as usize) < self.tris.len());
         // SAFETY: `Accel::assemble` renumbers every leaf entry to the position where it
         // pushed that triangle into `tris`, so each entry is < tris.len().
@@ -343,7 +343,7 @@ impl Tree<'_> {
     }
 
     #[inline(always)]
-    fn soup_index(&self, p: u32) -> u32 {
+    pub(crate) fn soup_index(&self, p: u32) -> u32 {
         debug_assert!((p as usize) < self.soup_index.len());
         // SAFETY: as for `tri`: `soup_index` has one entry per element of `tris`.
         unsafe { *self.soup_index.get_unchecked(p as usize) }
@@ -558,7 +558,7 @@ pub(crate) fn keep_closer<F: FnMut(&Hit, bool) -> bool>(
 }
 
 #[inline(always)]
-fn candidate(prim: u32, h: RawHit) -> Hit {
+pub(crate) fn candidate(prim: u32, h: RawHit) -> Hit {
     Hit {
         t: h.t,
         prim,

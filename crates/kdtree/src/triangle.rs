@@ -336,18 +336,102 @@ pub fn intersect4_along<const KZ: usize>(
     debug_assert_eq!(r.kz, KZ);
     let kx = (KZ + 1) % 3;
     let ky = (KZ + 2) % 3;
-    let (sx, sy, sz, o) = (r.sx, r.sy, r.sz, r.origin);
+    let o = r.origin;
     // One vector per coordinate: vertex k's coordinate on `axis`, relative to the origin.
     let vertices = gather4(tri);
     let rel = |k: usize, axis: usize| vertices[k][axis] - Vec4::splat(o[axis]);
-    let (az, bz, cz) = (rel(0, KZ), rel(1, KZ), rel(2, KZ));
-    let (sxv, syv) = (Vec4::splat(sx), Vec4::splat(sy));
-    let ax = rel(0, kx) - sxv * az;
-    let ay = rel(0, ky) - syv * az;
-    let bx = rel(1, kx) - sxv * bz;
-    let by = rel(1, ky) - syv * bz;
-    let cx = rel(2, kx) - sxv * cz;
-    let cy = rel(2, ky) - syv * cz;
+    let z = [rel(0, KZ), rel(1, KZ), rel(2, KZ)];
+    let xy = [
+        rel(0, kx),
+        rel(0, ky),
+        rel(1, kx),
+        rel(1, ky),
+        rel(2, kx),
+        rel(2, ky),
+    ];
+    let shear = [Vec4::splat(r.sx), Vec4::splat(r.sy), Vec4::splat(r.sz)];
+    lanes4(xy, z, shear, [Vec4::splat(tmin), Vec4::splat(tmax)], |l| {
+        intersect_along::<KZ>(r, tri[l], tmin, tmax)
+    })
+}
+
+/// Four rays' constants of the watertight test, one lane per ray, for testing one triangle
+/// against four rays with the same dominant axis ([`intersect_rays4_along`]).
+#[derive(Clone, Copy, Debug)]
+pub struct RayPre4 {
+    pub rays: [RayPre; 4],
+    origin: [Vec4; 3],
+    shear: [Vec4; 3],
+}
+
+impl RayPre4 {
+    /// The four rays' constants gathered lane by lane; every `kz` must be the same.
+    #[inline(always)]
+    pub fn new(rays: [RayPre; 4]) -> RayPre4 {
+        let lanes = |f: fn(&RayPre) -> f32| Vec4::from_array(rays.each_ref().map(f));
+        RayPre4 {
+            origin: [
+                lanes(|r| r.origin[0]),
+                lanes(|r| r.origin[1]),
+                lanes(|r| r.origin[2]),
+            ],
+            shear: [lanes(|r| r.sx), lanes(|r| r.sy), lanes(|r| r.sz)],
+            rays,
+        }
+    }
+}
+
+/// [`intersect_along`] for one triangle against four rays, lane `l` the test of ray
+/// `r.rays[l]` in [`tmin[l]`, `tmax[l]`], each with the same bits as the scalar test (a ray
+/// with an edge function exactly zero goes to it, for its f64 decision). The triangle is
+/// read once for four rays: a packet whose lanes reach the same leaf tests each of its
+/// triangles once, not once per lane.
+#[inline(always)]
+pub fn intersect_rays4_along<const KZ: usize>(
+    r: &RayPre4,
+    tri: &[[f32; 3]; 3],
+    tmin: [f32; 4],
+    tmax: [f32; 4],
+) -> Hits4 {
+    debug_assert!(r.rays.iter().all(|r| r.kz == KZ));
+    let kx = (KZ + 1) % 3;
+    let ky = (KZ + 2) % 3;
+    let rel = |k: usize, axis: usize| Vec4::splat(tri[k][axis]) - r.origin[axis];
+    let z = [rel(0, KZ), rel(1, KZ), rel(2, KZ)];
+    let xy = [
+        rel(0, kx),
+        rel(0, ky),
+        rel(1, kx),
+        rel(1, ky),
+        rel(2, kx),
+        rel(2, ky),
+    ];
+    let bounds = [Vec4::from_array(tmin), Vec4::from_array(tmax)];
+    lanes4(xy, z, r.shear, bounds, |l| {
+        intersect_along::<KZ>(&r.rays[l], tri, tmin[l], tmax[l])
+    })
+}
+
+/// The four-lane test from the vertices relative to each lane's origin: `xy` holds
+/// a, b and c's x and y (the axes after the dominant one), `z` their dominant-axis
+/// coordinates, `shear` the rays' sx, sy and sz, `bounds` their tmin and tmax. When some
+/// lane's edge function is exactly zero every lane is answered by `exact`, the scalar test.
+#[inline(always)]
+fn lanes4(
+    xy: [Vec4; 6],
+    z: [Vec4; 3],
+    shear: [Vec4; 3],
+    bounds: [Vec4; 2],
+    exact: impl Fn(usize) -> Option<RawHit>,
+) -> Hits4 {
+    let [sxv, syv, sz] = shear;
+    let [az, bz, cz] = z;
+    let ax = xy[0] - sxv * az;
+    let ay = xy[1] - syv * az;
+    let bx = xy[2] - sxv * bz;
+    let by = xy[3] - syv * bz;
+    let cx = xy[4] - sxv * cz;
+    let cy = xy[5] - syv * cz;
     let u = cx * by - cy * bx;
     let v = ax * cy - ay * cx;
     let w = bx * ay - by * ax;
@@ -363,8 +447,8 @@ pub fn intersect4_along<const KZ: usize>(
         front: [false; 4],
     };
     if zero.any() {
-        for (l, t) in tri.into_iter().enumerate() {
-            if let Some(h) = intersect_along::<KZ>(r, t, tmin, tmax) {
+        for l in 0..4 {
+            if let Some(h) = exact(l) {
                 (out.hit[l], out.t[l], out.u[l], out.v[l], out.front[l]) =
                     (true, h.t, h.u, h.v, h.front);
             }
@@ -387,7 +471,7 @@ pub fn intersect4_along<const KZ: usize>(
     let inv = Vec4::ONE / det;
     let max_z = max3_4(zu, zv, zw);
     let near = t.cmplt(max_z * (1.0 / 1024.0));
-    let (tmin4, tmax4) = (Vec4::splat(tmin), Vec4::splat(tmax));
+    let [tmin4, tmax4] = bounds;
     let hit = det.cmpne(z)
         & !det.is_nan_mask()
         & tt.cmpge(tmin4 * adet)
@@ -395,12 +479,8 @@ pub fn intersect4_along<const KZ: usize>(
         & t.cmpge(tmin4)
         & t.cmple(tmax4);
     let mut hit = hit.bitmask() & !outside;
-    // `faces_front`: the determinant's sign folded with the dominant axis's.
-    let front = if sz < 0.0 {
-        negative.bitmask()
-    } else {
-        !negative.bitmask()
-    };
+    // `faces_front`: the determinant's sign equal to the dominant axis's.
+    let front = !(negative.bitmask() ^ sz.cmplt(z).bitmask());
     out.u = (v * inv).to_array();
     out.v = (w * inv).to_array();
     let (t, inv) = (t.to_array(), inv.to_array());
@@ -576,6 +656,64 @@ mod tests {
                 let one = intersect(&r, tri, 0.0, tmax);
                 let lane = four.hit[l].then(|| four.raw(l));
                 assert_eq!(bits(lane), bits(one), "group {i}, lane {l}");
+                hits += one.is_some() as u32;
+                if let Some(h) = one {
+                    on_edges += (h.u == 0.0 || h.v == 0.0 || h.u + h.v == 1.0) as u32;
+                }
+            }
+        }
+        assert!(hits > 5_000, "{hits} hits");
+        assert!(on_edges > 100, "{on_edges} hits on an edge or vertex");
+    }
+
+    /// One random triangle against four random rays with the same dominant axis, each with
+    /// its own interval, a third snapped to a coarse grid with axis-aligned rays (the f64
+    /// path): every lane answers with exactly the scalar test's bits.
+    #[test]
+    fn one_triangle_four_rays_matches_the_scalar_test_bit_for_bit() {
+        let mut rng = crate::testkit::Rng(9);
+        let mut unit = move || 2.0 * rng.unit() - 1.0;
+        let bits =
+            |h: Option<RawHit>| h.map(|h| (h.t.to_bits(), h.u.to_bits(), h.v.to_bits(), h.front));
+        let (mut hits, mut on_edges) = (0, 0);
+        for i in 0..30_000 {
+            let snap = i % 3 == 0;
+            let mut p = || {
+                let v = 2.0 * unit();
+                if snap {
+                    v.round()
+                } else {
+                    v
+                }
+            };
+            let tri: [[f32; 3]; 3] = std::array::from_fn(|_| [p(), p(), p()]);
+            let kz = i % 3;
+            let rays: [RayPre; 4] = std::array::from_fn(|l| {
+                let mut o = [p(), p(), p()];
+                let mut d = if snap {
+                    [0.0; 3]
+                } else {
+                    [p() * 0.35, p() * 0.35, 0.0]
+                };
+                d.rotate_right(kz);
+                let along = if (i + l) % 2 == 0 { 1.0 } else { -1.0 };
+                d[kz] = along;
+                o[kz] -= 4.0 * along;
+                RayPre::new(Vec3::from(o), Vec3::from(d)).expect("a usable ray")
+            });
+            assert!(rays.iter().all(|r| r.kz == kz));
+            let tmin = std::array::from_fn(|l| [0.0, 3.5, 0.0, 1e-4][(i + l) % 4]);
+            let tmax = std::array::from_fn(|l| [f32::INFINITY, 5.0, 4.2, 1e30][(i + 2 * l) % 4]);
+            let four = RayPre4::new(rays);
+            let got = match kz {
+                0 => intersect_rays4_along::<0>(&four, &tri, tmin, tmax),
+                1 => intersect_rays4_along::<1>(&four, &tri, tmin, tmax),
+                _ => intersect_rays4_along::<2>(&four, &tri, tmin, tmax),
+            };
+            for l in 0..4 {
+                let one = intersect(&rays[l], &tri, tmin[l], tmax[l]);
+                let lane = got.hit[l].then(|| got.raw(l));
+                assert_eq!(bits(lane), bits(one), "triangle {i}, lane {l}");
                 hits += one.is_some() as u32;
                 if let Some(h) = one {
                     on_edges += (h.u == 0.0 || h.v == 0.0 || h.u + h.v == 1.0) as u32;
