@@ -18,7 +18,8 @@
 //! whose directions differ in sign on some axis or in their dominant axis would want the
 //! children in different orders: they are traced one by one.
 
-use crate::traverse::{candidate, keep_closer, setup, Setup, Tree, STACK};
+use crate::aabb::Aabb;
+use crate::traverse::{candidate, keep_closer, Tree, STACK};
 use crate::triangle::{self, RayPre4, PAD};
 use crate::Ray;
 use formats::{Hit, KdNode};
@@ -43,12 +44,12 @@ fn lanes_of(mask: u8) -> impl Iterator<Item = usize> {
     (0..LANES).filter(move |l| mask >> l & 1 != 0)
 }
 
-/// Four rays' numbers for one walk: each lane's setup (a lane without one borrows the
-/// lead's and never becomes active), the lanes that have one, and, axis by axis, the
-/// origins and reciprocal directions, so that a node's four plane distances are one vector
-/// operation, and which child comes first.
+/// Four rays' numbers for one walk, lane by lane: the lanes that meet the tree, their
+/// watertight-test constants, intervals within the tree's box, origins and reciprocal
+/// directions axis by axis (so that a node's four plane distances are one vector
+/// operation), and which child comes first. A lane that does not meet the tree holds
+/// numbers nobody reads.
 struct Packet {
-    s: [Setup; LANES],
     live: u8,
     o: [Vec4; 3],
     inv: [Vec4; 3],
@@ -56,6 +57,8 @@ struct Packet {
     pre: RayPre4,
     tmin: [f32; LANES],
     tmax: [f32; LANES],
+    t0: Vec4,
+    t1: Vec4,
 }
 
 /// How four rays go through the tree. Built and taken apart within one query, on the
@@ -72,47 +75,86 @@ enum Walk {
 }
 
 impl Packet {
+    /// `traverse::setup` on four lanes at once, the same operations on each lane's numbers
+    /// (so each lane's interval and test constants are its single query's), then whether
+    /// the lanes can walk together.
     #[inline(always)]
-    fn walk(rays: &[Ray; LANES], bounds: &crate::aabb::Aabb) -> Walk {
-        let setups = rays.each_ref().map(|r| setup(r, bounds));
-        let mut live = 0u8;
-        for (l, s) in setups.iter().enumerate() {
-            live |= (s.is_some() as u8) << l;
+    fn walk(rays: &[Ray; LANES], b: &Aabb) -> Walk {
+        let lanes = |f: fn(&Ray) -> f32| Vec4::from_array(rays.each_ref().map(f));
+        let o = [
+            lanes(|r| r.origin.x),
+            lanes(|r| r.origin.y),
+            lanes(|r| r.origin.z),
+        ];
+        let d = [lanes(|r| r.dir.x), lanes(|r| r.dir.y), lanes(|r| r.dir.z)];
+        let (tmin, tmax) = (lanes(|r| r.tmin), lanes(|r| r.tmax));
+        // The refusals of `setup` and `RayPre::new` as a lane mask: a bad interval, an
+        // origin or direction not finite, a zero dominant component, the box missed.
+        let inf = Vec4::splat(f32::INFINITY);
+        let mut ok = tmin.cmple(tmax) & tmax.cmpne(-inf) & tmin.cmpne(inf);
+        for a in 0..3 {
+            ok &= o[a].is_finite_mask() & d[a].is_finite_mask();
         }
-        let Some(lead) = setups.iter().flatten().next().copied() else {
+        let abs = d.map(Vec4::abs);
+        let kz0 = abs[0].cmpge(abs[1]) & abs[0].cmpge(abs[2]);
+        let kz1 = !kz0 & abs[1].cmpge(abs[2]);
+        ok &= Vec4::select(kz0, d[0], Vec4::select(kz1, d[1], d[2])).cmpne(Vec4::ZERO);
+        let inv = d.map(|d| Vec4::ONE / d);
+        let (mut t0, mut t1) = (tmin, tmax);
+        for a in 0..3 {
+            let parallel = !inv[a].is_finite_mask();
+            let (lo, hi) = (Vec4::splat(b.lo[a]), Vec4::splat(b.hi[a]));
+            ok &= !(parallel & (o[a].cmplt(lo) | o[a].cmpgt(hi)));
+            let ta = (lo - o[a]) * inv[a];
+            let tb = (hi - o[a]) * inv[a];
+            let positive = inv[a].cmpgt(Vec4::ZERO);
+            // No NaN reaches these in a lane that meets the box, so the vector maximum and
+            // minimum are `f32::max` and `f32::min`.
+            let near = Vec4::select(positive, ta, tb);
+            let far = Vec4::select(positive, tb, ta);
+            t0 = Vec4::select(parallel, t0, t0.max(near));
+            t1 = Vec4::select(parallel, t1, t1.min(far));
+        }
+        ok &= down4(t0).cmple(up4(t1));
+        let live = ok.bitmask() as u8;
+        if live == 0 {
             return Walk::Nowhere;
+        }
+        // Together when every lane that meets the tree has the lead's dominant axis and
+        // direction signs.
+        let alike = |m: u32| {
+            let m = m as u8 & live;
+            m == 0 || m == live
         };
+        let positive = inv.map(|i| i.cmpgt(Vec4::ZERO).bitmask());
         let together = live.count_ones() > 1
-            && setups.iter().flatten().all(|s| {
-                s.pre.kz == lead.pre.kz && (0..3).all(|a| (s.inv[a] > 0.0) == (lead.inv[a] > 0.0))
-            });
+            && alike(kz0.bitmask())
+            && alike(kz1.bitmask())
+            && positive.iter().all(|&m| alike(m));
         if !together {
             return Walk::Alone;
         }
-        let s = setups.map(|s| s.unwrap_or(lead));
-        let axis = |f: fn(&Setup, usize) -> f32| -> [Vec4; 3] {
-            std::array::from_fn(|a| Vec4::from_array(s.each_ref().map(|s| f(s, a))))
+        let lead = live & live.wrapping_neg();
+        let kz = if kz0.bitmask() as u8 & lead != 0 {
+            0
+        } else if kz1.bitmask() as u8 & lead != 0 {
+            1
+        } else {
+            2
         };
+        let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
+        let shear = [d[kx] / d[kz], d[ky] / d[kz], Vec4::ONE / d[kz]];
         Walk::Together(Packet {
-            o: axis(|s, a| s.o[a]),
-            inv: axis(|s, a| s.inv[a]),
-            forward: [lead.inv[0] > 0.0, lead.inv[1] > 0.0, lead.inv[2] > 0.0],
-            pre: RayPre4::new(s.map(|s| s.pre)),
-            tmin: rays.each_ref().map(|r| r.tmin),
-            tmax: rays.each_ref().map(|r| r.tmax),
-            s,
             live,
+            forward: positive.map(|m| m as u8 & lead != 0),
+            pre: RayPre4::from_lanes(kz, o, shear),
+            o,
+            inv,
+            tmin: tmin.to_array(),
+            tmax: tmax.to_array(),
+            t0,
+            t1,
         })
-    }
-
-    #[inline(always)]
-    fn t0(&self) -> Vec4 {
-        Vec4::from_array(self.s.each_ref().map(|s| s.t0))
-    }
-
-    #[inline(always)]
-    fn t1(&self) -> Vec4 {
-        Vec4::from_array(self.s.each_ref().map(|s| s.t1))
     }
 }
 
@@ -205,7 +247,7 @@ impl Tree<'_> {
             }
             Walk::Nowhere => return [None; LANES],
         };
-        match p.s[0].pre.kz {
+        match p.pre.rays[0].kz {
             0 => self.closest4_along::<0, F>(rays, &p, &mut accept),
             1 => self.closest4_along::<1, F>(rays, &p, &mut accept),
             _ => self.closest4_along::<2, F>(rays, &p, &mut accept),
@@ -224,7 +266,7 @@ impl Tree<'_> {
         let mut best_t = rays.each_ref().map(|r| r.tmax);
         let mut stack = [MaybeUninit::<Waiting>::uninit(); STACK];
         let mut sp = 0;
-        let (mut node_i, mut mask, mut t0, mut t1) = (0u32, p.live, p.t0(), p.t1());
+        let (mut node_i, mut mask, mut t0, mut t1) = (0u32, p.live, p.t0, p.t1);
         loop {
             let leaf = self.to_leaf(
                 p,
@@ -256,7 +298,7 @@ impl Tree<'_> {
                 for l in lanes_of(mask) {
                     let mut accept_l = |h: &Hit, front: bool| accept(l, h, front);
                     self.leaf_closest::<KZ, _>(
-                        &p.s[l],
+                        &p.pre.rays[l],
                         &rays[l],
                         leaf,
                         &mut best[l],
@@ -299,7 +341,7 @@ impl Tree<'_> {
             }
             Walk::Nowhere => return [false; LANES],
         };
-        let blocked = match p.s[0].pre.kz {
+        let blocked = match p.pre.rays[0].kz {
             0 => self.any4_along::<0, F>(rays, &p, &mut blocks),
             1 => self.any4_along::<1, F>(rays, &p, &mut blocks),
             _ => self.any4_along::<2, F>(rays, &p, &mut blocks),
@@ -318,7 +360,7 @@ impl Tree<'_> {
         let mut blocked = 0u8;
         let mut stack = [MaybeUninit::<Waiting>::uninit(); STACK];
         let mut sp = 0;
-        let (mut node_i, mut mask, mut t0, mut t1) = (0u32, p.live, p.t0(), p.t1());
+        let (mut node_i, mut mask, mut t0, mut t1) = (0u32, p.live, p.t0, p.t1);
         loop {
             let leaf = self.to_leaf(
                 p,
@@ -349,7 +391,7 @@ impl Tree<'_> {
             } else {
                 for l in lanes_of(mask) {
                     let mut blocks_l = |h: &Hit, front: bool| blocks(l, h, front);
-                    if self.leaf_any::<KZ, _>(&p.s[l], &rays[l], leaf, &mut blocks_l) {
+                    if self.leaf_any::<KZ, _>(&p.pre.rays[l], &rays[l], leaf, &mut blocks_l) {
                         blocked |= 1 << l;
                     }
                 }

@@ -129,8 +129,13 @@ pub(crate) fn setup(ray: &Ray, b: &Aabb) -> Option<Setup> {
 }
 
 #[inline(always)]
-fn test<const KZ: usize>(s: &Setup, ray: &Ray, tri: &[[f32; 3]; 3], tmax: f32) -> Option<RawHit> {
-    triangle::intersect_along::<KZ>(&s.pre, tri, ray.tmin, tmax)
+fn test<const KZ: usize>(
+    pre: &RayPre,
+    ray: &Ray,
+    tri: &[[f32; 3]; 3],
+    tmax: f32,
+) -> Option<RawHit> {
+    triangle::intersect_along::<KZ>(pre, tri, ray.tmin, tmax)
 }
 
 /// Children of interior node `i` to visit, in order, with their intervals.
@@ -329,7 +334,7 @@ impl Tree<'_> {
     #[inline(always)]
     fn test4<const KZ: usize>(
         &self,
-        s: &Setup,
+        pre: &RayPre,
         ray: &Ray,
         group: &[u32],
         tmax: f32,
@@ -337,7 +342,7 @@ impl Tree<'_> {
         let last = group[group.len() - 1];
         let lanes: [u32; 4] = std::array::from_fn(|l| *group.get(l).unwrap_or(&last));
         let tris = lanes.map(|p| self.tri(p));
-        let mut hits = triangle::intersect4_along::<KZ>(&s.pre, tris, ray.tmin, tmax);
+        let mut hits = triangle::intersect4_along::<KZ>(pre, tris, ray.tmin, tmax);
         hits.hit[group.len()..].fill(false);
         (lanes, hits)
     }
@@ -393,7 +398,7 @@ impl Tree<'_> {
             }
             let leaf = self.leaf(node);
             count.leaf(leaf.len());
-            self.leaf_closest::<KZ, F>(s, ray, leaf, &mut best, &mut best_t, accept);
+            self.leaf_closest::<KZ, F>(&s.pre, ray, leaf, &mut best, &mut best_t, accept);
             // Next cell: the first waiting one that starts before the best hit. The stack
             // is not always front to back, so a cell that starts beyond the hit is skipped,
             // not taken as the end: a ray lying in a split plane waits on the far child over
@@ -416,7 +421,7 @@ impl Tree<'_> {
     #[inline(always)]
     pub(crate) fn leaf_closest<const KZ: usize, F: FnMut(&Hit, bool) -> bool>(
         &self,
-        s: &Setup,
+        pre: &RayPre,
         ray: &Ray,
         leaf: &[u32],
         best: &mut Hit,
@@ -426,7 +431,7 @@ impl Tree<'_> {
         if leaf.len() >= 2 {
             for group in leaf.chunks(4) {
                 let bound = triangle::widen(*best_t);
-                let (lanes, hits) = self.test4::<KZ>(s, ray, group, bound);
+                let (lanes, hits) = self.test4::<KZ>(pre, ray, group, bound);
                 for l in hits.hit_lanes() {
                     let p = self.soup_index(lanes[l]);
                     keep_closer(best, best_t, p, hits.raw(l), accept);
@@ -434,7 +439,7 @@ impl Tree<'_> {
             }
         } else {
             for &p in leaf {
-                if let Some(h) = test::<KZ>(s, ray, self.tri(p), triangle::widen(*best_t)) {
+                if let Some(h) = test::<KZ>(pre, ray, self.tri(p), triangle::widen(*best_t)) {
                     keep_closer(best, best_t, self.soup_index(p), h, accept);
                 }
             }
@@ -489,7 +494,7 @@ impl Tree<'_> {
             }
             let leaf = self.leaf(node);
             count.leaf(leaf.len());
-            if self.leaf_any::<KZ, F>(s, ray, leaf, blocks) {
+            if self.leaf_any::<KZ, F>(&s.pre, ray, leaf, blocks) {
                 return true;
             }
             if sp == 0 {
@@ -507,14 +512,14 @@ impl Tree<'_> {
     #[inline(always)]
     pub(crate) fn leaf_any<const KZ: usize, F: FnMut(&Hit, bool) -> bool>(
         &self,
-        s: &Setup,
+        pre: &RayPre,
         ray: &Ray,
         leaf: &[u32],
         blocks: &mut F,
     ) -> bool {
         if leaf.len() >= 2 {
             for group in leaf.chunks(4) {
-                let (lanes, hits) = self.test4::<KZ>(s, ray, group, ray.tmax);
+                let (lanes, hits) = self.test4::<KZ>(pre, ray, group, ray.tmax);
                 for l in hits.hit_lanes() {
                     let h = hits.raw(l);
                     if blocks(&candidate(self.soup_index(lanes[l]), h), h.front) {
@@ -524,7 +529,7 @@ impl Tree<'_> {
             }
         } else {
             for &p in leaf {
-                if let Some(h) = test::<KZ>(s, ray, self.tri(p), ray.tmax) {
+                if let Some(h) = test::<KZ>(pre, ray, self.tri(p), ray.tmax) {
                     if blocks(&candidate(self.soup_index(p), h), h.front) {
                         return true;
                     }

@@ -365,6 +365,24 @@ pub struct RayPre4 {
 }
 
 impl RayPre4 {
+    /// Four rays with dominant axis `kz`, from their origins and their sx, sy and sz
+    /// (`RayPre`'s fields) axis by axis, as vectors.
+    #[inline(always)]
+    pub fn from_lanes(kz: usize, origin: [Vec4; 3], shear: [Vec4; 3]) -> RayPre4 {
+        let [o, s] = [origin, shear].map(|v| v.map(|x| x.to_array()));
+        RayPre4 {
+            rays: std::array::from_fn(|l| RayPre {
+                origin: [o[0][l], o[1][l], o[2][l]],
+                kz,
+                sx: s[0][l],
+                sy: s[1][l],
+                sz: s[2][l],
+            }),
+            origin,
+            shear,
+        }
+    }
+
     /// The four rays' constants gathered lane by lane; every `kz` must be the same.
     #[inline(always)]
     pub fn new(rays: [RayPre; 4]) -> RayPre4 {
