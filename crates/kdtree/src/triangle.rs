@@ -382,21 +382,6 @@ impl RayPre4 {
             shear,
         }
     }
-
-    /// The four rays' constants gathered lane by lane; every `kz` must be the same.
-    #[inline(always)]
-    pub fn new(rays: [RayPre; 4]) -> RayPre4 {
-        let lanes = |f: fn(&RayPre) -> f32| Vec4::from_array(rays.each_ref().map(f));
-        RayPre4 {
-            origin: [
-                lanes(|r| r.origin[0]),
-                lanes(|r| r.origin[1]),
-                lanes(|r| r.origin[2]),
-            ],
-            shear: [lanes(|r| r.sx), lanes(|r| r.sy), lanes(|r| r.sz)],
-            rays,
-        }
-    }
 }
 
 /// [`intersect_along`] for one triangle against four rays, lane `l` the test of ray
@@ -629,30 +614,61 @@ mod tests {
         }
     }
 
+    /// Uniform in [-2, 2) (2·unit − 1 is exact on unit's 2⁻²⁴ grid), rounded to a whole
+    /// number when `snap`, so that edge functions come out exactly zero (the f64 path).
+    fn coord(rng: &mut crate::testkit::Rng, snap: bool) -> f32 {
+        let v = 2.0 * (2.0 * rng.unit() - 1.0);
+        if snap {
+            v.round()
+        } else {
+            v
+        }
+    }
+
+    /// Lanes held to the scalar test bit for bit, with how many of the scalar answers hit,
+    /// and hit on an edge or vertex.
+    #[derive(Default)]
+    struct Tally {
+        hits: u32,
+        on_edges: u32,
+    }
+
+    impl Tally {
+        fn lane(&mut self, got: Option<RawHit>, want: Option<RawHit>, what: std::fmt::Arguments) {
+            let bits = |h: Option<RawHit>| {
+                h.map(|h| (h.t.to_bits(), h.u.to_bits(), h.v.to_bits(), h.front))
+            };
+            assert_eq!(bits(got), bits(want), "{what}");
+            if let Some(h) = want {
+                self.hits += 1;
+                self.on_edges += (h.u == 0.0 || h.v == 0.0 || h.u + h.v == 1.0) as u32;
+            }
+        }
+
+        fn enough(&self) {
+            assert!(self.hits > 5_000, "{} hits", self.hits);
+            assert!(
+                self.on_edges > 100,
+                "{} hits on an edge or vertex",
+                self.on_edges
+            );
+        }
+    }
+
     /// Random groups of four triangles and rays, a third of them snapped to a coarse grid
     /// with axis-aligned rays so that edge functions are exactly zero (the f64 path):
     /// every lane answers with exactly the scalar test's bits.
     #[test]
     fn four_wide_matches_the_scalar_test_bit_for_bit() {
-        // Uniform in [-1, 1): 2·unit − 1 is exact on unit's 2⁻²⁴ grid.
         let mut rng = crate::testkit::Rng(7);
-        let mut unit = move || 2.0 * rng.unit() - 1.0;
-        let bits =
-            |h: Option<RawHit>| h.map(|h| (h.t.to_bits(), h.u.to_bits(), h.v.to_bits(), h.front));
-        let (mut hits, mut on_edges) = (0, 0);
+        let mut tally = Tally::default();
         for i in 0..30_000 {
             let snap = i % 3 == 0;
-            let mut p = || {
-                let v = 2.0 * unit();
-                if snap {
-                    v.round()
-                } else {
-                    v
-                }
-            };
+            let mut p = || coord(&mut rng, snap);
             let tris: [[[f32; 3]; 3]; 4] =
                 std::array::from_fn(|_| std::array::from_fn(|_| [p(), p(), p()]));
             let origin = Vec3::new(p(), p(), p() - 4.0);
+            let mut unit = || 2.0 * rng.unit() - 1.0;
             let dir = if snap {
                 [Vec3::X, Vec3::Y, Vec3::Z, -Vec3::Z][i % 4]
             } else {
@@ -671,17 +687,12 @@ mod tests {
             let lanes: Vec<usize> = four.hit_lanes().collect();
             assert_eq!(lanes, (0..4).filter(|&l| four.hit[l]).collect::<Vec<_>>());
             for (l, tri) in tris.iter().enumerate() {
-                let one = intersect(&r, tri, 0.0, tmax);
                 let lane = four.hit[l].then(|| four.raw(l));
-                assert_eq!(bits(lane), bits(one), "group {i}, lane {l}");
-                hits += one.is_some() as u32;
-                if let Some(h) = one {
-                    on_edges += (h.u == 0.0 || h.v == 0.0 || h.u + h.v == 1.0) as u32;
-                }
+                let one = intersect(&r, tri, 0.0, tmax);
+                tally.lane(lane, one, format_args!("group {i}, lane {l}"));
             }
         }
-        assert!(hits > 5_000, "{hits} hits");
-        assert!(on_edges > 100, "{on_edges} hits on an edge or vertex");
+        tally.enough();
     }
 
     /// One random triangle against four random rays with the same dominant axis, each with
@@ -690,20 +701,10 @@ mod tests {
     #[test]
     fn one_triangle_four_rays_matches_the_scalar_test_bit_for_bit() {
         let mut rng = crate::testkit::Rng(9);
-        let mut unit = move || 2.0 * rng.unit() - 1.0;
-        let bits =
-            |h: Option<RawHit>| h.map(|h| (h.t.to_bits(), h.u.to_bits(), h.v.to_bits(), h.front));
-        let (mut hits, mut on_edges) = (0, 0);
+        let mut tally = Tally::default();
         for i in 0..30_000 {
             let snap = i % 3 == 0;
-            let mut p = || {
-                let v = 2.0 * unit();
-                if snap {
-                    v.round()
-                } else {
-                    v
-                }
-            };
+            let mut p = || coord(&mut rng, snap);
             let tri: [[f32; 3]; 3] = std::array::from_fn(|_| [p(), p(), p()]);
             let kz = i % 3;
             let rays: [RayPre; 4] = std::array::from_fn(|l| {
@@ -722,24 +723,28 @@ mod tests {
             assert!(rays.iter().all(|r| r.kz == kz));
             let tmin = std::array::from_fn(|l| [0.0, 3.5, 0.0, 1e-4][(i + l) % 4]);
             let tmax = std::array::from_fn(|l| [f32::INFINITY, 5.0, 4.2, 1e30][(i + 2 * l) % 4]);
-            let four = RayPre4::new(rays);
+            let lanes = |f: fn(&RayPre) -> f32| Vec4::from_array(rays.each_ref().map(f));
+            let four = RayPre4::from_lanes(
+                kz,
+                [
+                    lanes(|r| r.origin[0]),
+                    lanes(|r| r.origin[1]),
+                    lanes(|r| r.origin[2]),
+                ],
+                [lanes(|r| r.sx), lanes(|r| r.sy), lanes(|r| r.sz)],
+            );
             let got = match kz {
                 0 => intersect_rays4_along::<0>(&four, &tri, tmin, tmax),
                 1 => intersect_rays4_along::<1>(&four, &tri, tmin, tmax),
                 _ => intersect_rays4_along::<2>(&four, &tri, tmin, tmax),
             };
             for l in 0..4 {
-                let one = intersect(&rays[l], &tri, tmin[l], tmax[l]);
                 let lane = got.hit[l].then(|| got.raw(l));
-                assert_eq!(bits(lane), bits(one), "triangle {i}, lane {l}");
-                hits += one.is_some() as u32;
-                if let Some(h) = one {
-                    on_edges += (h.u == 0.0 || h.v == 0.0 || h.u + h.v == 1.0) as u32;
-                }
+                let one = intersect(&rays[l], &tri, tmin[l], tmax[l]);
+                tally.lane(lane, one, format_args!("triangle {i}, lane {l}"));
             }
         }
-        assert!(hits > 5_000, "{hits} hits");
-        assert!(on_edges > 100, "{on_edges} hits on an edge or vertex");
+        tally.enough();
     }
 
     /// Two overlapping coplanar triangles of the baseline scene (soup triangles 8880 and
