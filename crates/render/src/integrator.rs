@@ -78,6 +78,34 @@ impl Surface {
     }
 }
 
+/// A surface point being shaded: what its lights and mirror ray need, and the light
+/// gathered so far.
+struct Lit {
+    l: Vec3,
+    /// The surface's α.
+    a: f32,
+    albedo: Vec3,
+    /// The albedo is not black, so lights can show.
+    lit: bool,
+    surf: Surface,
+    /// Unit shading normal, facing the ray.
+    ns: Vec3,
+    layer: u8,
+    /// The object receives shadows.
+    receives: bool,
+    reflectance: Vec3,
+}
+
+impl Lit {
+    /// Adds a light's share arriving from `inc` at cosine `cos`, `visible` of it unshadowed.
+    #[inline(always)]
+    fn add(&mut self, inc: &Incident, cos: f32, visible: f32) {
+        if visible > 0.0 {
+            self.l += inc.radiance * (cos * visible) * self.albedo;
+        }
+    }
+}
+
 /// What a material needs from its texture, resolved once per render.
 struct Surfacing {
     /// The sampler (index into `Integrator::samplers`) and tiling of its map.
@@ -340,38 +368,8 @@ impl<'a> Integrator<'a> {
         counts: &mut RayCounts,
     ) -> (Vec3, Primary) {
         let first = self.first_visible(ray, cone, counts);
-        self.camera_sample_from(ray, first, cone, rng, counts)
-    }
-
-    /// [`Integrator::camera_sample`] for the rays of four neighbouring pixels, their first
-    /// hits found together: the same four results and counts, bit for bit.
-    pub fn camera_sample4(
-        &self,
-        rays: &[Ray; LANES],
-        cone: RayCone,
-        rngs: &mut [Rng; LANES],
-        counts: &mut RayCounts,
-    ) -> [(Vec3, Primary); LANES] {
-        let first = self.first_visible4(rays, cone, counts);
-        let mut lanes = rngs.iter_mut().zip(rays).zip(first);
-        std::array::from_fn(|_| {
-            let ((rng, ray), first) = lanes.next().expect("four lanes");
-            self.camera_sample_from(ray, first, cone, rng, counts)
-        })
-    }
-
-    /// [`Integrator::camera_sample`] once the ray's first visible hit is known.
-    fn camera_sample_from(
-        &self,
-        ray: &Ray,
-        first: Option<Hit>,
-        cone: RayCone,
-        rng: &mut Rng,
-        counts: &mut RayCounts,
-    ) -> (Vec3, Primary) {
-        counts.camera += 1;
         let mut primary = Primary::MISS;
-        let mut l = self.radiance_from(
+        let l = self.radiance_from(
             ray,
             first,
             cone,
@@ -381,22 +379,42 @@ impl<'a> Integrator<'a> {
             counts,
             Some(&mut primary),
         );
-        if sanitize(&mut l) {
-            counts.sanitized += 1;
-        }
-        let mut n = primary.normal;
-        let mut a = primary.albedo;
-        if sanitize(&mut n) | sanitize(&mut a) || !primary.depth.is_finite() {
-            counts.sanitized += 1;
-            primary.depth = if primary.depth.is_finite() {
-                primary.depth
-            } else {
-                f32::MAX
-            };
-        }
-        primary.normal = n;
-        primary.albedo = a;
-        (l, primary)
+        finish_camera(l, primary, counts)
+    }
+
+    /// [`Integrator::camera_sample`] for the rays of four neighbouring pixels: their first
+    /// hits found together, and their first hits' hard shadow rays towards each light
+    /// traced together ([`Integrator::shade4`]). The same four results and counts, bit for
+    /// bit.
+    pub fn camera_sample4(
+        &self,
+        rays: &[Ray; LANES],
+        cone: RayCone,
+        rngs: &mut [Rng; LANES],
+        counts: &mut RayCounts,
+    ) -> [(Vec3, Primary); LANES] {
+        let first = self.first_visible4(rays, cone, counts);
+        let mut primary = [Primary::MISS; LANES];
+        let mut slots = primary.each_mut().map(Some);
+        let shaded = self.shade4(rays, &first, cone, rngs, counts, &mut slots);
+        let l: [Vec3; LANES] = std::array::from_fn(|i| match (first[i], shaded[i]) {
+            (Some(hit), Some(shaded)) => {
+                let slot = slots[i].take();
+                self.behind(
+                    &rays[i],
+                    hit,
+                    shaded,
+                    cone,
+                    0,
+                    Vec3::ONE,
+                    &mut rngs[i],
+                    counts,
+                    slot,
+                )
+            }
+            _ => environment::background(&self.soup.environment, rays[i].dir),
+        });
+        std::array::from_fn(|i| finish_camera(l[i], primary[i], counts))
     }
 
     /// Radiance along `ray`: the first visible surface's, and where that surface is
@@ -430,41 +448,51 @@ impl<'a> Integrator<'a> {
         primary: Option<&mut Primary>,
     ) -> Vec3 {
         let mut primary = primary;
+        let Some(hit) = first else {
+            return environment::background(&self.soup.environment, ray.dir);
+        };
+        let shaded = self.shade(
+            ray,
+            &hit,
+            cone,
+            bounce,
+            weight,
+            1.0,
+            rng,
+            counts,
+            &mut primary,
+        );
+        self.behind(ray, hit, shaded, cone, bounce, weight, rng, counts, primary)
+    }
+
+    /// [`Integrator::radiance`] once its first visible hit is shaded (`shaded`, its light
+    /// and α): that light, mixed, where the surface is blended, with what lies behind it.
+    /// `primary` is still to be filled when the first hit was fully transparent.
+    #[allow(clippy::too_many_arguments)]
+    fn behind(
+        &self,
+        ray: &Ray,
+        hit: Hit,
+        shaded: (Vec3, f32),
+        cone: RayCone,
+        bounce: u32,
+        weight: Vec3,
+        rng: &mut Rng,
+        counts: &mut RayCounts,
+        primary: Option<&mut Primary>,
+    ) -> Vec3 {
         if !self.alpha {
-            let Some(hit) = first else {
-                return environment::background(&self.soup.environment, ray.dir);
-            };
-            let p = &mut primary;
-            return self
-                .shade(ray, &hit, cone, bounce, weight, 1.0, rng, counts, p)
-                .0;
+            return shaded.0;
         }
+        let mut primary = primary;
         let mut r = *ray;
-        let mut next = first;
+        let (mut hit, mut shaded) = (hit, shaded);
         // Light gathered from the blended layers so far, and the share of what lies behind
         // them that still reaches the eye.
         let mut acc = Vec3::ZERO;
         let mut through = 1.0f32;
         loop {
-            let Some(hit) = next else {
-                let bg = environment::background(&self.soup.environment, r.dir);
-                return if through == 1.0 {
-                    bg
-                } else {
-                    acc + bg * through
-                };
-            };
-            let (l, a) = self.shade(
-                &r,
-                &hit,
-                cone,
-                bounce,
-                weight,
-                through,
-                rng,
-                counts,
-                &mut primary,
-            );
+            let (l, a) = shaded;
             if a >= 1.0 && through == 1.0 {
                 return l;
             }
@@ -478,7 +506,26 @@ impl<'a> Integrator<'a> {
             counts.blend_continuation += 1;
             // Past this surface point, and past the triangle sharing the edge it may lie on.
             r.tmin = (hit.t + hit.t * SAME_SURFACE).max(hit.t.next_up());
-            next = self.first_visible(&r, cone, counts);
+            let Some(next) = self.first_visible(&r, cone, counts) else {
+                let bg = environment::background(&self.soup.environment, r.dir);
+                return if through == 1.0 {
+                    bg
+                } else {
+                    acc + bg * through
+                };
+            };
+            hit = next;
+            shaded = self.shade(
+                &r,
+                &hit,
+                cone,
+                bounce,
+                weight,
+                through,
+                rng,
+                counts,
+                &mut primary,
+            );
         }
     }
 
@@ -499,6 +546,105 @@ impl<'a> Integrator<'a> {
         counts: &mut RayCounts,
         primary: &mut Option<&mut Primary>,
     ) -> (Vec3, f32) {
+        let Some(mut lit) = self.surface(ray, hit, cone, counts, primary) else {
+            return (Vec3::ZERO, 0.0);
+        };
+        for al in &self.lights {
+            let Some((inc, cos, shadows)) = self.reaches(&lit, al) else {
+                continue;
+            };
+            let visible = match shadows {
+                ShadowMode::None => 1.0,
+                ShadowMode::Hard => {
+                    counts.shadow += 1;
+                    self.transmittance(&lit.surf, inc.dir, inc.dist, counts)
+                }
+                ShadowMode::Soft => self.soft_visibility(&lit.surf, al.light, &inc, rng, counts),
+            };
+            lit.add(&inc, cos, visible);
+        }
+        self.reflect(lit, ray, hit, cone, bounce, weight, through, rng, counts)
+    }
+
+    /// [`Integrator::shade`] on the first hits of four camera rays (bounce 0, nothing in
+    /// front): each light's hard shadow rays from the four points are traced as one packet,
+    /// as they leave neighbouring points towards one light. Each lane's light is added,
+    /// and its generator drawn from, in the single path's order, so each lane's result and
+    /// counts are [`Integrator::shade`]'s, bit for bit. None for a lane without a hit.
+    fn shade4(
+        &self,
+        rays: &[Ray; LANES],
+        first: &[Option<Hit>; LANES],
+        cone: RayCone,
+        rngs: &mut [Rng; LANES],
+        counts: &mut RayCounts,
+        primary: &mut [Option<&mut Primary>; LANES],
+    ) -> [Option<(Vec3, f32)>; LANES] {
+        let mut lit: [Option<Lit>; LANES] = std::array::from_fn(|l| {
+            let hit = first[l]?;
+            self.surface(&rays[l], &hit, cone, counts, &mut primary[l])
+        });
+        for al in &self.lights {
+            let mut shadow = [Ray::new(Vec3::ZERO, Vec3::X, 1.0, 0.0); LANES];
+            let mut hard = [None; LANES];
+            for l in 0..LANES {
+                let Some(lit) = lit[l].as_mut() else {
+                    continue;
+                };
+                let Some((inc, cos, shadows)) = self.reaches(lit, al) else {
+                    continue;
+                };
+                match shadows {
+                    ShadowMode::None => lit.add(&inc, cos, 1.0),
+                    ShadowMode::Hard => {
+                        counts.shadow += 1;
+                        let s = &lit.surf;
+                        shadow[l] = shadow_ray(s.spawn(inc.dir), s.p, inc.dir, inc.dist);
+                        hard[l] = Some((inc, cos));
+                    }
+                    ShadowMode::Soft => {
+                        let v =
+                            self.soft_visibility(&lit.surf, al.light, &inc, &mut rngs[l], counts);
+                        lit.add(&inc, cos, v);
+                    }
+                }
+            }
+            if hard.iter().any(Option::is_some) {
+                let live = hard.map(|h| h.is_some());
+                let visible = self.transmittance4(&shadow, live, &mut None, counts);
+                for l in 0..LANES {
+                    if let (Some(lit), Some((inc, cos))) = (lit[l].as_mut(), hard[l]) {
+                        lit.add(&inc, cos, visible[l]);
+                    }
+                }
+            }
+        }
+        let mut lit = lit.into_iter();
+        std::array::from_fn(|l| {
+            let lit = lit.next().expect("four lanes");
+            let hit = first[l]?;
+            Some(match lit {
+                Some(lit) => {
+                    let rng = &mut rngs[l];
+                    self.reflect(lit, &rays[l], &hit, cone, 0, Vec3::ONE, 1.0, rng, counts)
+                }
+                None => (Vec3::ZERO, 0.0),
+            })
+        })
+    }
+
+    /// A surface hit's material, point and normals, and the light it gives off whatever
+    /// the lights do (emission, ambient); fills `primary` (once). None where the surface
+    /// is fully transparent there: it sends back nothing, α 0.
+    #[inline(always)]
+    fn surface(
+        &self,
+        ray: &Ray,
+        hit: &Hit,
+        cone: RayCone,
+        counts: &mut RayCounts,
+        primary: &mut Option<&mut Primary>,
+    ) -> Option<Lit> {
         let prim = hit.prim as usize;
         let mat_index = self.soup.tri_material[prim] as usize;
         let mat = &self.soup.materials[mat_index];
@@ -523,7 +669,7 @@ impl<'a> Integrator<'a> {
                 _ => {}
             }
             if a <= 0.0 {
-                return (Vec3::ZERO, 0.0);
+                return None;
             }
         }
 
@@ -565,51 +711,79 @@ impl<'a> Integrator<'a> {
         if self.emission {
             l += mat.emission;
         }
-        // A black albedo cannot show any light: skip the lights and their shadow rays.
-        if albedo.max_element() > 0.0 {
-            if self.ambient {
-                l += environment::ambient(&self.soup.environment, ns) * albedo;
-            }
-            for al in &self.lights {
-                if !al.light.lights_layer(obj.layer) {
-                    continue;
-                }
-                let Some(inc) = incident(al.light, p) else {
-                    continue;
-                };
-                let cos = ns.dot(inc.dir);
-                if cos <= 0.0 {
-                    continue;
-                }
-                let shadows = if obj.receive_shadows {
-                    al.shadows
-                } else {
-                    ShadowMode::None
-                };
-                let visible = match shadows {
-                    ShadowMode::None => 1.0,
-                    ShadowMode::Hard => {
-                        counts.shadow += 1;
-                        self.transmittance(&surf, inc.dir, inc.dist, counts)
-                    }
-                    ShadowMode::Soft => self.soft_visibility(&surf, al.light, &inc, rng, counts),
-                };
-                if visible > 0.0 {
-                    l += inc.radiance * (cos * visible) * albedo;
-                }
-            }
+        // A black albedo cannot show any light: no light is asked, no shadow ray traced.
+        let lit = albedo.max_element() > 0.0;
+        if lit && self.ambient {
+            l += environment::ambient(&self.soup.environment, ns) * albedo;
         }
+        Some(Lit {
+            l,
+            a,
+            albedo,
+            lit,
+            surf,
+            ns,
+            layer: obj.layer,
+            receives: obj.receive_shadows,
+            reflectance: mat.reflectance(),
+        })
+    }
 
+    /// What light `al` brings to the point: where it arrives from, the cosine with the
+    /// shading normal and how its shadow is found. None where it brings nothing (a dark
+    /// surface, a layer it does not light, out of its reach, or from behind).
+    #[inline(always)]
+    fn reaches(&self, lit: &Lit, al: &ActiveLight) -> Option<(Incident, f32, ShadowMode)> {
+        if !lit.lit || !al.light.lights_layer(lit.layer) {
+            return None;
+        }
+        let inc = incident(al.light, lit.surf.p)?;
+        let cos = lit.ns.dot(inc.dir);
+        if cos <= 0.0 {
+            return None;
+        }
+        let shadows = if lit.receives {
+            al.shadows
+        } else {
+            ShadowMode::None
+        };
+        Some((inc, cos, shadows))
+    }
+
+    /// The shaded point's light with its mirror reflection added (while the bounce and
+    /// the mirror ray's weight allow: the ray's `weight` times `through`, the share of this
+    /// surface's light that reaches the eye past blended layers in front of it), and its α.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn reflect(
+        &self,
+        lit: Lit,
+        ray: &Ray,
+        hit: &Hit,
+        cone: RayCone,
+        bounce: u32,
+        weight: Vec3,
+        through: f32,
+        rng: &mut Rng,
+        counts: &mut RayCounts,
+    ) -> (Vec3, f32) {
+        let Lit {
+            mut l,
+            a,
+            surf,
+            ns,
+            reflectance: refl,
+            ..
+        } = lit;
         if bounce < self.max_depth {
-            let refl = mat.reflectance();
             let w = weight * (through * a) * refl;
             if w.max_element() >= self.cutoff && refl.max_element() > 0.0 {
                 let d = ray.dir;
                 let mut r = d - ns * (2.0 * d.dot(ns));
                 // An interpolated normal can send the mirror ray into the surface: then
                 // mirror about the true surface instead.
-                if r.dot(ng) <= 0.0 {
-                    r = d - ng * (2.0 * d.dot(ng));
+                if r.dot(surf.ng) <= 0.0 {
+                    r = d - surf.ng * (2.0 * d.dot(surf.ng));
                 }
                 let r = r.normalize_or_zero();
                 if r != Vec3::ZERO {
@@ -967,6 +1141,29 @@ impl<'a> Integrator<'a> {
         }
         visible / n as f32
     }
+}
+
+/// A camera sample's radiance and AOVs, their non-finite channels zeroed (and counted).
+fn finish_camera(l: Vec3, primary: Primary, counts: &mut RayCounts) -> (Vec3, Primary) {
+    counts.camera += 1;
+    let mut l = l;
+    let mut primary = primary;
+    if sanitize(&mut l) {
+        counts.sanitized += 1;
+    }
+    let mut n = primary.normal;
+    let mut a = primary.albedo;
+    if sanitize(&mut n) | sanitize(&mut a) || !primary.depth.is_finite() {
+        counts.sanitized += 1;
+        primary.depth = if primary.depth.is_finite() {
+            primary.depth
+        } else {
+            f32::MAX
+        };
+    }
+    primary.normal = n;
+    primary.albedo = a;
+    (l, primary)
 }
 
 /// The cosine of the half angle of a directional light's soft-shadow cone (its

@@ -278,6 +278,60 @@ fn pixels_do_not_depend_on_threads_or_tiles() {
     assert_eq!(a.counts, b.counts);
 }
 
+/// A 2×2 block's hard shadow rays towards each light are traced together. With lights of
+/// every shadow kind (hard point and sun, soft spot, none), one lighting only some layers,
+/// a mirror whose hits' shadow rays are traced alone, an object that casts no shadow and one
+/// that receives none, tiles of 1, 5 and 32 pixels give the same pixels and counts.
+#[test]
+fn shadow_rays_traced_in_blocks_equal_shadow_rays_traced_alone() {
+    let mut s = shadow_scene(Shadows::Hard, 0.0);
+    let grey = s.diffuse(Vec3::splat(0.7));
+    let ghost = s.cube(
+        "casts nothing",
+        Vec3::new(-2.5, 0.0, 1.0),
+        Vec3::new(-1.5, 1.5, 2.0),
+        grey,
+    );
+    s.soup.objects[ghost as usize].cast_shadows = formats::CastShadows::Off;
+    let unshadowed = s.cube(
+        "receives nothing",
+        Vec3::new(2.0, 0.0, -3.0),
+        Vec3::new(3.0, 1.0, -2.0),
+        grey,
+    );
+    s.soup.objects[unshadowed as usize].receive_shadows = false;
+    s.soup.objects[unshadowed as usize].layer = 3;
+    let glass = s.material(mirror(0.8));
+    s.quad(
+        "mirror",
+        Vec3::new(-4.0, 0.0, -3.0),
+        Vec3::new(0.0, 0.0, 6.0),
+        Vec3::new(1.0, 2.0, 0.0),
+        glass,
+    );
+    let mut sun = directional_light(Vec3::new(-1.0, -2.0, 0.5), 0.8, Shadows::Hard);
+    sun.culling_mask = !(1 << 3);
+    s.light(sun);
+    let mut spot = spot_light(Vec3::new(-1.0, 5.0, 0.0), -Vec3::Y, 70.0, 50.0, 20.0);
+    spot.shadows = Shadows::Soft;
+    spot.shadow_radius = 0.4;
+    s.light(spot);
+    s.light(point_light(
+        Vec3::new(0.0, 3.0, 3.0),
+        0.5,
+        10.0,
+        Shadows::None,
+    ));
+    let (soup, kd) = s.build();
+    let mut o = opts(37, 29);
+    o.soft_samples = 4;
+    let out = render_alike_at_tiles(&soup, &kd, &o);
+    let c = &out.counts;
+    assert!(c.shadow > 2 * 37 * 29 - 400, "{c:?}");
+    assert!(c.soft_shadow > 0 && c.reflection > 0, "{c:?}");
+    assert!(c.shadow_pass_through > 0, "{c:?}");
+}
+
 /// At one sample per pixel the camera rays of 2×2 blocks are traced together: tiles of one
 /// pixel (no blocks), of 5 (blocks, and a last row and column alone) and of 32 give the
 /// same pixels and the same counts.
