@@ -106,6 +106,16 @@ impl Lit {
     }
 }
 
+/// A shaded point's mirror ray, its cone, the weight it carries to the eye and the
+/// reflectance its light is scaled by.
+#[derive(Clone, Copy)]
+struct Mirror {
+    ray: Ray,
+    cone: RayCone,
+    weight: Vec3,
+    reflectance: Vec3,
+}
+
 /// What a material needs from its texture, resolved once per render.
 struct Surfacing {
     /// The sampler (index into `Integrator::samplers`) and tiling of its map.
@@ -382,10 +392,8 @@ impl<'a> Integrator<'a> {
         finish_camera(l, primary, counts)
     }
 
-    /// [`Integrator::camera_sample`] for the rays of four neighbouring pixels: their first
-    /// hits found together, and their first hits' hard shadow rays towards each light
-    /// traced together ([`Integrator::shade4`]). The same four results and counts, bit for
-    /// bit.
+    /// [`Integrator::camera_sample`] for the rays of four neighbouring pixels, traced
+    /// together ([`Integrator::radiance4`]): the same four results and counts, bit for bit.
     pub fn camera_sample4(
         &self,
         rays: &[Ray; LANES],
@@ -393,28 +401,58 @@ impl<'a> Integrator<'a> {
         rngs: &mut [Rng; LANES],
         counts: &mut RayCounts,
     ) -> [(Vec3, Primary); LANES] {
-        let first = self.first_visible4(rays, cone, counts);
         let mut primary = [Primary::MISS; LANES];
         let mut slots = primary.each_mut().map(Some);
-        let shaded = self.shade4(rays, &first, cone, rngs, counts, &mut slots);
-        let l: [Vec3; LANES] = std::array::from_fn(|i| match (first[i], shaded[i]) {
-            (Some(hit), Some(shaded)) => {
-                let slot = slots[i].take();
-                self.behind(
-                    &rays[i],
-                    hit,
-                    shaded,
-                    cone,
-                    0,
-                    Vec3::ONE,
-                    &mut rngs[i],
-                    counts,
-                    slot,
-                )
-            }
-            _ => environment::background(&self.soup.environment, rays[i].dir),
-        });
+        let l = self.radiance4(
+            rays,
+            [true; LANES],
+            [cone; LANES],
+            0,
+            [Vec3::ONE; LANES],
+            rngs,
+            counts,
+            &mut slots,
+        );
         std::array::from_fn(|i| finish_camera(l[i], primary[i], counts))
+    }
+
+    /// [`Integrator::radiance`] on four rays that travel side by side, lane by lane the
+    /// same results, counts and draws from each lane's generator: their first hits are
+    /// found together, then each light's hard shadow rays from those hits and their mirror
+    /// rays are traced together, level by level ([`Integrator::shade4`]). Lanes not `live`
+    /// trace nothing and send back black.
+    #[allow(clippy::too_many_arguments)]
+    fn radiance4(
+        &self,
+        rays: &[Ray; LANES],
+        live: [bool; LANES],
+        cones: [RayCone; LANES],
+        bounce: u32,
+        weights: [Vec3; LANES],
+        rngs: &mut [Rng; LANES],
+        counts: &mut RayCounts,
+        primary: &mut [Option<&mut Primary>; LANES],
+    ) -> [Vec3; LANES] {
+        let rays = std::array::from_fn(|i| if live[i] { rays[i] } else { no_ray() });
+        let first = self.first_visible4(&rays, &cones, counts);
+        let shaded = self.shade4(
+            &rays, &first, &cones, bounce, weights, rngs, counts, primary,
+        );
+        std::array::from_fn(|i| match (first[i], shaded[i]) {
+            (Some(hit), Some(shaded)) => self.behind(
+                &rays[i],
+                hit,
+                shaded,
+                cones[i],
+                bounce,
+                weights[i],
+                &mut rngs[i],
+                counts,
+                primary[i].take(),
+            ),
+            _ if live[i] => environment::background(&self.soup.environment, rays[i].dir),
+            _ => Vec3::ZERO,
+        })
     }
 
     /// Radiance along `ray`: the first visible surface's, and where that surface is
@@ -566,26 +604,29 @@ impl<'a> Integrator<'a> {
         self.reflect(lit, ray, hit, cone, bounce, weight, through, rng, counts)
     }
 
-    /// [`Integrator::shade`] on the first hits of four camera rays (bounce 0, nothing in
-    /// front): each light's hard shadow rays from the four points are traced as one packet,
-    /// as they leave neighbouring points towards one light. Each lane's light is added,
+    /// [`Integrator::shade`] on the first hits of four rays (nothing blended in front of
+    /// them): each light's hard shadow rays from the four points are traced as one packet,
+    /// as are their mirror rays ([`Integrator::radiance4`]). Each lane's light is added,
     /// and its generator drawn from, in the single path's order, so each lane's result and
     /// counts are [`Integrator::shade`]'s, bit for bit. None for a lane without a hit.
+    #[allow(clippy::too_many_arguments)]
     fn shade4(
         &self,
         rays: &[Ray; LANES],
         first: &[Option<Hit>; LANES],
-        cone: RayCone,
+        cones: &[RayCone; LANES],
+        bounce: u32,
+        weights: [Vec3; LANES],
         rngs: &mut [Rng; LANES],
         counts: &mut RayCounts,
         primary: &mut [Option<&mut Primary>; LANES],
     ) -> [Option<(Vec3, f32)>; LANES] {
         let mut lit: [Option<Lit>; LANES] = std::array::from_fn(|l| {
             let hit = first[l]?;
-            self.surface(&rays[l], &hit, cone, counts, &mut primary[l])
+            self.surface(&rays[l], &hit, cones[l], counts, &mut primary[l])
         });
         for al in &self.lights {
-            let mut shadow = [Ray::new(Vec3::ZERO, Vec3::X, 1.0, 0.0); LANES];
+            let mut shadow = [no_ray(); LANES];
             let mut hard = [None; LANES];
             for l in 0..LANES {
                 let Some(lit) = lit[l].as_mut() else {
@@ -619,17 +660,37 @@ impl<'a> Integrator<'a> {
                 }
             }
         }
-        let mut lit = lit.into_iter();
-        std::array::from_fn(|l| {
-            let lit = lit.next().expect("four lanes");
-            let hit = first[l]?;
-            Some(match lit {
-                Some(lit) => {
-                    let rng = &mut rngs[l];
-                    self.reflect(lit, &rays[l], &hit, cone, 0, Vec3::ONE, 1.0, rng, counts)
+        let mirrors: [Option<Mirror>; LANES] = std::array::from_fn(|l| {
+            let (lit, hit) = (lit[l].as_ref()?, first[l]?);
+            self.mirror(
+                lit, &rays[l], &hit, cones[l], bounce, weights[l], 1.0, counts,
+            )
+        });
+        if mirrors.iter().any(Option::is_some) {
+            let next = mirrors.map(|m| m.map_or(no_ray(), |m| m.ray));
+            let reflected = self.radiance4(
+                &next,
+                mirrors.map(|m| m.is_some()),
+                mirrors.map(|m| m.map_or(cones[0], |m| m.cone)),
+                bounce + 1,
+                mirrors.map(|m| m.map_or(Vec3::ZERO, |m| m.weight)),
+                rngs,
+                counts,
+                &mut [None, None, None, None],
+            );
+            for l in 0..LANES {
+                if let (Some(lit), Some(m)) = (lit[l].as_mut(), mirrors[l]) {
+                    lit.l += m.reflectance * reflected[l];
                 }
-                None => (Vec3::ZERO, 0.0),
-            })
+            }
+        }
+        std::array::from_fn(|l| {
+            first[l]?;
+            Some(
+                lit[l]
+                    .as_ref()
+                    .map_or((Vec3::ZERO, 0.0), |lit| (lit.l, lit.a)),
+            )
         })
     }
 
@@ -750,9 +811,7 @@ impl<'a> Integrator<'a> {
         Some((inc, cos, shadows))
     }
 
-    /// The shaded point's light with its mirror reflection added (while the bounce and
-    /// the mirror ray's weight allow: the ray's `weight` times `through`, the share of this
-    /// surface's light that reaches the eye past blended layers in front of it), and its α.
+    /// The shaded point's light with its mirror reflection added, and its α.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn reflect(
@@ -767,39 +826,68 @@ impl<'a> Integrator<'a> {
         rng: &mut Rng,
         counts: &mut RayCounts,
     ) -> (Vec3, f32) {
+        let mut l = lit.l;
+        if let Some(m) = self.mirror(&lit, ray, hit, cone, bounce, weight, through, counts) {
+            l += m.reflectance
+                * self.radiance(&m.ray, m.cone, bounce + 1, m.weight, rng, counts, None);
+        }
+        (l, lit.a)
+    }
+
+    /// The shaded point's mirror ray (counted), where the bounce and the mirror ray's
+    /// weight allow: the ray's `weight` times `through`, the share of this surface's light
+    /// that reaches the eye past blended layers in front of it, times its α and
+    /// reflectance.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn mirror(
+        &self,
+        lit: &Lit,
+        ray: &Ray,
+        hit: &Hit,
+        cone: RayCone,
+        bounce: u32,
+        weight: Vec3,
+        through: f32,
+        counts: &mut RayCounts,
+    ) -> Option<Mirror> {
         let Lit {
-            mut l,
             a,
             surf,
             ns,
             reflectance: refl,
             ..
         } = lit;
-        if bounce < self.max_depth {
-            let w = weight * (through * a) * refl;
-            if w.max_element() >= self.cutoff && refl.max_element() > 0.0 {
-                let d = ray.dir;
-                let mut r = d - ns * (2.0 * d.dot(ns));
-                // An interpolated normal can send the mirror ray into the surface: then
-                // mirror about the true surface instead.
-                if r.dot(surf.ng) <= 0.0 {
-                    r = d - surf.ng * (2.0 * d.dot(surf.ng));
-                }
-                let r = r.normalize_or_zero();
-                if r != Vec3::ZERO {
-                    counts.reflection += 1;
-                    let next = Ray {
-                        origin: surf.spawn(r),
-                        dir: r,
-                        tmin: SPAWN_TMIN,
-                        tmax: f32::INFINITY,
-                    };
-                    let c = cone.reflected(hit.t);
-                    l += refl * self.radiance(&next, c, bounce + 1, w, rng, counts, None);
-                }
-            }
+        if bounce >= self.max_depth {
+            return None;
         }
-        (l, a)
+        let w = weight * (through * a) * *refl;
+        if !(w.max_element() >= self.cutoff && refl.max_element() > 0.0) {
+            return None;
+        }
+        let d = ray.dir;
+        let mut r = d - *ns * (2.0 * d.dot(*ns));
+        // An interpolated normal can send the mirror ray into the surface: then mirror
+        // about the true surface instead.
+        if r.dot(surf.ng) <= 0.0 {
+            r = d - surf.ng * (2.0 * d.dot(surf.ng));
+        }
+        let r = r.normalize_or_zero();
+        if r == Vec3::ZERO {
+            return None;
+        }
+        counts.reflection += 1;
+        Some(Mirror {
+            ray: Ray {
+                origin: surf.spawn(r),
+                dir: r,
+                tmin: SPAWN_TMIN,
+                tmax: f32::INFINITY,
+            },
+            cone: cone.reflected(hit.t),
+            weight: w,
+            reflectance: *refl,
+        })
     }
 
     /// The closest hit camera and reflection rays see, passing through culled faces,
@@ -834,7 +922,7 @@ impl<'a> Integrator<'a> {
     fn first_visible4(
         &self,
         rays: &[Ray; LANES],
-        cone: RayCone,
+        cones: &[RayCone; LANES],
         counts: &mut RayCounts,
     ) -> [Option<Hit>; LANES] {
         match (self.culling, self.alpha) {
@@ -847,9 +935,9 @@ impl<'a> Integrator<'a> {
                 });
                 std::array::from_fn(|l| self.unless_culled(&rays[l], first[l]?, front[l], counts))
             }
-            (_, true) => rays
-                .each_ref()
-                .map(|r| self.first_visible_alpha(r, cone, counts)),
+            (_, true) => {
+                std::array::from_fn(|l| self.first_visible_alpha(&rays[l], cones[l], counts))
+            }
         }
     }
 
@@ -1141,6 +1229,11 @@ impl<'a> Integrator<'a> {
         }
         visible / n as f32
     }
+}
+
+/// A lane of a packet that traces nothing: an empty interval, refused before any walk.
+fn no_ray() -> Ray {
+    Ray::new(Vec3::ZERO, Vec3::X, 1.0, 0.0)
 }
 
 /// A camera sample's radiance and AOVs, their non-finite channels zeroed (and counted).

@@ -278,58 +278,113 @@ fn pixels_do_not_depend_on_threads_or_tiles() {
     assert_eq!(a.counts, b.counts);
 }
 
-/// A 2×2 block's hard shadow rays towards each light are traced together. With lights of
-/// every shadow kind (hard point and sun, soft spot, none), one lighting only some layers,
-/// a mirror whose hits' shadow rays are traced alone, an object that casts no shadow and one
-/// that receives none, tiles of 1, 5 and 32 pixels give the same pixels and counts.
+/// A 2×2 block's hard shadow rays towards each light, and its mirror rays, are traced
+/// together. With lights of every shadow kind (hard point and sun, soft spot, none), one
+/// lighting only some layers, a tilted mirror, an object that casts no shadow, one that
+/// receives none and a face culled from above, and then with a cut-out and a blended quad
+/// too, tiles of 1, 5 and 32 pixels give the same pixels and counts.
 #[test]
-fn shadow_rays_traced_in_blocks_equal_shadow_rays_traced_alone() {
-    let mut s = shadow_scene(Shadows::Hard, 0.0);
-    let grey = s.diffuse(Vec3::splat(0.7));
-    let ghost = s.cube(
-        "casts nothing",
-        Vec3::new(-2.5, 0.0, 1.0),
-        Vec3::new(-1.5, 1.5, 2.0),
-        grey,
-    );
-    s.soup.objects[ghost as usize].cast_shadows = formats::CastShadows::Off;
-    let unshadowed = s.cube(
-        "receives nothing",
-        Vec3::new(2.0, 0.0, -3.0),
-        Vec3::new(3.0, 1.0, -2.0),
-        grey,
-    );
-    s.soup.objects[unshadowed as usize].receive_shadows = false;
-    s.soup.objects[unshadowed as usize].layer = 3;
-    let glass = s.material(mirror(0.8));
-    s.quad(
-        "mirror",
-        Vec3::new(-4.0, 0.0, -3.0),
-        Vec3::new(0.0, 0.0, 6.0),
-        Vec3::new(1.0, 2.0, 0.0),
-        glass,
-    );
-    let mut sun = directional_light(Vec3::new(-1.0, -2.0, 0.5), 0.8, Shadows::Hard);
-    sun.culling_mask = !(1 << 3);
-    s.light(sun);
-    let mut spot = spot_light(Vec3::new(-1.0, 5.0, 0.0), -Vec3::Y, 70.0, 50.0, 20.0);
-    spot.shadows = Shadows::Soft;
-    spot.shadow_radius = 0.4;
-    s.light(spot);
-    s.light(point_light(
-        Vec3::new(0.0, 3.0, 3.0),
-        0.5,
-        10.0,
-        Shadows::None,
-    ));
-    let (soup, kd) = s.build();
-    let mut o = opts(37, 29);
-    o.soft_samples = 4;
-    let out = render_alike_at_tiles(&soup, &kd, &o);
-    let c = &out.counts;
-    assert!(c.shadow > 2 * 37 * 29 - 400, "{c:?}");
-    assert!(c.soft_shadow > 0 && c.reflection > 0, "{c:?}");
-    assert!(c.shadow_pass_through > 0, "{c:?}");
+fn shadow_and_mirror_rays_traced_in_blocks_equal_rays_traced_alone() {
+    for alpha in [false, true] {
+        let mut s = shadow_scene(Shadows::Hard, 0.0);
+        let grey = s.diffuse(Vec3::splat(0.7));
+        let ghost = s.cube(
+            "casts nothing",
+            Vec3::new(-2.5, 0.0, 1.0),
+            Vec3::new(-1.5, 1.5, 2.0),
+            grey,
+        );
+        s.soup.objects[ghost as usize].cast_shadows = formats::CastShadows::Off;
+        let unshadowed = s.cube(
+            "receives nothing",
+            Vec3::new(2.0, 0.0, -3.0),
+            Vec3::new(3.0, 1.0, -2.0),
+            grey,
+        );
+        s.soup.objects[unshadowed as usize].receive_shadows = false;
+        s.soup.objects[unshadowed as usize].layer = 3;
+        let one_sided = s.material(formats::Material {
+            cull: formats::Cull::Back,
+            ..diffuse(Vec3::new(0.9, 0.2, 0.2))
+        });
+        // Facing down: culled seen from the camera, drawn seen in the mirror.
+        s.quad(
+            "one-sided",
+            Vec3::new(-1.0, 1.0, -3.0),
+            Vec3::new(1.5, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, 1.5),
+            one_sided,
+        );
+        let glass = s.material(mirror(0.8));
+        s.quad(
+            "mirror",
+            Vec3::new(-4.0, 0.0, -3.0),
+            Vec3::new(0.0, 0.0, 6.0),
+            Vec3::new(1.0, 2.0, 0.0),
+            glass,
+        );
+        if alpha {
+            let holes = s.texture(texture(
+                2,
+                1,
+                &[[255, 255, 255, 0], [255, 255, 255, 255]],
+                formats::texture::Wrap::Clamp,
+            ));
+            let map = Some(formats::texture::TextureRef {
+                texture: holes,
+                tiling: Default::default(),
+            });
+            let cut_out = s.material(formats::Material {
+                alpha: formats::Alpha::Cutout { cutoff: 0.5 },
+                albedo_map: map,
+                ..diffuse(Vec3::splat(0.6))
+            });
+            s.quad(
+                "cut-out",
+                Vec3::new(-1.0, 2.5, -1.0),
+                Vec3::new(0.0, 0.0, 2.0),
+                Vec3::new(1.5, 0.0, 0.0),
+                cut_out,
+            );
+            let blended = s.material(formats::Material {
+                alpha: formats::Alpha::Blend,
+                opacity: 0.5,
+                ..diffuse(Vec3::new(0.2, 0.3, 0.9))
+            });
+            s.quad(
+                "blended",
+                Vec3::new(1.0, 1.0, 1.5),
+                Vec3::new(0.0, 0.0, 1.5),
+                Vec3::new(2.0, 0.0, 0.0),
+                blended,
+            );
+        }
+        let mut sun = directional_light(Vec3::new(-1.0, -2.0, 0.5), 0.8, Shadows::Hard);
+        sun.culling_mask = !(1 << 3);
+        s.light(sun);
+        let mut spot = spot_light(Vec3::new(-1.0, 5.0, 0.0), -Vec3::Y, 70.0, 50.0, 20.0);
+        spot.shadows = Shadows::Soft;
+        spot.shadow_radius = 0.4;
+        s.light(spot);
+        s.light(point_light(
+            Vec3::new(0.0, 3.0, 3.0),
+            0.5,
+            10.0,
+            Shadows::None,
+        ));
+        let (soup, kd) = s.build();
+        let mut o = opts(37, 29);
+        o.soft_samples = 4;
+        let out = render_alike_at_tiles(&soup, &kd, &o);
+        let c = &out.counts;
+        assert!(c.shadow > 2 * 37 * 29 - 400, "{c:?}");
+        assert!(c.soft_shadow > 0 && c.reflection > 40, "{c:?}");
+        assert!(c.pass_through > 0 && c.shadow_pass_through > 0, "{c:?}");
+        if alpha {
+            assert!(c.alpha_lookups > 0 && c.blend_continuation > 0, "{c:?}");
+            assert!(c.shadow_blend > 0, "{c:?}");
+        }
+    }
 }
 
 /// At one sample per pixel the camera rays of 2×2 blocks are traced together: tiles of one
