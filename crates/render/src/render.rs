@@ -129,10 +129,10 @@ fn render_tiles(
     (frame, shared.load())
 }
 
-/// A tile's pixels, row by row. At one sample per pixel the camera rays of each 2×2 block
-/// are traced together ([`Integrator::camera_sample4`]); an odd last row or column, and
-/// every pixel at more samples, goes through [`render_pixel`]. Either way each pixel gets
-/// the same value to the bit.
+/// A tile's pixels, row by row. At one sample per pixel each 2×2 block's rays (camera, hard
+/// shadow and mirror) are traced together ([`Integrator::camera_sample4`]); an odd last row
+/// or column, and every pixel at more samples, goes through [`render_pixel`]. Either way
+/// each pixel gets the same value to the bit.
 fn render_tile(
     camera: &CameraModel,
     cone: RayCone,
