@@ -393,7 +393,8 @@ impl<'a> Integrator<'a> {
     }
 
     /// [`Integrator::camera_sample`] for the rays of four neighbouring pixels, traced
-    /// together ([`Integrator::radiance4`]): the same four results and counts, bit for bit.
+    /// together: their first hits, each light's hard shadow rays and their mirror rays, one
+    /// packet query each, level by level. The same four results and counts, bit for bit.
     pub fn camera_sample4(
         &self,
         rays: &[Ray; LANES],
