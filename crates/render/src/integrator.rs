@@ -26,16 +26,17 @@ use crate::alpha::{alpha_use, min_alphas, AlphaUse};
 use crate::cone::RayCone;
 use crate::counters::RayCounts;
 use crate::environment;
-use crate::lights::{basis, incident, Incident};
+use crate::lights::{incident, Incident};
 use crate::offset::{
     hit_point, intersector_margin, offset_origin, SHADOW_TMAX_FRACTION, SPAWN_TMIN,
 };
 use crate::plan::{colour_mapped, Plan, ShadowMode};
 use crate::sampling::{disc_sample, Rng};
+use crate::soft::SoftCone;
 use crate::solid::Solids;
 use crate::texture::{cone_footprint, Sampler};
 use crate::TextureFilter;
-use formats::{CastShadows, Hit, Light, LightKind, Soup, Tiling};
+use formats::{CastShadows, Hit, Light, Soup, Tiling};
 use glam::{Vec2, Vec3, Vec4};
 use kdtree::triangle::RayPre;
 use kdtree::{Accel, Ray, LANES};
@@ -1197,32 +1198,26 @@ impl<'a> Integrator<'a> {
     ) -> f32 {
         let n = self.soft_samples;
         let rotation = rng.next_f32() * std::f32::consts::TAU;
-        let (t, b) = basis(inc.dir);
         // A spawned origin depends on the side of the surface a ray leaves by, not on its
         // direction: two origins serve every sample.
         let above = surf.spawn(surf.ng);
         let below = surf.spawn(-surf.ng);
-        let cos_half = cone_cos_half(light);
+        let cone = SoftCone::new(light, surf.p, inc.dir, surf.ng, above, below);
         let mut visible = 0.0f32;
         let mut blocker = None;
         // The samples leave one point towards one light, so four at a time share their walk
         // through the tree. Tracing draws nothing from `rng`: the samples are the same as
         // when each was traced before the next was drawn, and so is their sum.
         for first in (0..n).step_by(LANES) {
-            let mut rays = [Ray::new(surf.p, inc.dir, 0.0, 0.0); LANES];
-            let mut live = [false; LANES];
+            let (mut dx, mut dy) = ([0.0; LANES], [0.0; LANES]);
+            let mut drawn = [false; LANES];
             for (l, i) in (first..n.min(first + LANES as u32)).enumerate() {
-                let (dx, dy) = disc_sample(i, n, rng.next_f32(), rotation);
+                (dx[l], dy[l]) = disc_sample(i, n, rng.next_f32(), rotation);
                 counts.soft_shadow += 1;
-                let Some((dir, dist)) =
-                    soft_sample(light, surf.p, inc.dir, (t, b), cos_half, dx, dy)
-                else {
-                    continue;
-                };
-                let origin = if dir.dot(surf.ng) < 0.0 { below } else { above };
-                rays[l] = shadow_ray(origin, surf.p, dir, dist);
-                live[l] = true;
+                drawn[l] = true;
             }
+            let (rays, traced) = cone.rays4(dx, dy);
+            let live = std::array::from_fn(|l| drawn[l] && traced[l]);
             // Lanes that are not live answer 0, which leaves the sum as it was.
             for v in self.transmittance4(&rays, live, &mut blocker, counts) {
                 visible += v;
@@ -1260,15 +1255,6 @@ fn finish_camera(l: Vec3, primary: Primary, counts: &mut RayCounts) -> (Vec3, Pr
     (l, primary)
 }
 
-/// The cosine of the half angle of a directional light's soft-shadow cone (its
-/// `shadow_radius` is the cone's angular diameter in degrees, at most a hemisphere).
-fn cone_cos_half(light: &Light) -> f32 {
-    (light.shadow_radius * 0.5)
-        .to_radians()
-        .min(std::f32::consts::FRAC_PI_2)
-        .cos()
-}
-
 /// The point's blocker after a packet: the opaque caster that stopped the packet's last
 /// sample stopped by one, else the one before. By lane, not by the order the walk met them
 /// in, so the blocker (and what later samples count) does not depend on how a leaf's
@@ -1276,50 +1262,6 @@ fn cone_cos_half(light: &Light) -> f32 {
 fn keep_last(blocker: &mut Option<u32>, casters: [Option<u32>; LANES]) {
     if let Some(&prim) = casters.iter().rev().flatten().next() {
         *blocker = Some(prim);
-    }
-}
-
-/// Direction and distance of one soft-shadow sample from `p`, for the point (dx, dy) of
-/// the unit disc: a cone of angular diameter `shadow_radius` degrees around `towards`
-/// (directional; `cos_half` is the cosine of its half angle), or a point of the disc of
-/// radius `shadow_radius` spanned by `tb` around the light (point, spot). None when that
-/// point is `p` itself.
-fn soft_sample(
-    light: &Light,
-    p: Vec3,
-    towards: Vec3,
-    (t, b): (Vec3, Vec3),
-    cos_half: f32,
-    dx: f32,
-    dy: f32,
-) -> Option<(Vec3, f32)> {
-    match light.kind {
-        LightKind::Directional => {
-            // Uniform over the spherical cap, stratified by the disc's area strata.
-            let r2 = dx * dx + dy * dy;
-            let cos_t = 1.0 - r2 * (1.0 - cos_half);
-            let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
-            let r = r2.sqrt();
-            let (c, s) = if r > 0.0 {
-                (dx / r, dy / r)
-            } else {
-                (1.0, 0.0)
-            };
-            let dir = (t * (c * sin_t) + b * (s * sin_t) + towards * cos_t).normalize();
-            Some((dir, f32::INFINITY))
-        }
-        LightKind::Point | LightKind::Spot { .. } => {
-            let q = light.position + (t * dx + b * dy) * light.shadow_radius;
-            let to = q - p;
-            let dist = to.length();
-            // Written so that a NaN distance is traced (and refused by the traversal), as
-            // every other non-finite ray is.
-            if dist <= 0.0 {
-                None
-            } else {
-                Some((to / dist, dist))
-            }
-        }
     }
 }
 
@@ -1349,9 +1291,10 @@ fn shadow_ray(origin: Vec3, p: Vec3, dir: Vec3, dist: f32) -> Ray {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::soft::tests::sample;
     use crate::solid::tests::box_faces;
     use crate::RenderOptions;
-    use formats::{Alpha, Cull, Material, Object, Shadows};
+    use formats::{Alpha, Cull, LightKind, Material, Object, Shadows};
 
     fn material(cull: Cull, alpha: Alpha, opacity: f32) -> Material {
         Material {
@@ -1507,15 +1450,12 @@ mod tests {
 
                         let (mut rng_b, mut counts_b) = (Rng::new(seed), RayCounts::default());
                         let rotation = rng_b.next_f32() * std::f32::consts::TAU;
-                        let tb = basis(inc.dir);
+                        let cone = SoftCone::new(light, p, inc.dir, surf.ng, p, p);
                         let mut alone = 0.0f32;
                         for s in 0..n {
                             let (dx, dy) = disc_sample(s, n, rng_b.next_f32(), rotation);
                             counts_b.soft_shadow += 1;
-                            let cos_half = cone_cos_half(light);
-                            if let Some((dir, dist)) =
-                                soft_sample(light, p, inc.dir, tb, cos_half, dx, dy)
-                            {
+                            if let Some((dir, dist)) = sample(&cone, dx, dy) {
                                 let v = it.transmittance(&surf, dir, dist, &mut counts_b);
                                 blocked += (v == 0.0) as u64;
                                 alone += v;

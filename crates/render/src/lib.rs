@@ -8,6 +8,7 @@
 //! * [`texture`], [`alpha`]: albedo lookups, cut-out holes and blended surfaces;
 //! * [`lights`]: Unity's range falloff and spot cones;
 //! * [`integrator`]: emission, ambient, direct light with hard/soft shadows, mirrors;
+//! * `soft`: a soft shadow's sample rays, four at a time;
 //! * [`offset`]: secondary rays spawned past the hit point's rounding error;
 //! * [`sampling`]: per-pixel seeded RNG, stratified pixel and shadow samples;
 //! * [`mod@render`]: tiles in parallel (rayon work stealing), ray counters;
@@ -32,6 +33,7 @@ pub mod plan;
 pub mod preview;
 pub mod render;
 pub mod sampling;
+mod soft;
 pub mod solid;
 pub mod texture;
 
