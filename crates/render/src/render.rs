@@ -7,7 +7,7 @@ use crate::sampling::{pixel_samples, Rng};
 use crate::{CameraModel, Frame, Plan, RenderError, RenderOptions, Window};
 use formats::{KdFile, Soup};
 use glam::Vec3;
-use kdtree::Accel;
+use kdtree::{Accel, LANES};
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -129,10 +129,9 @@ fn render_tiles(
     (frame, shared.load())
 }
 
-/// A tile's pixels, row by row. At one sample per pixel each 2×2 block's rays (camera, hard
-/// shadow and mirror) are traced together ([`Integrator::camera_sample4`]); an odd last row
-/// or column, and every pixel at more samples, goes through [`render_pixel`]. Either way
-/// each pixel gets the same value to the bit.
+/// A tile's pixels, row by row. The pixels of each 2×2 block are traced together, sample by
+/// sample ([`render_block`]); an odd last row or column goes through [`render_pixel`].
+/// Either way each pixel gets the same value to the bit.
 fn render_tile(
     camera: &CameraModel,
     cone: RayCone,
@@ -144,23 +143,15 @@ fn render_tile(
     let width = (tile.x1 - tile.x0) as usize;
     let at = |x: u32, y: u32| (y - tile.y0) as usize * width + (x - tile.x0) as usize;
     let mut pixels = vec![(Vec3::ZERO, Primary::MISS); tile.pixels() as usize];
-    // The blocks cover [x0, x_end) × [y0, y_end); nothing at more than one sample.
-    let (x_end, y_end) = if opts.spp <= 1 {
-        (
-            tile.x1 - (tile.x1 - tile.x0) % 2,
-            tile.y1 - (tile.y1 - tile.y0) % 2,
-        )
-    } else {
-        (tile.x0, tile.y0)
-    };
+    // The blocks cover [x0, x_end) × [y0, y_end).
+    let x_end = tile.x1 - (tile.x1 - tile.x0) % 2;
+    let y_end = tile.y1 - (tile.y1 - tile.y0) % 2;
     for y in (tile.y0..y_end).step_by(2) {
         for x in (tile.x0..x_end).step_by(2) {
             let block = [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)];
-            let rays = block.map(|(x, y)| camera.ray(x as f32 + 0.5, y as f32 + 0.5));
-            let mut rngs = block.map(|(x, y)| Rng::for_pixel(opts.seed, x, y));
-            let samples = integrator.camera_sample4(&rays, cone, &mut rngs, counts);
-            for ((x, y), sample) in block.into_iter().zip(samples) {
-                pixels[at(x, y)] = one_sample(sample);
+            let values = render_block(camera, cone, integrator, opts, block, counts);
+            for ((x, y), value) in block.into_iter().zip(values) {
+                pixels[at(x, y)] = value;
             }
         }
     }
@@ -174,9 +165,56 @@ fn render_tile(
     pixels
 }
 
+/// Four pixels, [`render_pixel`]'s values bit for bit: each pixel's generator draws its
+/// sample positions first, then the four pixels' k-th samples are traced together
+/// ([`Integrator::camera_sample4`], which draws from each pixel's generator in its own
+/// order), and each pixel sums its samples in their order.
+fn render_block(
+    camera: &CameraModel,
+    cone: RayCone,
+    integrator: &Integrator,
+    opts: &RenderOptions,
+    block: [(u32, u32); LANES],
+    counts: &mut RayCounts,
+) -> [(Vec3, Primary); LANES] {
+    let mut rngs = block.map(|(x, y)| Rng::for_pixel(opts.seed, x, y));
+    let ray = |(x, y): (u32, u32), (sx, sy): (f32, f32)| camera.ray(x as f32 + sx, y as f32 + sy);
+    if opts.spp <= 1 {
+        let rays = block.map(|p| ray(p, (0.5, 0.5)));
+        return integrator
+            .camera_sample4(&rays, cone, &mut rngs, counts)
+            .map(one_sample);
+    }
+    let samples: [Vec<(f32, f32)>; LANES] =
+        std::array::from_fn(|l| pixel_samples(opts.spp, &mut rngs[l]));
+    let mut sum = [Vec3::ZERO; LANES];
+    let mut best = [(f32::INFINITY, Primary::MISS); LANES];
+    // Every pixel draws the same number of positions, `spp`.
+    for k in 0..samples[0].len() {
+        let at: [(f32, f32); LANES] = std::array::from_fn(|l| samples[l][k]);
+        let rays = std::array::from_fn(|l| ray(block[l], at[l]));
+        let out = integrator.camera_sample4(&rays, cone, &mut rngs, counts);
+        for l in 0..LANES {
+            let (value, primary) = out[l];
+            sum[l] += value;
+            let d = centre_distance(at[l]);
+            if d < best[l].0 {
+                best[l] = (d, primary);
+            }
+        }
+    }
+    std::array::from_fn(|l| (sum[l] / samples[l].len() as f32, best[l].1))
+}
+
 /// A pixel of one sample: the mean [`render_pixel`] takes of many, which turns −0 into +0.
 fn one_sample((l, primary): (Vec3, Primary)) -> (Vec3, Primary) {
     (Vec3::ZERO + l, primary)
+}
+
+/// How far a sample position lies from its pixel's centre (squared), to pick the sample
+/// whose AOVs the pixel keeps.
+fn centre_distance((sx, sy): (f32, f32)) -> f32 {
+    (sx - 0.5).powi(2) + (sy - 0.5).powi(2)
 }
 
 /// One pixel: the box-filtered mean of its samples. Its generator is seeded from
@@ -207,7 +245,7 @@ pub fn render_pixel(
         let ray = camera.ray(x as f32 + sx, y as f32 + sy);
         let (l, primary) = integrator.camera_sample(&ray, cone, &mut rng, counts);
         sum += l;
-        let d = (sx - 0.5).powi(2) + (sy - 0.5).powi(2);
+        let d = centre_distance((sx, sy));
         if d < best.0 {
             best = (d, primary);
         }
