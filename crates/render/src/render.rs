@@ -189,9 +189,10 @@ fn render_block(
         std::array::from_fn(|l| pixel_samples(opts.spp, &mut rngs[l]));
     let mut sum = [Vec3::ZERO; LANES];
     let mut best = [(f32::INFINITY, Primary::MISS); LANES];
+    let mut positions = samples.each_ref().map(|s| s.iter().copied());
     // Every pixel draws the same number of positions, `spp`.
-    for k in 0..samples[0].len() {
-        let at: [(f32, f32); LANES] = std::array::from_fn(|l| samples[l][k]);
+    while let [Some(a), Some(b), Some(c), Some(d)] = positions.each_mut().map(Iterator::next) {
+        let at = [a, b, c, d];
         let rays = std::array::from_fn(|l| ray(block[l], at[l]));
         let out = integrator.camera_sample4(&rays, cone, &mut rngs, counts);
         for l in 0..LANES {
