@@ -390,7 +390,7 @@ fn shadow_and_mirror_rays_traced_in_blocks_equal_rays_traced_alone() {
     }
 }
 
-/// At one sample per pixel the camera rays of 2×2 blocks are traced together: tiles of one
+/// The camera rays of 2×2 blocks are traced together: tiles of one
 /// pixel (no blocks), of 5 (blocks, and a last row and column alone) and of 32 give the
 /// same pixels and the same counts.
 #[test]
