@@ -918,9 +918,9 @@ impl<'a> Integrator<'a> {
         }
     }
 
-    /// [`Integrator::first_visible`] for four camera rays of neighbouring pixels (one
-    /// packet query where the scene has no cut-outs), lane by lane the same answers and
-    /// the same counts.
+    /// [`Integrator::first_visible`] for four rays that travel side by side, as packet
+    /// queries: lane by lane the same answers, and the same filters asked in the same
+    /// order, so the same counts.
     fn first_visible4(
         &self,
         rays: &[Ray; LANES],
@@ -935,12 +935,47 @@ impl<'a> Integrator<'a> {
                     front[l] = f;
                     true
                 });
-                std::array::from_fn(|l| self.unless_culled(&rays[l], first[l]?, front[l], counts))
+                self.unless_culled4(rays, first, front, counts)
             }
-            (_, true) => {
-                std::array::from_fn(|l| self.first_visible_alpha(&rays[l], cones[l], counts))
-            }
+            (_, true) => self.first_visible_alpha4(rays, cones, counts),
         }
+    }
+
+    /// [`Integrator::unless_culled`] on four lanes: the lanes whose first hit is culled
+    /// walk on from it together, as one packet.
+    #[inline(always)]
+    fn unless_culled4(
+        &self,
+        rays: &[Ray; LANES],
+        first: [Option<Hit>; LANES],
+        front: [bool; LANES],
+        counts: &mut RayCounts,
+    ) -> [Option<Hit>; LANES] {
+        let culled = std::array::from_fn(|l| {
+            first[l].is_some_and(|h| self.culled(h.prim as usize, front[l]))
+        });
+        if culled == [false; LANES] {
+            return first;
+        }
+        let rest = std::array::from_fn(|l| match first[l] {
+            Some(hit) if culled[l] => {
+                counts.pass_through += 1;
+                Ray {
+                    tmin: hit.t,
+                    ..rays[l]
+                }
+            }
+            _ => no_ray(),
+        });
+        let behind = self.accel.intersect4_filtered(&rest, |l, hit, front| {
+            if first[l].is_some_and(|f| f.prim == hit.prim) {
+                return false;
+            }
+            let through = self.culled(hit.prim as usize, front);
+            counts.pass_through += through as u64;
+            !through
+        });
+        std::array::from_fn(|l| if culled[l] { behind[l] } else { first[l] })
     }
 
     /// `first`, the ray's closest hit met on its front (`front`) or back, when its face is
@@ -975,16 +1010,42 @@ impl<'a> Integrator<'a> {
     /// without them keep the old query's code.
     #[inline(never)]
     fn first_visible_alpha(&self, ray: &Ray, cone: RayCone, counts: &mut RayCounts) -> Option<Hit> {
-        let culling = self.culling;
-        self.accel.intersect_filtered(ray, |hit, front| {
-            let prim = hit.prim as usize;
-            let s = &self.surfacing[self.soup.tri_material[prim] as usize];
-            let through = (culling && self.culled(prim, front))
-                || matches!(s.alpha, AlphaUse::Cutout { cutoff }
-                    if self.alpha_at(s, prim, hit, ray.dir, cone.at(hit.t), counts) < cutoff);
-            counts.pass_through += through as u64;
-            !through
+        self.accel
+            .intersect_filtered(ray, |hit, front| self.shows(ray, cone, hit, front, counts))
+    }
+
+    /// [`Integrator::first_visible_alpha`] on four rays, one packet.
+    #[inline(never)]
+    fn first_visible_alpha4(
+        &self,
+        rays: &[Ray; LANES],
+        cones: &[RayCone; LANES],
+        counts: &mut RayCounts,
+    ) -> [Option<Hit>; LANES] {
+        self.accel.intersect4_filtered(rays, |l, hit, front| {
+            self.shows(&rays[l], cones[l], hit, front, counts)
         })
+    }
+
+    /// Whether a camera or reflection ray stops at `hit` in a scene with cut-outs: not a
+    /// culled face (met on its front, `front`, or back), nor a hole of a cut-out at the
+    /// ray cone's footprint. Pass-throughs are counted.
+    #[inline(always)]
+    fn shows(
+        &self,
+        ray: &Ray,
+        cone: RayCone,
+        hit: &Hit,
+        front: bool,
+        counts: &mut RayCounts,
+    ) -> bool {
+        let prim = hit.prim as usize;
+        let s = &self.surfacing[self.soup.tri_material[prim] as usize];
+        let through = (self.culling && self.culled(prim, front))
+            || matches!(s.alpha, AlphaUse::Cutout { cutoff }
+                if self.alpha_at(s, prim, hit, ray.dir, cone.at(hit.t), counts) < cutoff);
+        counts.pass_through += through as u64;
+        !through
     }
 
     /// Whether camera and reflection rays pass through triangle `prim`, met on its front
