@@ -38,7 +38,7 @@ use crate::texture::{cone_footprint, Sampler};
 use crate::TextureFilter;
 use formats::{CastShadows, Hit, Light, Soup, Tiling};
 use glam::{Vec2, Vec3, Vec4};
-use kdtree::triangle::{self, RayPre, RayPre4};
+use kdtree::triangle::RayPre;
 use kdtree::{Accel, Ray, LANES};
 
 /// What the first hit of a camera ray tells the AOVs.
@@ -1098,9 +1098,8 @@ impl<'a> Integrator<'a> {
         // A sample that the caster which blocked an earlier sample of this point blocks
         // too is dark whatever else lies on its way: one triangle test instead of a walk.
         if let Some(prim) = *blocker {
-            let stopped = self.blocked_by4(prim, rays, live);
             for l in 0..LANES {
-                if stopped[l] {
+                if live[l] && self.blocked_by(prim, &rays[l]) {
                     live[l] = false;
                     counts.shadow_reuse += 1;
                 }
@@ -1145,50 +1144,15 @@ impl<'a> Integrator<'a> {
                 || self.surfacing[self.soup.tri_material[p] as usize].alpha == AlphaUse::Opaque)
     }
 
-    /// Which rays in `live` meet triangle `prim` within their interval, where `prim` stops
-    /// them ([`Integrator::opaque_caster`]): the watertight test the traversal runs on it,
-    /// the triangle read once and tested against the rays at once where they share a
-    /// dominant axis (each lane's answer the single test's, bit for bit), else ray by ray.
-    fn blocked_by4(&self, prim: u32, rays: &[Ray; LANES], live: [bool; LANES]) -> [bool; LANES] {
-        let pre: [Option<RayPre>; LANES] = std::array::from_fn(|l| {
-            live[l]
-                .then(|| RayPre::new(rays[l].origin, rays[l].dir))
-                .flatten()
-        });
-        let Some(lead) = pre.iter().flatten().next().copied() else {
-            return [false; LANES];
+    /// Whether `ray` meets triangle `prim` within its interval, and `prim` stops it there
+    /// ([`Integrator::opaque_caster`]): the watertight test the traversal runs on it.
+    fn blocked_by(&self, prim: u32, ray: &Ray) -> bool {
+        let Some(pre) = RayPre::new(ray.origin, ray.dir) else {
+            return false;
         };
         let tri = self.soup.corners(prim as usize).map(|v| v.to_array());
-        let stops = |h: Option<kdtree::triangle::RawHit>| {
-            h.is_some_and(|h| self.opaque_caster(prim, h.front))
-        };
-        if pre.iter().flatten().any(|p| p.kz != lead.kz) {
-            return std::array::from_fn(|l| {
-                stops(
-                    pre[l].and_then(|p| triangle::intersect(&p, &tri, rays[l].tmin, rays[l].tmax)),
-                )
-            });
-        }
-        // A lane without a ray borrows the lead's constants and tests an empty interval.
-        let lanes = pre.map(|p| p.unwrap_or(lead));
-        let tmin = std::array::from_fn(|l| if pre[l].is_some() { rays[l].tmin } else { 1.0 });
-        let tmax = std::array::from_fn(|l| if pre[l].is_some() { rays[l].tmax } else { 0.0 });
-        let column = |f: fn(&RayPre) -> f32| Vec4::from_array(lanes.each_ref().map(f));
-        let r4 = RayPre4::from_lanes(
-            lead.kz,
-            [
-                column(|p| p.origin[0]),
-                column(|p| p.origin[1]),
-                column(|p| p.origin[2]),
-            ],
-            [column(|p| p.sx), column(|p| p.sy), column(|p| p.sz)],
-        );
-        let hits = match lead.kz {
-            0 => triangle::intersect_rays4_along::<0>(&r4, &tri, tmin, tmax),
-            1 => triangle::intersect_rays4_along::<1>(&r4, &tri, tmin, tmax),
-            _ => triangle::intersect_rays4_along::<2>(&r4, &tri, tmin, tmax),
-        };
-        std::array::from_fn(|l| pre[l].is_some() && hits.hit[l] && stops(Some(hits.raw(l))))
+        kdtree::triangle::intersect(&pre, &tri, ray.tmin, ray.tmax)
+            .is_some_and(|h| self.opaque_caster(prim, h.front))
     }
 
     /// Whether a hit stops an opaque scene's shadow ray: a face that casts, or the face a
