@@ -127,6 +127,27 @@ struct Surfacing {
     opacity: f32,
 }
 
+/// What a camera or mirror ray has gathered from the blended layers it passed: their light,
+/// and the share of what lies behind them that still reaches the eye.
+#[derive(Clone, Copy)]
+struct Layers {
+    acc: Vec3,
+    through: f32,
+}
+
+impl Layers {
+    const NONE: Layers = Layers {
+        acc: Vec3::ZERO,
+        through: 1.0,
+    };
+}
+
+/// Where a ray goes on behind a blended hit: past the surface point, and past the triangle
+/// sharing the edge it may lie on.
+fn past(hit: &Hit) -> f32 {
+    (hit.t + hit.t * SAME_SURFACE).max(hit.t.next_up())
+}
+
 /// Two hits of one object closer than this fraction of their distance are one surface
 /// point: the any-hit query reports a triangle once per leaf it spans, and a ray through an
 /// edge meets both triangles that share it (at t a few ulps apart). Distinct layers this
@@ -421,8 +442,10 @@ impl<'a> Integrator<'a> {
     /// [`Integrator::radiance`] on four rays that travel side by side, lane by lane the
     /// same results, counts and draws from each lane's generator: their first hits are
     /// found together, then each light's hard shadow rays from those hits and their mirror
-    /// rays are traced together, level by level ([`Integrator::shade4`]). Lanes not `live`
-    /// trace nothing and send back black.
+    /// rays are traced together, level by level ([`Integrator::shade4`]), and the lanes
+    /// that see through a blended surface go on to the next layer together, with
+    /// [`Integrator::behind`]'s arithmetic. Lanes not `live` trace nothing and send back
+    /// black.
     #[allow(clippy::too_many_arguments)]
     fn radiance4(
         &self,
@@ -435,26 +458,65 @@ impl<'a> Integrator<'a> {
         counts: &mut RayCounts,
         primary: &mut [Option<&mut Primary>; LANES],
     ) -> [Vec3; LANES] {
-        let rays = std::array::from_fn(|i| if live[i] { rays[i] } else { no_ray() });
-        let first = self.first_visible4(&rays, &cones, counts);
-        let shaded = self.shade4(
-            &rays, &first, &cones, bounce, weights, rngs, counts, primary,
-        );
-        std::array::from_fn(|i| match (first[i], shaded[i]) {
-            (Some(hit), Some(shaded)) => self.behind(
-                &rays[i],
-                hit,
-                shaded,
-                cones[i],
-                bounce,
-                weights[i],
-                &mut rngs[i],
-                counts,
-                primary[i].take(),
-            ),
-            _ if live[i] => environment::background(&self.soup.environment, rays[i].dir),
-            _ => Vec3::ZERO,
-        })
+        let mut rays = std::array::from_fn(|i| if live[i] { rays[i] } else { no_ray() });
+        let mut going = live;
+        let mut layers = [Layers::NONE; LANES];
+        let mut out = [Vec3::ZERO; LANES];
+        loop {
+            let first = self.first_visible4(&rays, &cones, counts);
+            let through = layers.map(|f| f.through);
+            let shaded = self.shade4(
+                &rays, &first, &cones, bounce, weights, through, rngs, counts, primary,
+            );
+            let was = going;
+            for i in (0..LANES).filter(|&i| was[i]) {
+                going[i] = false;
+                let (Some(hit), Some(shaded)) = (first[i], shaded[i]) else {
+                    out[i] = self.beyond(&layers[i], rays[i].dir);
+                    continue;
+                };
+                if let Some(done) = self.fold(&mut layers[i], weights[i], shaded) {
+                    out[i] = done;
+                    continue;
+                }
+                counts.blend_continuation += 1;
+                rays[i].tmin = past(&hit);
+                going[i] = true;
+            }
+            if going == [false; LANES] {
+                return out;
+            }
+            for i in 0..LANES {
+                if !going[i] {
+                    rays[i] = no_ray();
+                }
+            }
+        }
+    }
+
+    /// A layer's light `l` and α `a` folded into what a ray has gathered: its radiance when
+    /// the layer ends it (opaque, or what passes too faint to matter by the reflection
+    /// cut-off's rule), None when it goes on behind the layer. `weight` is the ray's.
+    #[inline(always)]
+    fn fold(&self, layers: &mut Layers, weight: Vec3, (l, a): (Vec3, f32)) -> Option<Vec3> {
+        if !self.alpha || (a >= 1.0 && layers.through == 1.0) {
+            return Some(l);
+        }
+        layers.acc += l * (a * layers.through);
+        layers.through *= 1.0 - a;
+        let faint = self.cutoff.max(f32::MIN_POSITIVE);
+        (a >= 1.0 || (weight * layers.through).max_element() < faint).then_some(layers.acc)
+    }
+
+    /// The radiance of a ray that leaves the scene along `dir` behind its blended layers.
+    #[inline(always)]
+    fn beyond(&self, layers: &Layers, dir: Vec3) -> Vec3 {
+        let bg = environment::background(&self.soup.environment, dir);
+        if layers.through == 1.0 {
+            bg
+        } else {
+            layers.acc + bg * layers.through
+        }
     }
 
     /// Radiance along `ray`: the first visible surface's, and where that surface is
@@ -521,38 +583,18 @@ impl<'a> Integrator<'a> {
         counts: &mut RayCounts,
         primary: Option<&mut Primary>,
     ) -> Vec3 {
-        if !self.alpha {
-            return shaded.0;
-        }
         let mut primary = primary;
         let mut r = *ray;
         let (mut hit, mut shaded) = (hit, shaded);
-        // Light gathered from the blended layers so far, and the share of what lies behind
-        // them that still reaches the eye.
-        let mut acc = Vec3::ZERO;
-        let mut through = 1.0f32;
+        let mut layers = Layers::NONE;
         loop {
-            let (l, a) = shaded;
-            if a >= 1.0 && through == 1.0 {
-                return l;
-            }
-            acc += l * (a * through);
-            through *= 1.0 - a;
-            // A layer that stops all light, or a remainder too faint to matter (the
-            // reflection cut-off's rule), ends the ray.
-            if a >= 1.0 || (weight * through).max_element() < self.cutoff.max(f32::MIN_POSITIVE) {
-                return acc;
+            if let Some(done) = self.fold(&mut layers, weight, shaded) {
+                return done;
             }
             counts.blend_continuation += 1;
-            // Past this surface point, and past the triangle sharing the edge it may lie on.
-            r.tmin = (hit.t + hit.t * SAME_SURFACE).max(hit.t.next_up());
+            r.tmin = past(&hit);
             let Some(next) = self.first_visible(&r, cone, counts) else {
-                let bg = environment::background(&self.soup.environment, r.dir);
-                return if through == 1.0 {
-                    bg
-                } else {
-                    acc + bg * through
-                };
+                return self.beyond(&layers, r.dir);
             };
             hit = next;
             shaded = self.shade(
@@ -561,7 +603,7 @@ impl<'a> Integrator<'a> {
                 cone,
                 bounce,
                 weight,
-                through,
+                layers.through,
                 rng,
                 counts,
                 &mut primary,
@@ -606,8 +648,9 @@ impl<'a> Integrator<'a> {
         self.reflect(lit, ray, hit, cone, bounce, weight, through, rng, counts)
     }
 
-    /// [`Integrator::shade`] on the first hits of four rays (nothing blended in front of
-    /// them): each light's hard shadow rays from the four points are traced as one packet,
+    /// [`Integrator::shade`] on the hits of four rays (`through` the share of each hit's
+    /// light that passes the blended layers in front of it): each light's hard shadow rays
+    /// from the four points are traced as one packet,
     /// as are their mirror rays ([`Integrator::radiance4`]). Each lane's light is added,
     /// and its generator drawn from, in the single path's order, so each lane's result and
     /// counts are [`Integrator::shade`]'s, bit for bit. None for a lane without a hit.
@@ -619,6 +662,7 @@ impl<'a> Integrator<'a> {
         cones: &[RayCone; LANES],
         bounce: u32,
         weights: [Vec3; LANES],
+        through: [f32; LANES],
         rngs: &mut [Rng; LANES],
         counts: &mut RayCounts,
         primary: &mut [Option<&mut Primary>; LANES],
@@ -665,7 +709,7 @@ impl<'a> Integrator<'a> {
         let mirrors: [Option<Mirror>; LANES] = std::array::from_fn(|l| {
             let (lit, hit) = (lit[l].as_ref()?, first[l]?);
             self.mirror(
-                lit, &rays[l], &hit, cones[l], bounce, weights[l], 1.0, counts,
+                lit, &rays[l], &hit, cones[l], bounce, weights[l], through[l], counts,
             )
         });
         if mirrors.iter().any(Option::is_some) {
