@@ -444,8 +444,8 @@ impl<'a> Integrator<'a> {
     /// found together, then each light's hard shadow rays from those hits and their mirror
     /// rays are traced together, level by level ([`Integrator::shade4`]), and the lanes
     /// that see through a blended surface go on to the next layer together, with
-    /// [`Integrator::behind`]'s arithmetic. Lanes not `live` trace nothing and send back
-    /// black.
+    /// [`Integrator::radiance_from`]'s arithmetic. Lanes not `live` trace nothing and send
+    /// back black.
     #[allow(clippy::too_many_arguments)]
     fn radiance4(
         &self,
@@ -536,7 +536,8 @@ impl<'a> Integrator<'a> {
         self.radiance_from(ray, first, cone, bounce, weight, rng, counts, primary)
     }
 
-    /// [`Integrator::radiance`] once the ray's first visible hit, `first`, is known.
+    /// [`Integrator::radiance`] once the ray's first visible hit, `first`, is known: that
+    /// surface's light and, where it is blended, what lies behind it, layer by layer.
     #[allow(clippy::too_many_arguments)]
     fn radiance_from(
         &self,
@@ -550,54 +551,14 @@ impl<'a> Integrator<'a> {
         primary: Option<&mut Primary>,
     ) -> Vec3 {
         let mut primary = primary;
-        let Some(hit) = first else {
-            return environment::background(&self.soup.environment, ray.dir);
-        };
-        let shaded = self.shade(
-            ray,
-            &hit,
-            cone,
-            bounce,
-            weight,
-            1.0,
-            rng,
-            counts,
-            &mut primary,
-        );
-        self.behind(ray, hit, shaded, cone, bounce, weight, rng, counts, primary)
-    }
-
-    /// [`Integrator::radiance`] once its first visible hit is shaded (`shaded`, its light
-    /// and α): that light, mixed, where the surface is blended, with what lies behind it.
-    /// `primary` is still to be filled when the first hit was fully transparent.
-    #[allow(clippy::too_many_arguments)]
-    fn behind(
-        &self,
-        ray: &Ray,
-        hit: Hit,
-        shaded: (Vec3, f32),
-        cone: RayCone,
-        bounce: u32,
-        weight: Vec3,
-        rng: &mut Rng,
-        counts: &mut RayCounts,
-        primary: Option<&mut Primary>,
-    ) -> Vec3 {
-        let mut primary = primary;
         let mut r = *ray;
-        let (mut hit, mut shaded) = (hit, shaded);
+        let mut next = first;
         let mut layers = Layers::NONE;
         loop {
-            if let Some(done) = self.fold(&mut layers, weight, shaded) {
-                return done;
-            }
-            counts.blend_continuation += 1;
-            r.tmin = past(&hit);
-            let Some(next) = self.first_visible(&r, cone, counts) else {
+            let Some(hit) = next else {
                 return self.beyond(&layers, r.dir);
             };
-            hit = next;
-            shaded = self.shade(
+            let shaded = self.shade(
                 &r,
                 &hit,
                 cone,
@@ -608,6 +569,12 @@ impl<'a> Integrator<'a> {
                 counts,
                 &mut primary,
             );
+            if let Some(done) = self.fold(&mut layers, weight, shaded) {
+                return done;
+            }
+            counts.blend_continuation += 1;
+            r.tmin = past(&hit);
+            next = self.first_visible(&r, cone, counts);
         }
     }
 
