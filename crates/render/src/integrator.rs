@@ -1341,7 +1341,7 @@ fn keep_last(blocker: &mut Option<u32>, casters: [Option<u32>; LANES]) {
 /// unit `dir` towards a light `dist` away from `p` (`dist` infinite: a directional light,
 /// the ray is unbounded), re-aimed and re-measured from the spawned origin and stopped
 /// short of the light by a relative margin.
-fn shadow_ray(origin: Vec3, p: Vec3, dir: Vec3, dist: f32) -> Ray {
+pub(crate) fn shadow_ray(origin: Vec3, p: Vec3, dir: Vec3, dist: f32) -> Ray {
     if dist.is_infinite() {
         return Ray {
             origin,

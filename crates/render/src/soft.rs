@@ -123,7 +123,7 @@ impl<'a> SoftCone<'a> {
         let origin: Lanes3 =
             std::array::from_fn(|a| Vec4::select(leaves_below, below[a], above[a]));
         // Towards a light at a distance, re-aimed and re-measured from the spawned origin
-        // and stopped short of the light (`shadow_ray`).
+        // and stopped short of the light (`integrator::shadow_ray`).
         let p = splat(self.p);
         let to: Lanes3 = std::array::from_fn(|a| p[a] + dir[a] * dist - origin[a]);
         let d = sqrt(dot(&to, &to));
@@ -155,6 +155,7 @@ fn cos_half(light: &Light) -> f32 {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use crate::integrator::shadow_ray;
     use crate::sampling::{disc_sample, Rng};
     use formats::Shadows;
 
@@ -187,16 +188,6 @@ pub(crate) mod tests {
                 }
             }
         }
-    }
-
-    /// `shadow_ray` one ray at a time.
-    fn shadow_ray(origin: Vec3, p: Vec3, dir: Vec3, dist: f32) -> Ray {
-        if dist.is_infinite() {
-            return Ray::new(origin, dir, SPAWN_TMIN, f32::INFINITY);
-        }
-        let to = p + dir * dist - origin;
-        let d = to.length();
-        Ray::new(origin, to / d, SPAWN_TMIN, d * SHADOW_TMAX_FRACTION)
     }
 
     fn light(kind: LightKind, position: Vec3, shadow_radius: f32) -> Light {
