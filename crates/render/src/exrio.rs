@@ -5,7 +5,7 @@
 use crate::{Frame, RenderError, Window};
 use exr::block::chunk::{Chunk, CompressedBlock, CompressedScanLineBlock};
 use exr::block::writer::ChunksWriter;
-use exr::block::UncompressedBlock;
+use exr::block::{BlockIndex, UncompressedBlock};
 use exr::image::write::layers::{LayersWriter, WritableLayers};
 use exr::meta::header::Header;
 use exr::prelude::*;
@@ -119,22 +119,54 @@ impl ExrImage {
     /// threads. The `exr` crate deflates with miniz at level 4, which on a rendered frame
     /// takes 3× as long for a file of the same size (see `exrwrite`).
     pub fn encode(&self) -> std::result::Result<Vec<u8>, String> {
-        let image = self.exr_image(Encoding::SMALL_LOSSLESS)?;
+        let n = self.window.pixels() as usize;
+        if let Some((name, _)) = self.channels.iter().find(|(_, s)| s.len() != n) {
+            return Err(format!(
+                "channel {name} does not hold one sample per pixel of the {}×{} window",
+                self.window.width(),
+                self.window.height()
+            ));
+        }
+        // On little-endian machines the blocks are built here from the channels, and the
+        // crate's image only describes the header: it need not copy the samples.
+        let big_endian = cfg!(target_endian = "big");
+        let image = self.exr_image(Encoding::SMALL_LOSSLESS, big_endian)?;
         let headers = image.write().infer_meta_data();
+        // The header's channel order, which is what a block's lines follow.
+        let planes = headers[0]
+            .channels
+            .list
+            .iter()
+            .map(|c| {
+                let name = c.name.to_string();
+                self.channel(&name).ok_or(format!(
+                    "channel {name} is in the header but not in the image"
+                ))
+            })
+            .collect::<std::result::Result<Vec<_>, _>>()?;
         let layers = image.layer_data.create_writer(&headers);
         let mut out = Cursor::new(Vec::new());
         exr::block::write(&mut out, headers, true, |meta, writer| {
             let blocks: Vec<_> = meta.enumerate_ordered_header_block_indices().collect();
             let chunks = blocks
                 .into_par_iter()
-                .map_init(
-                    || Compressor::new(CompressionLvl::new(1).expect("level 1 exists")),
-                    |deflate, (i, index)| {
-                        let raw = layers.extract_uncompressed_block(&meta.headers, index);
-                        let block = UncompressedBlock { index, data: raw };
-                        zip_chunk(deflate, &meta.headers, block).map(|c| (i, c))
-                    },
-                )
+                .map_init(ZipScratch::new, |scratch, (i, index)| {
+                    let chunk = if big_endian {
+                        // The samples must be swapped to little-endian first: leave that to
+                        // the crate.
+                        let data = layers.extract_uncompressed_block(&meta.headers, index);
+                        UncompressedBlock { index, data }.compress_to_chunk(&meta.headers)
+                    } else {
+                        block_bytes(
+                            &planes,
+                            self.window.width() as usize,
+                            index,
+                            &mut scratch.raw,
+                        );
+                        Ok(zip_chunk(scratch, &meta.headers, index))
+                    };
+                    chunk.map(|c| (i, c))
+                })
                 .collect::<exr::error::Result<Vec<_>>>()?;
             for (i, chunk) in chunks {
                 writer.write_chunk(i, chunk)?;
@@ -148,17 +180,20 @@ impl ExrImage {
     /// Encode with the `exr` crate's own compressors (what `exrwrite` compares).
     pub fn encode_with(&self, encoding: Encoding) -> std::result::Result<Vec<u8>, String> {
         let mut out = Cursor::new(Vec::new());
-        self.exr_image(encoding)?
+        self.exr_image(encoding, true)?
             .write()
             .to_buffered(&mut out)
             .map_err(|e| e.to_string())?;
         Ok(out.into_inner())
     }
 
-    /// The `exr` crate's image of this one: one layer, its channels and attributes.
+    /// The `exr` crate's image of this one: one layer, its channels and attributes; without
+    /// `samples`, each channel's sample type but none of its samples, which is enough for
+    /// the header.
     fn exr_image(
         &self,
         encoding: Encoding,
+        samples: bool,
     ) -> std::result::Result<Image<Layer<AnyChannels<FlatSamples>>>, String> {
         let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = self
             .channels
@@ -166,7 +201,13 @@ impl ExrImage {
             .map(|(name, s)| {
                 let text =
                     Text::new_or_none(name).ok_or(format!("channel name {name:?} is not ASCII"))?;
-                Ok(AnyChannel::new(text, s.clone()))
+                let s = match s {
+                    _ if samples => s.clone(),
+                    FlatSamples::F16(_) => FlatSamples::F16(Vec::new()),
+                    FlatSamples::F32(_) => FlatSamples::F32(Vec::new()),
+                    FlatSamples::U32(_) => FlatSamples::U32(Vec::new()),
+                };
+                Ok(AnyChannel::new(text, s))
             })
             .collect::<std::result::Result<_, String>>()?;
         let size = (self.window.width() as usize, self.window.height() as usize);
@@ -260,46 +301,143 @@ impl ExrImage {
     }
 }
 
-/// One scan-line block as OpenEXR's ZIP compressor stores it: the block's little-endian
-/// bytes split into the even-indexed then the odd-indexed ones, each byte replaced by its
-/// difference to the one before plus 128, then zlib; a block that would not shrink is
-/// stored as it is, which readers recognise by its size.
-fn zip_chunk(
-    deflate: &mut Compressor,
-    headers: &[Header],
-    block: UncompressedBlock,
-) -> exr::error::Result<Chunk> {
-    if cfg!(target_endian = "big") {
-        // The samples must be swapped to little-endian first: leave that to the crate.
-        return block.compress_to_chunk(headers);
-    }
-    let raw = &block.data;
-    let n = raw.len();
-    let mut split = vec![0u8; n];
-    let (evens, odds) = split.split_at_mut(n.div_ceil(2));
-    for (i, pair) in raw.chunks(2).enumerate() {
-        evens[i] = pair[0];
-        if let Some(&b) = pair.get(1) {
-            odds[i] = b;
+/// What one thread reuses from block to block: its compressor, and buffers the size of a
+/// block, which are too large to allocate cheaply each time.
+struct ZipScratch {
+    deflate: Compressor,
+    raw: Vec<u8>,
+    split: Vec<u8>,
+    predicted: Vec<u8>,
+    packed: Vec<u8>,
+}
+
+impl ZipScratch {
+    fn new() -> Self {
+        ZipScratch {
+            deflate: Compressor::new(CompressionLvl::new(1).expect("level 1 exists")),
+            raw: Vec::new(),
+            split: Vec::new(),
+            predicted: Vec::new(),
+            packed: Vec::new(),
         }
     }
-    for i in (1..n).rev() {
-        split[i] = split[i].wrapping_sub(split[i - 1]).wrapping_add(128);
+}
+
+/// The little-endian bytes of one scan-line block into `out`: for each line, each channel
+/// of `planes` (the header's order) with that line's samples. `width` is the data
+/// window's.
+fn block_bytes(planes: &[&FlatSamples], width: usize, index: BlockIndex, out: &mut Vec<u8>) {
+    let (x, y) = (index.pixel_position.x(), index.pixel_position.y());
+    let (w, h) = (index.pixel_size.width(), index.pixel_size.height());
+    let per_pixel: usize = planes.iter().map(|p| sample_bytes(p)).sum();
+    out.resize(w * h * per_pixel, 0);
+    let mut at = 0;
+    for row in y..y + h {
+        let line = row * width + x..row * width + x + w;
+        for plane in planes {
+            let dst = &mut out[at..at + w * sample_bytes(plane)];
+            match plane {
+                FlatSamples::F16(v) => put(dst, &v[line.clone()], |s| s.to_le_bytes()),
+                FlatSamples::F32(v) => put(dst, &v[line.clone()], |s| s.to_le_bytes()),
+                FlatSamples::U32(v) => put(dst, &v[line.clone()], |s| s.to_le_bytes()),
+            }
+            at += dst.len();
+        }
     }
-    let mut packed = vec![0u8; deflate.zlib_compress_bound(n)];
+}
+
+fn sample_bytes(samples: &FlatSamples) -> usize {
+    match samples {
+        FlatSamples::F16(_) => 2,
+        FlatSamples::F32(_) | FlatSamples::U32(_) => 4,
+    }
+}
+
+fn put<T: Copy, const N: usize>(dst: &mut [u8], src: &[T], bytes: impl Fn(T) -> [u8; N]) {
+    for (d, &s) in dst.chunks_exact_mut(N).zip(src) {
+        d.copy_from_slice(&bytes(s));
+    }
+}
+
+/// `raw`'s even-indexed bytes into `evens`, its odd-indexed ones into `odds`, each half as
+/// long as `raw` (whose length is even, as every sample's is).
+fn deinterleave(raw: &[u8], evens: &mut [u8], odds: &mut [u8]) {
+    const LOW: u64 = 0x00ff_00ff_00ff_00ff;
+    // The low bytes of the four 16-bit lanes of `x` (each 0 to 255) gathered into its low
+    // 32 bits: eight bytes a step instead of one, which the compiler does not find itself.
+    let gather = |x: u64| {
+        let x = (x | x >> 8) & 0x0000_ffff_0000_ffff;
+        (x | x >> 16) & 0xffff_ffff
+    };
+    let (raw16, rest) = raw.split_at(raw.len() / 16 * 16);
+    let (evens8, evens_rest) = evens.split_at_mut(raw16.len() / 2);
+    let (odds8, odds_rest) = odds.split_at_mut(raw16.len() / 2);
+    let words = raw16
+        .chunks_exact(16)
+        .zip(evens8.chunks_exact_mut(8))
+        .zip(odds8.chunks_exact_mut(8));
+    for ((src, e), o) in words {
+        let [a, b] = [&src[..8], &src[8..]].map(|s| {
+            u64::from_le_bytes(
+                s.try_into()
+                    .expect("a chunk of 16 bytes has two halves of 8"),
+            )
+        });
+        e.copy_from_slice(&(gather(a & LOW) | gather(b & LOW) << 32).to_le_bytes());
+        o.copy_from_slice(&(gather(a >> 8 & LOW) | gather(b >> 8 & LOW) << 32).to_le_bytes());
+    }
+    for ((pair, e), o) in rest.chunks_exact(2).zip(evens_rest).zip(odds_rest) {
+        *e = pair[0];
+        *o = pair[1];
+    }
+}
+
+/// One scan-line block, its little-endian bytes in `scratch.raw`, as OpenEXR's ZIP
+/// compressor stores it: the even-indexed bytes, then the odd-indexed ones, each byte
+/// replaced by its difference to the one before plus 128, then zlib; a block that would
+/// not shrink is stored as it is, which readers recognise by its size.
+fn zip_chunk(scratch: &mut ZipScratch, headers: &[Header], index: BlockIndex) -> Chunk {
+    let ZipScratch {
+        deflate,
+        raw,
+        split,
+        predicted,
+        packed,
+    } = scratch;
+    let n = raw.len();
+    split.resize(n, 0);
+    predicted.resize(n, 0);
+    let (evens, odds) = split.split_at_mut(n / 2);
+    deinterleave(raw, evens, odds);
+    // From a copy, front to back: in place it would have to run backwards, which the
+    // compiler does not vectorise.
+    if n > 0 {
+        predicted[0] = split[0];
+        let pairs = predicted[1..]
+            .iter_mut()
+            .zip(&split[1..])
+            .zip(&split[..n - 1]);
+        for ((d, &cur), &prev) in pairs {
+            *d = cur.wrapping_sub(prev).wrapping_add(128);
+        }
+    }
+    packed.resize(deflate.zlib_compress_bound(n), 0);
     // The only failure is a too small buffer, which the bound rules out; it would store
     // the block as it is.
-    let size = deflate.zlib_compress(&split, &mut packed).unwrap_or(n);
-    packed.truncate(size);
-    let header = &headers[block.index.layer];
-    let y = block.index.pixel_position.y() as i32 + header.own_attributes.layer_position.y();
-    Ok(Chunk {
-        layer_index: block.index.layer,
+    let size = deflate.zlib_compress(predicted, packed).unwrap_or(n);
+    let header = &headers[index.layer];
+    let y = index.pixel_position.y() as i32 + header.own_attributes.layer_position.y();
+    Chunk {
+        layer_index: index.layer,
         compressed_block: CompressedBlock::ScanLine(CompressedScanLineBlock {
             y_coordinate: y,
-            compressed_pixels_le: if size < n { packed } else { block.data },
+            compressed_pixels_le: if size < n {
+                packed[..size].to_vec()
+            } else {
+                raw.clone()
+            },
         }),
-    })
+    }
 }
 
 /// Attributes that must agree between the crops of one image: the settings that change
@@ -588,16 +726,158 @@ mod tests {
             assert_eq!(back.attributes[&format!("{ATTR_PREFIX}spp")], "1");
             assert_eq!(back.channel_names(), ["A", "R", "Z"]);
             for ((name, ours), (_, theirs)) in back.channels.iter().zip(&image.channels) {
-                let bits = |s: &FlatSamples| -> Vec<u32> {
-                    match s {
-                        FlatSamples::F16(v) => v.iter().map(|h| h.to_bits() as u32).collect(),
-                        FlatSamples::F32(v) => v.iter().map(|f| f.to_bits()).collect(),
-                        FlatSamples::U32(v) => v.clone(),
-                    }
-                };
-                assert_eq!(bits(ours), bits(theirs), "channel {name}, noise {noise}");
+                assert_eq!(
+                    sample_bits(ours),
+                    sample_bits(theirs),
+                    "channel {name}, noise {noise}"
+                );
             }
         }
+    }
+
+    /// A 37×21 crop at (5, 11) of a 64×40 image with every sample type, each channel
+    /// filled with random bits.
+    fn odd_crop() -> ExrImage {
+        let window = Window {
+            x0: 5,
+            y0: 11,
+            x1: 42,
+            y1: 32,
+        };
+        let n = window.pixels() as usize;
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut bits = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state as u32
+        };
+        let mut f32s = || (0..n).map(|_| f32::from_bits(bits())).collect::<Vec<_>>();
+        let (red, depth) = (f32s(), f32s());
+        let alpha = (0..n).map(|_| f16::from_bits(bits() as u16)).collect();
+        let object = (0..n).map(|_| bits()).collect();
+        ExrImage {
+            width: 64,
+            height: 40,
+            window,
+            // Out of name order: the blocks follow the header's order.
+            channels: vec![
+                ("Z".into(), FlatSamples::F32(depth)),
+                ("A".into(), FlatSamples::F16(alpha)),
+                ("object".into(), FlatSamples::U32(object)),
+                ("R".into(), FlatSamples::F32(red)),
+            ],
+            attributes: BTreeMap::new(),
+        }
+    }
+
+    /// The samples as bits: NaNs compare equal to themselves.
+    fn sample_bits(s: &FlatSamples) -> Vec<u32> {
+        match s {
+            FlatSamples::F16(v) => v.iter().map(|h| h.to_bits() as u32).collect(),
+            FlatSamples::F32(v) => v.iter().map(|f| f.to_bits()).collect(),
+            FlatSamples::U32(v) => v.clone(),
+        }
+    }
+
+    fn block_indices(headers: &[Header]) -> Vec<BlockIndex> {
+        exr::block::enumerate_ordered_header_block_indices(headers)
+            .map(|(_, index)| index)
+            .collect()
+    }
+
+    #[test]
+    fn blocks_hold_the_bytes_the_exr_crate_extracts() {
+        for image in [odd_crop(), encodable(false), encodable(true)] {
+            let crate_image = image.exr_image(Encoding::SMALL_LOSSLESS, true).unwrap();
+            let headers = crate_image.write().infer_meta_data();
+            let layers = crate_image.layer_data.create_writer(&headers);
+            let planes: Vec<_> = headers[0]
+                .channels
+                .list
+                .iter()
+                .map(|c| image.channel(&c.name.to_string()).unwrap())
+                .collect();
+            let mut ours = Vec::new();
+            let blocks = block_indices(&headers);
+            assert!(blocks.len() >= 2);
+            for index in blocks {
+                block_bytes(&planes, image.window.width() as usize, index, &mut ours);
+                let theirs = layers.extract_uncompressed_block(&headers, index);
+                assert_eq!(ours, theirs, "block at line {}", index.pixel_position.y());
+            }
+        }
+    }
+
+    #[test]
+    fn an_odd_crop_of_every_sample_type_gives_back_every_sample() {
+        let image = odd_crop();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("odd.exr");
+        std::fs::write(&path, image.encode().unwrap()).unwrap();
+        let back = ExrImage::read(&path).unwrap();
+        assert_eq!(back.window, image.window);
+        assert_eq!(back.channel_names(), ["A", "R", "Z", "object"]);
+        for (name, samples) in &image.channels {
+            let back = back.channel(name).unwrap();
+            assert_eq!(sample_bits(back), sample_bits(samples), "channel {name}");
+        }
+    }
+
+    #[test]
+    fn zip_chunks_hold_the_split_and_predicted_bytes() {
+        // The definition, a byte at a time.
+        let reference = |raw: &[u8]| {
+            let evens = raw.iter().step_by(2);
+            let split: Vec<u8> = evens
+                .chain(raw.iter().skip(1).step_by(2))
+                .copied()
+                .collect();
+            let mut predicted = split.clone();
+            for i in 1..split.len() {
+                predicted[i] = split[i].wrapping_sub(split[i - 1]).wrapping_add(128);
+            }
+            predicted
+        };
+        let image = odd_crop();
+        let headers = image
+            .exr_image(Encoding::SMALL_LOSSLESS, false)
+            .unwrap()
+            .write()
+            .infer_meta_data();
+        let index = block_indices(&headers)[0];
+        let mut scratch = ZipScratch::new();
+        let mut inflate = libdeflater::Decompressor::new();
+        // Lengths on either side of the 16 bytes deinterleaved at a time; smooth bytes,
+        // which deflate shrinks.
+        for n in [2, 4, 14, 16, 18, 30, 32, 34, 250, 4096 + 6] {
+            scratch.raw = (0..n).map(|i| (i / 7 + i % 2 * 40) as u8).collect();
+            let chunk = zip_chunk(&mut scratch, &headers, index);
+            let CompressedBlock::ScanLine(block) = chunk.compressed_block else {
+                panic!("a scan-line block");
+            };
+            let mut back = vec![0; n];
+            let bytes = block.compressed_pixels_le;
+            let got = match inflate.zlib_decompress(&bytes, &mut back) {
+                Ok(size) if size == n => back,
+                // Stored as it is.
+                _ => bytes.clone(),
+            };
+            assert!(n < 250 || bytes.len() < n, "{n} bytes did not shrink");
+            if bytes.len() < n {
+                assert_eq!(got, reference(&scratch.raw), "{n} bytes");
+            } else {
+                assert_eq!(bytes, scratch.raw, "{n} bytes stored");
+            }
+        }
+    }
+
+    #[test]
+    fn encoding_refuses_a_channel_of_another_size() {
+        let mut image = odd_crop();
+        image.channels[1].1 = FlatSamples::F16(vec![f16::ONE; 3]);
+        let err = image.encode().unwrap_err();
+        assert!(err.contains("channel A"), "{err}");
     }
 
     #[test]
