@@ -2,6 +2,7 @@
 //! scan-line file, the data window set to the rendered crop and the display window to the
 //! full image; reading back; and merging crops into the full image.
 
+use crate::frame::ChannelView;
 use crate::{Frame, RenderError, Window};
 use exr::block::chunk::{Chunk, CompressedBlock, CompressedScanLineBlock};
 use exr::block::writer::ChunksWriter;
@@ -127,6 +128,68 @@ impl ExrImage {
                 self.window.height()
             ));
         }
+        self.encode_planes(|name| self.channel(name).map(Plane::Samples))
+    }
+
+    /// [`ExrImage::from_frame`] encoded, the same bytes, but each block read straight from
+    /// the frame's buffers: gathering the planes first costs more than the blocks' copying,
+    /// most of it in page faults on the fresh memory.
+    pub fn encode_frame(
+        frame: &Frame,
+        half: bool,
+        attributes: BTreeMap<String, String>,
+    ) -> std::result::Result<Vec<u8>, String> {
+        if cfg!(target_endian = "big") {
+            // The crate writes the blocks there, from samples of its own.
+            return Self::from_frame(frame, half, attributes).encode();
+        }
+        let n = frame.window.pixels() as usize;
+        let views = frame.channel_views();
+        for (name, view) in &views {
+            let len = match view {
+                ChannelView::Plane(v) => v.len(),
+                ChannelView::Component(v, _) => v.len(),
+                ChannelView::One => n,
+            };
+            if len != n {
+                return Err(format!(
+                    "channel {name} of the frame holds {len} of {n} pixels"
+                ));
+            }
+        }
+        let halved = |name: &str| half && halvable(name);
+        // The header's image: each channel's type, no samples.
+        let mut channels: Vec<(String, FlatSamples)> = views
+            .iter()
+            .map(|(name, _)| {
+                let samples = match halved(name) {
+                    true => FlatSamples::F16(Vec::new()),
+                    false => FlatSamples::F32(Vec::new()),
+                };
+                (name.to_string(), samples)
+            })
+            .collect();
+        channels.sort_by(|a, b| a.0.cmp(&b.0));
+        let layout = ExrImage {
+            width: frame.width,
+            height: frame.height,
+            window: frame.window,
+            channels,
+            attributes,
+        };
+        layout.encode_planes(|name| {
+            let (_, view) = views.iter().find(|(n, _)| *n == name)?;
+            Some(Plane::Frame(*view, halved(name)))
+        })
+    }
+
+    /// Encode with each block's samples from `plane` (by channel name) and the header
+    /// from this image. On big-endian machines the crate builds the blocks, from this
+    /// image's samples.
+    fn encode_planes<'a>(
+        &self,
+        plane: impl Fn(&str) -> Option<Plane<'a>>,
+    ) -> std::result::Result<Vec<u8>, String> {
         // On little-endian machines the blocks are built here from the channels, and the
         // crate's image only describes the header: it need not copy the samples.
         let big_endian = cfg!(target_endian = "big");
@@ -139,7 +202,7 @@ impl ExrImage {
             .iter()
             .map(|c| {
                 let name = c.name.to_string();
-                self.channel(&name).ok_or(format!(
+                plane(&name).ok_or(format!(
                     "channel {name} is in the header but not in the image"
                 ))
             })
@@ -240,6 +303,23 @@ impl ExrImage {
         Ok(())
     }
 
+    /// [`ExrImage::encode_frame`] written atomically.
+    pub fn write_frame(
+        frame: &Frame,
+        half: bool,
+        attributes: BTreeMap<String, String>,
+        path: &Path,
+    ) -> std::result::Result<(), RenderError> {
+        let bytes = Self::encode_frame(frame, half, attributes).map_err(|detail| {
+            RenderError::ExrWrite {
+                path: path.to_path_buf(),
+                detail,
+            }
+        })?;
+        formats::write_atomic(path, &bytes)?;
+        Ok(())
+    }
+
     pub fn read(path: &Path) -> std::result::Result<Self, RenderError> {
         let err = |detail: String| RenderError::ExrRead {
             path: path.to_path_buf(),
@@ -323,33 +403,63 @@ impl ZipScratch {
     }
 }
 
+/// A channel's samples as the blocks read them.
+#[derive(Clone, Copy)]
+enum Plane<'a> {
+    Samples(&'a FlatSamples),
+    /// A frame's f32 values, converted to f16 on the way when `.1`.
+    Frame(ChannelView<'a>, bool),
+}
+
+impl Plane<'_> {
+    fn sample_bytes(&self) -> usize {
+        match self {
+            Plane::Samples(FlatSamples::F16(_)) | Plane::Frame(_, true) => 2,
+            Plane::Samples(_) | Plane::Frame(_, false) => 4,
+        }
+    }
+}
+
 /// The little-endian bytes of one scan-line block into `out`: for each line, each channel
 /// of `planes` (the header's order) with that line's samples. `width` is the data
 /// window's.
-fn block_bytes(planes: &[&FlatSamples], width: usize, index: BlockIndex, out: &mut Vec<u8>) {
+fn block_bytes(planes: &[Plane], width: usize, index: BlockIndex, out: &mut Vec<u8>) {
     let (x, y) = (index.pixel_position.x(), index.pixel_position.y());
     let (w, h) = (index.pixel_size.width(), index.pixel_size.height());
-    let per_pixel: usize = planes.iter().map(|p| sample_bytes(p)).sum();
+    let per_pixel: usize = planes.iter().map(Plane::sample_bytes).sum();
     out.resize(w * h * per_pixel, 0);
     let mut at = 0;
     for row in y..y + h {
         let line = row * width + x..row * width + x + w;
         for plane in planes {
-            let dst = &mut out[at..at + w * sample_bytes(plane)];
-            match plane {
-                FlatSamples::F16(v) => put(dst, &v[line.clone()], |s| s.to_le_bytes()),
-                FlatSamples::F32(v) => put(dst, &v[line.clone()], |s| s.to_le_bytes()),
-                FlatSamples::U32(v) => put(dst, &v[line.clone()], |s| s.to_le_bytes()),
+            let dst = &mut out[at..at + w * plane.sample_bytes()];
+            let line = line.clone();
+            let half = |v: f32| f16::from_f32(v).to_le_bytes();
+            match *plane {
+                Plane::Samples(FlatSamples::F16(v)) => put(dst, &v[line], |s| s.to_le_bytes()),
+                Plane::Samples(FlatSamples::F32(v)) => put(dst, &v[line], |s| s.to_le_bytes()),
+                Plane::Samples(FlatSamples::U32(v)) => put(dst, &v[line], |s| s.to_le_bytes()),
+                Plane::Frame(ChannelView::Plane(v), false) => {
+                    put(dst, &v[line], |s| s.to_le_bytes())
+                }
+                Plane::Frame(ChannelView::Plane(v), true) => put(dst, &v[line], half),
+                Plane::Frame(ChannelView::Component(v, c), false) => {
+                    put(dst, &v[line], |p| p[c].to_le_bytes())
+                }
+                Plane::Frame(ChannelView::Component(v, c), true) => {
+                    put(dst, &v[line], |p| half(p[c]))
+                }
+                Plane::Frame(ChannelView::One, false) => fill(dst, 1.0f32.to_le_bytes()),
+                Plane::Frame(ChannelView::One, true) => fill(dst, half(1.0)),
             }
             at += dst.len();
         }
     }
 }
 
-fn sample_bytes(samples: &FlatSamples) -> usize {
-    match samples {
-        FlatSamples::F16(_) => 2,
-        FlatSamples::F32(_) | FlatSamples::U32(_) => 4,
+fn fill<const N: usize>(dst: &mut [u8], bytes: [u8; N]) {
+    for d in dst.chunks_exact_mut(N) {
+        d.copy_from_slice(&bytes);
     }
 }
 
@@ -628,6 +738,7 @@ fn copy_row<T: Copy>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::AovSet;
 
     fn crop(window: Window, attrs: &[(&str, &str)]) -> ExrImage {
         let n = window.pixels() as usize;
@@ -796,7 +907,7 @@ mod tests {
                 .channels
                 .list
                 .iter()
-                .map(|c| image.channel(&c.name.to_string()).unwrap())
+                .map(|c| Plane::Samples(image.channel(&c.name.to_string()).unwrap()))
                 .collect();
             let mut ours = Vec::new();
             let blocks = block_indices(&headers);
@@ -878,6 +989,45 @@ mod tests {
         image.channels[1].1 = FlatSamples::F16(vec![f16::ONE; 3]);
         let err = image.encode().unwrap_err();
         assert!(err.contains("channel A"), "{err}");
+    }
+
+    #[test]
+    fn frames_encode_to_the_bytes_of_their_images() {
+        let window = Window {
+            x0: 7,
+            y0: 3,
+            x1: 50,
+            y1: 40,
+        };
+        for (aovs, half) in [
+            (AovSet::default(), false),
+            (AovSet::all(), false),
+            (AovSet::all(), true),
+        ] {
+            let mut frame = Frame::new(64, 48, window, aovs);
+            let mut state = 0x9e37_79b9u32;
+            let mut value = move || {
+                state ^= state << 13;
+                state ^= state >> 17;
+                state ^= state << 5;
+                // Spread over many binades, with bits that f16 must round.
+                (state % 100_000) as f32 / 997.0 - 3.0
+            };
+            let mut vec3 = || glam::Vec3::new(value(), value(), value());
+            frame.color.iter_mut().for_each(|p| *p = vec3());
+            frame.normal.iter_mut().for_each(|p| *p = vec3());
+            frame.albedo.iter_mut().for_each(|p| *p = vec3());
+            frame.depth.iter_mut().for_each(|d| *d = vec3().x);
+            frame
+                .object
+                .iter_mut()
+                .for_each(|o| *o = vec3().y.abs().floor());
+            // One attribute: the crate writes them in hash order.
+            let attrs = BTreeMap::from([(format!("{ATTR_PREFIX}spp"), "1".to_string())]);
+            let direct = ExrImage::encode_frame(&frame, half, attrs.clone()).unwrap();
+            let planes = ExrImage::from_frame(&frame, half, attrs).encode().unwrap();
+            assert!(direct == planes, "aovs {aovs:?}, half {half}");
+        }
     }
 
     #[test]

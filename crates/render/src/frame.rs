@@ -4,6 +4,27 @@ use crate::integrator::Primary;
 use crate::{Aov, AovSet, Window};
 use glam::Vec3;
 
+/// One channel of a [`Frame`] where it lies: a plane of its own, one component of the
+/// pixels' triples, or 1 everywhere.
+#[derive(Clone, Copy, Debug)]
+pub enum ChannelView<'a> {
+    Plane(&'a [f32]),
+    /// Component 0, 1 or 2.
+    Component(&'a [Vec3], usize),
+    One,
+}
+
+impl ChannelView<'_> {
+    /// The channel's first `n` values (`n` is the frame's pixel count).
+    pub fn to_vec(self, n: usize) -> Vec<f32> {
+        match self {
+            ChannelView::Plane(v) => v.to_vec(),
+            ChannelView::Component(v, c) => v.iter().map(|p| p[c]).collect(),
+            ChannelView::One => vec![1.0; n],
+        }
+    }
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct Frame {
     /// Full image size (the EXR display window).
@@ -69,20 +90,29 @@ impl Frame {
     /// Every channel as a plane, named as in the EXR: R, G, B, A (1: the image is opaque,
     /// background included), then the AOVs' channels.
     pub fn channels(&self) -> Vec<(&'static str, Vec<f32>)> {
-        let plane = |v: &[Vec3], c: usize| v.iter().map(|p| p[c]).collect::<Vec<f32>>();
+        self.channel_views()
+            .into_iter()
+            .map(|(name, view)| (name, view.to_vec(self.color.len())))
+            .collect()
+    }
+
+    /// [`Frame::channels`] as they lie in the frame's buffers, without copying them.
+    pub fn channel_views(&self) -> Vec<(&'static str, ChannelView<'_>)> {
         let mut out = vec![
-            ("R", plane(&self.color, 0)),
-            ("G", plane(&self.color, 1)),
-            ("B", plane(&self.color, 2)),
-            ("A", vec![1.0; self.color.len()]),
+            ("R", ChannelView::Component(&self.color, 0)),
+            ("G", ChannelView::Component(&self.color, 1)),
+            ("B", ChannelView::Component(&self.color, 2)),
+            ("A", ChannelView::One),
         ];
         for aov in self.aovs.list() {
             let names = aov.channels();
             match aov {
-                Aov::Depth => out.push((names[0], self.depth.clone())),
-                Aov::Object => out.push((names[0], self.object.clone())),
-                Aov::Normal => (0..3).for_each(|c| out.push((names[c], plane(&self.normal, c)))),
-                Aov::Albedo => (0..3).for_each(|c| out.push((names[c], plane(&self.albedo, c)))),
+                Aov::Depth => out.push((names[0], ChannelView::Plane(&self.depth))),
+                Aov::Object => out.push((names[0], ChannelView::Plane(&self.object))),
+                Aov::Normal => (0..3)
+                    .for_each(|c| out.push((names[c], ChannelView::Component(&self.normal, c)))),
+                Aov::Albedo => (0..3)
+                    .for_each(|c| out.push((names[c], ChannelView::Component(&self.albedo, c)))),
             }
         }
         out

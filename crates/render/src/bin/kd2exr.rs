@@ -258,9 +258,8 @@ fn run(a: RenderArgs) -> Result<()> {
     // The EXR's compression and the PNG's are independent: one thread each (the EXR also
     // spreads its blocks over whatever threads are free).
     let t_write = Instant::now();
-    let exr = ExrImage::from_frame(&out.frame, a.half, attrs);
     let (exr_written, png_written) = rayon::join(
-        || exr.write(&out_path),
+        || ExrImage::write_frame(&out.frame, a.half, attrs, &out_path),
         || {
             a.preview
                 .as_ref()
