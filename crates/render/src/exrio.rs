@@ -57,11 +57,12 @@ pub struct ExrImage {
 
 impl ExrImage {
     pub fn from_frame(frame: &Frame, half: bool, attributes: BTreeMap<String, String>) -> Self {
-        let mut channels: Vec<(String, FlatSamples)> = frame
-            .channels()
+        let n = frame.window.pixels() as usize;
+        let channels = frame_layout(frame, half)
             .into_iter()
-            .map(|(name, plane)| {
-                let samples = if half && halvable(name) {
+            .map(|(name, view, halved)| {
+                let plane = view.to_vec(n);
+                let samples = if halved {
                     FlatSamples::F16(plane.into_iter().map(f16::from_f32).collect())
                 } else {
                     FlatSamples::F32(plane)
@@ -69,7 +70,6 @@ impl ExrImage {
                 (name.to_string(), samples)
             })
             .collect();
-        channels.sort_by(|a, b| a.0.cmp(&b.0));
         ExrImage {
             width: frame.width,
             height: frame.height,
@@ -144,8 +144,7 @@ impl ExrImage {
             return Self::from_frame(frame, half, attributes).encode();
         }
         let n = frame.window.pixels() as usize;
-        let views = frame.channel_views();
-        for (name, view) in &views {
+        for (name, view) in frame.channel_views() {
             let len = match view {
                 ChannelView::Plane(v) => v.len(),
                 ChannelView::Component(v, _) => v.len(),
@@ -157,29 +156,28 @@ impl ExrImage {
                 ));
             }
         }
-        let halved = |name: &str| half && halvable(name);
+        let layout = frame_layout(frame, half);
         // The header's image: each channel's type, no samples.
-        let mut channels: Vec<(String, FlatSamples)> = views
+        let channels = layout
             .iter()
-            .map(|(name, _)| {
-                let samples = match halved(name) {
+            .map(|&(name, _, halved)| {
+                let samples = match halved {
                     true => FlatSamples::F16(Vec::new()),
                     false => FlatSamples::F32(Vec::new()),
                 };
                 (name.to_string(), samples)
             })
             .collect();
-        channels.sort_by(|a, b| a.0.cmp(&b.0));
-        let layout = ExrImage {
+        let header = ExrImage {
             width: frame.width,
             height: frame.height,
             window: frame.window,
             channels,
             attributes,
         };
-        layout.encode_planes(|name| {
-            let (_, view) = views.iter().find(|(n, _)| *n == name)?;
-            Some(Plane::Frame(*view, halved(name)))
+        header.encode_planes(|name| {
+            let &(_, view, halved) = layout.iter().find(|c| c.0 == name)?;
+            Some(Plane::Frame(view, halved))
         })
     }
 
@@ -295,12 +293,7 @@ impl ExrImage {
 
     /// Write atomically (temp file in the same folder + rename).
     pub fn write(&self, path: &Path) -> std::result::Result<(), RenderError> {
-        let bytes = self.encode().map_err(|detail| RenderError::ExrWrite {
-            path: path.to_path_buf(),
-            detail,
-        })?;
-        formats::write_atomic(path, &bytes)?;
-        Ok(())
+        write_encoded(path, self.encode())
     }
 
     /// [`ExrImage::encode_frame`] written atomically.
@@ -310,14 +303,7 @@ impl ExrImage {
         attributes: BTreeMap<String, String>,
         path: &Path,
     ) -> std::result::Result<(), RenderError> {
-        let bytes = Self::encode_frame(frame, half, attributes).map_err(|detail| {
-            RenderError::ExrWrite {
-                path: path.to_path_buf(),
-                detail,
-            }
-        })?;
-        formats::write_atomic(path, &bytes)?;
-        Ok(())
+        write_encoded(path, Self::encode_frame(frame, half, attributes))
     }
 
     pub fn read(path: &Path) -> std::result::Result<Self, RenderError> {
@@ -379,6 +365,30 @@ impl ExrImage {
             attributes,
         })
     }
+}
+
+/// A frame's channels in the EXR's order (by name), each with whether it is stored as f16.
+fn frame_layout(frame: &Frame, half: bool) -> Vec<(&'static str, ChannelView<'_>, bool)> {
+    let mut layout: Vec<_> = frame
+        .channel_views()
+        .into_iter()
+        .map(|(name, view)| (name, view, half && halvable(name)))
+        .collect();
+    layout.sort_by_key(|c| c.0);
+    layout
+}
+
+/// An encoded image written atomically, or its encoding error named with the path.
+fn write_encoded(
+    path: &Path,
+    encoded: std::result::Result<Vec<u8>, String>,
+) -> std::result::Result<(), RenderError> {
+    let bytes = encoded.map_err(|detail| RenderError::ExrWrite {
+        path: path.to_path_buf(),
+        detail,
+    })?;
+    formats::write_atomic(path, &bytes)?;
+    Ok(())
 }
 
 /// What one thread reuses from block to block: its compressor, and buffers the size of a
@@ -765,6 +775,16 @@ mod tests {
         (w(0), w(2))
     }
 
+    /// Random bits, repeatable from `seed` (xorshift64).
+    fn xorshift(mut state: u64) -> impl FnMut() -> u32 {
+        move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state as u32
+        }
+    }
+
     /// A 50×40 crop at (3, 37) of a 60×90 image: three blocks of 16 lines, the last one
     /// short. `noise` fills every channel with random bits, which deflate cannot shrink.
     fn encodable(noise: bool) -> ExrImage {
@@ -775,13 +795,7 @@ mod tests {
             y1: 77,
         };
         let n = window.pixels() as usize;
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut bits = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state as u32
-        };
+        let mut bits = xorshift(0x9e37_79b9_7f4a_7c15);
         let mut f32s = |f: fn(usize) -> f32| -> Vec<f32> {
             (0..n)
                 .map(|i| if noise { f32::from_bits(bits()) } else { f(i) })
@@ -856,13 +870,7 @@ mod tests {
             y1: 32,
         };
         let n = window.pixels() as usize;
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut bits = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state as u32
-        };
+        let mut bits = xorshift(0x2545_f491_4f6c_dd1d);
         let mut f32s = || (0..n).map(|_| f32::from_bits(bits())).collect::<Vec<_>>();
         let (red, depth) = (f32s(), f32s());
         let alpha = (0..n).map(|_| f16::from_bits(bits() as u16)).collect();
@@ -1005,14 +1013,9 @@ mod tests {
             (AovSet::all(), true),
         ] {
             let mut frame = Frame::new(64, 48, window, aovs);
-            let mut state = 0x9e37_79b9u32;
-            let mut value = move || {
-                state ^= state << 13;
-                state ^= state >> 17;
-                state ^= state << 5;
-                // Spread over many binades, with bits that f16 must round.
-                (state % 100_000) as f32 / 997.0 - 3.0
-            };
+            let mut bits = xorshift(0x9e37_79b9);
+            // Spread over many binades, with bits that f16 must round.
+            let mut value = move || (bits() % 100_000) as f32 / 997.0 - 3.0;
             let mut vec3 = || glam::Vec3::new(value(), value(), value());
             frame.color.iter_mut().for_each(|p| *p = vec3());
             frame.normal.iter_mut().for_each(|p| *p = vec3());

@@ -87,16 +87,8 @@ impl Frame {
         }
     }
 
-    /// Every channel as a plane, named as in the EXR: R, G, B, A (1: the image is opaque,
-    /// background included), then the AOVs' channels.
-    pub fn channels(&self) -> Vec<(&'static str, Vec<f32>)> {
-        self.channel_views()
-            .into_iter()
-            .map(|(name, view)| (name, view.to_vec(self.color.len())))
-            .collect()
-    }
-
-    /// [`Frame::channels`] as they lie in the frame's buffers, without copying them.
+    /// Every channel where it lies in the frame's buffers, named as in the EXR: R, G, B, A
+    /// (1: the image is opaque, background included), then the AOVs' channels.
     pub fn channel_views(&self) -> Vec<(&'static str, ChannelView<'_>)> {
         let mut out = vec![
             ("R", ChannelView::Component(&self.color, 0)),
