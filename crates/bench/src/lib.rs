@@ -9,6 +9,7 @@
 
 pub mod accuracy;
 pub mod agreement;
+pub mod binned_build;
 pub mod config;
 pub mod contenders;
 #[cfg(feature = "embree")]

@@ -1,9 +1,11 @@
 //! Build-parameter experiments:
-//! `cargo run --release -p bench --bin kdtune -- KT KI BONUS MAX_DEPTH LEAF_SIZE FILE…`
+//! `cargo run --release -p bench --bin kdtune -- [--bins B] KT KI BONUS MAX_DEPTH LEAF_SIZE FILE…`
 //! builds each soup or OBJ (or `gen:N`, kdbench's generated scene of N triangles) with
 //! those parameters and prints build time (best of up to 9 builds, all threads), primary,
 //! shadow, random and surface-origin (closest/any hit) Mrays/s (best of 15, 1 thread), the tree's statistics and a
-//! digest of its nodes (equal digests, identical trees). Only ratios within one run mean
+//! digest of its nodes (equal digests, identical trees). With `--bins B` the tree comes from
+//! the approximate builder that prices only B slab boundaries per axis
+//! ([`bench::binned_build`]) instead of the product's exact plane search. Only ratios within one run mean
 //! anything on a noisy machine.
 
 use anyhow::{bail, Context, Result};
@@ -34,9 +36,23 @@ fn best_of<T>(runs: usize, mut f: impl FnMut() -> T) -> (f64, T) {
 }
 
 fn run() -> Result<()> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
+    let mut args: Vec<String> = std::env::args().skip(1).collect();
+    let bins = match args.iter().position(|a| a == "--bins") {
+        Some(i) if i + 1 < args.len() => {
+            let b: usize = args[i + 1]
+                .parse()
+                .with_context(|| format!("--bins {:?} is not a count", args[i + 1]))?;
+            if b < 2 {
+                bail!("--bins {b}: at least 2 slabs");
+            }
+            args.drain(i..i + 2);
+            Some(b)
+        }
+        Some(_) => bail!("--bins needs a count"),
+        None => None,
+    };
     if args.len() < 6 {
-        bail!("usage: kdtune KT KI BONUS MAX_DEPTH LEAF_SIZE FILE…");
+        bail!("usage: kdtune [--bins B] KT KI BONUS MAX_DEPTH LEAF_SIZE FILE…");
     }
     let num = |i: usize| -> Result<f32> {
         args[i]
@@ -65,7 +81,10 @@ fn run() -> Result<()> {
         let tris = &s.triangles;
         let hash = formats::soup::geometry_hash(tris);
         let builds = (3_000_000 / tris.len().max(1)).clamp(1, 9);
-        let (build, kd) = best_of(builds, || kdtree::build(tris, &p, hash));
+        let (build, kd) = best_of(builds, || match bins {
+            Some(b) => bench::binned_build::build_binned(tris, &p, b, hash),
+            None => kdtree::build(tris, &p, hash),
+        });
         let a = Accel::from_triangles(tris, &kd)?;
         let b = scenes::bounds(tris);
         let prim = rays::primary(&s.view.unwrap_or(rays::framing(b)), 512);
