@@ -168,9 +168,11 @@ impl Accel {
         self.tree().closest(ray, |_, _| true, &mut ())
     }
 
-    /// Whether anything blocks the ray in [tmin, tmax]; stops at the first blocker.
+    /// Whether anything blocks the ray in [tmin, tmax]; stops at the first blocker. The
+    /// walk takes the far cells first (a ray leaving a surface meets its blocker sooner
+    /// so); [`Accel::occluded_filtered`] walks front to back.
     pub fn occluded(&self, ray: &Ray) -> bool {
-        self.tree().any(ray, |_, _| true, &mut ())
+        self.tree().any_unfiltered(ray, &mut ())
     }
 
     /// The closest hit that `accept` takes (it is asked about each hit that would be the
@@ -232,7 +234,7 @@ impl Accel {
 
     /// [`Accel::occluded`] that also adds what the traversal did to `counts`.
     pub fn occluded_counted(&self, ray: &Ray, counts: &mut Counts) -> bool {
-        self.tree().any(ray, |_, _| true, counts)
+        self.tree().any_unfiltered(ray, counts)
     }
 
     /// Bytes held for queries: nodes, leaf lists and triangle data.

@@ -288,6 +288,45 @@ fn take_step_branch_free(
     *t1 = if both { near_end(tp, *t1) } else { *t1 };
 }
 
+/// The interior step of an unfiltered any-hit walk: the far child first. Any blocker
+/// answers such a walk, so its order is free, and a ray leaving a surface finds a blocker
+/// sooner from the far end: its near cells hold the surface it leaves, whose triangles
+/// rarely block it (blocked bunny surface rays: 30 steps and 16 triangle tests instead of 45
+/// and 34). Branches rather than selects, as `take_step` does: here the next cell is the
+/// near one whenever the ray ends before the plane, too often for a select's wait on the
+/// plane distance to pay (unblocked rays ran at two thirds of the speed).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn take_step_far_first(
+    s: &Setup,
+    node: KdNode,
+    node_i: &mut u32,
+    t0: &mut f32,
+    t1: f32,
+    stack: &mut Stack,
+    sp: &mut usize,
+) {
+    let a = node.axis();
+    let below = *node_i + 1;
+    let above = node.above_child();
+    let tp = (node.split() - s.o[a]) * s.inv[a];
+    let (near, far) = if s.inv[a] > 0.0 {
+        (below, above)
+    } else {
+        (above, below)
+    };
+    if tp > pad_up(t1) {
+        *node_i = near;
+    } else if tp < pad_down(*t0) {
+        *node_i = far;
+    } else {
+        stack[*sp] = MaybeUninit::new((near, *t0, near_end(tp, t1)));
+        *sp += 1;
+        *node_i = far;
+        *t0 = far_start(tp, *t0);
+    }
+}
+
 /// Asks for the cache line at `p` ahead of its use; a no-op elsewhere than x86_64.
 #[inline(always)]
 fn prefetch<T>(p: *const T) {
@@ -447,9 +486,29 @@ impl Tree<'_> {
     }
 
     /// Whether any triangle that `blocks` (soup index, t, u, v) is hit in [tmin, tmax];
-    /// stops at the first one found, in whatever order the cells give them.
+    /// stops at the first one found, in whatever order the cells give them: front to back,
+    /// the order the packet walks replay lane by lane and in which a filter that multiplies
+    /// up what passes (blended casters) rounds the same every time.
     #[inline(always)]
     pub fn any<F: FnMut(&Hit, bool) -> bool, C: Counter>(
+        &self,
+        ray: &Ray,
+        blocks: F,
+        count: &mut C,
+    ) -> bool {
+        self.any_in::<false, F, C>(ray, blocks, count)
+    }
+
+    /// Whether anything is hit in [tmin, tmax]: [`Tree::any`] with every hit a blocker,
+    /// walking the far child first ([`take_step_far_first`]); the answer cannot depend on
+    /// the order.
+    #[inline(always)]
+    pub fn any_unfiltered<C: Counter>(&self, ray: &Ray, count: &mut C) -> bool {
+        self.any_in::<true, _, C>(ray, |_, _| true, count)
+    }
+
+    #[inline(always)]
+    fn any_in<const FAR_FIRST: bool, F: FnMut(&Hit, bool) -> bool, C: Counter>(
         &self,
         ray: &Ray,
         mut blocks: F,
@@ -459,14 +518,19 @@ impl Tree<'_> {
             return false;
         };
         match s.pre.kz {
-            0 => self.any_along::<0, F, C>(ray, &s, &mut blocks, count),
-            1 => self.any_along::<1, F, C>(ray, &s, &mut blocks, count),
-            _ => self.any_along::<2, F, C>(ray, &s, &mut blocks, count),
+            0 => self.any_along::<0, FAR_FIRST, F, C>(ray, &s, &mut blocks, count),
+            1 => self.any_along::<1, FAR_FIRST, F, C>(ray, &s, &mut blocks, count),
+            _ => self.any_along::<2, FAR_FIRST, F, C>(ray, &s, &mut blocks, count),
         }
     }
 
     #[inline(always)]
-    fn any_along<const KZ: usize, F: FnMut(&Hit, bool) -> bool, C: Counter>(
+    fn any_along<
+        const KZ: usize,
+        const FAR_FIRST: bool,
+        F: FnMut(&Hit, bool) -> bool,
+        C: Counter,
+    >(
         &self,
         ray: &Ray,
         s: &Setup,
@@ -480,16 +544,20 @@ impl Tree<'_> {
             let node = self.node(node_i);
             if !node.is_leaf() {
                 count.node();
-                take_step_branch_free(
-                    self.nodes,
-                    s,
-                    node,
-                    &mut node_i,
-                    t0,
-                    &mut t1,
-                    &mut stack,
-                    &mut sp,
-                );
+                if FAR_FIRST {
+                    take_step_far_first(s, node, &mut node_i, &mut t0, t1, &mut stack, &mut sp);
+                } else {
+                    take_step_branch_free(
+                        self.nodes,
+                        s,
+                        node,
+                        &mut node_i,
+                        t0,
+                        &mut t1,
+                        &mut stack,
+                        &mut sp,
+                    );
+                }
                 continue;
             }
             let leaf = self.leaf(node);
