@@ -169,10 +169,10 @@ impl Accel {
     }
 
     /// Whether anything blocks the ray in [tmin, tmax]; stops at the first blocker. The
-    /// walk takes the far cells first (a ray leaving a surface meets its blocker sooner
-    /// so); [`Accel::occluded_filtered`] walks front to back.
+    /// walk takes each node's far child first: a ray leaving a surface meets a blocker
+    /// sooner from the far end than through the cells of the surface it leaves.
     pub fn occluded(&self, ray: &Ray) -> bool {
-        self.tree().any_unfiltered(ray, &mut ())
+        self.tree().any::<true, _, _>(ray, |_, _| true, &mut ())
     }
 
     /// The closest hit that `accept` takes (it is asked about each hit that would be the
@@ -205,16 +205,18 @@ impl Accel {
     }
 
     /// Whether a hit that `blocks` takes lies in [tmin, tmax]; stops at the first one.
-    /// Hits reach `blocks` in traversal order, not sorted by t, with the side as for
-    /// [`Accel::intersect_filtered`].
+    /// Hits reach `blocks` front to back cell by cell (not sorted by t within a cell), with
+    /// the side as for [`Accel::intersect_filtered`]: filters that gather along the ray (a
+    /// product of transmittances, a closed piece entered) see the surfaces in order, unlike
+    /// [`Accel::occluded`]'s walk.
     pub fn occluded_filtered(&self, ray: &Ray, blocks: impl FnMut(&Hit, bool) -> bool) -> bool {
-        self.tree().any(ray, blocks, &mut ())
+        self.tree().any::<false, _, _>(ray, blocks, &mut ())
     }
 
     /// [`Accel::occluded`] on four rays at once, the same answers bit for bit (rays that do
     /// not travel side by side are traced one by one, as for [`Accel::intersect4`]).
     pub fn occluded4(&self, rays: &[Ray; LANES]) -> [bool; LANES] {
-        self.tree().any4(rays, |_, _, _| true)
+        self.tree().any4::<true, _>(rays, |_, _, _| true)
     }
 
     /// [`Accel::occluded_filtered`] on four rays at once; `blocks` is told the lane too.
@@ -223,7 +225,7 @@ impl Accel {
         rays: &[Ray; LANES],
         blocks: impl FnMut(usize, &Hit, bool) -> bool,
     ) -> [bool; LANES] {
-        self.tree().any4(rays, blocks)
+        self.tree().any4::<false, _>(rays, blocks)
     }
 
     /// [`Accel::intersect`] that also adds what the traversal did to `counts` (benchmarks;
@@ -234,7 +236,7 @@ impl Accel {
 
     /// [`Accel::occluded`] that also adds what the traversal did to `counts`.
     pub fn occluded_counted(&self, ray: &Ray, counts: &mut Counts) -> bool {
-        self.tree().any_unfiltered(ray, counts)
+        self.tree().any::<true, _, _>(ray, |_, _| true, counts)
     }
 
     /// Bytes held for queries: nodes, leaf lists and triangle data.

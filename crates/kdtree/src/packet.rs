@@ -206,12 +206,58 @@ fn step4(
     }
 }
 
+/// [`step4`] for walks that take the far child first (`traverse::take_step_far_first` in
+/// four lanes): the packet goes where any lane goes, the far child first, and the near
+/// child waits with the intervals of the lanes that visit it.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn step4_far_first(
+    p: &Packet,
+    node: KdNode,
+    node_i: &mut u32,
+    mask: &mut u8,
+    t0: &mut Vec4,
+    t1: &mut Vec4,
+    stack: &mut [MaybeUninit<Waiting>; STACK],
+    sp: &mut usize,
+) {
+    let a = node.axis();
+    let (below, above) = (*node_i + 1, node.above_child());
+    let (near_i, far_i) = if p.forward[a] {
+        (below, above)
+    } else {
+        (above, below)
+    };
+    let tp = (Vec4::splat(node.split()) - p.o[a]) * p.inv[a];
+    let only_near = tp.cmpgt(up4(*t1));
+    let only_far = tp.cmplt(down4(*t0)) & !only_near;
+    let both = !(only_near | only_far);
+    let near = (!only_far).bitmask() as u8 & *mask;
+    let far = (!only_near).bitmask() as u8 & *mask;
+    let near_t1 = Vec4::select(both & tp.cmple(*t1), tp, *t1);
+    let far_t0 = Vec4::select(both & tp.cmpge(*t0), tp, *t0);
+    if far == 0 {
+        (*node_i, *mask, *t1) = (near_i, near, near_t1);
+    } else {
+        if near != 0 {
+            stack[*sp] = MaybeUninit::new(Waiting {
+                node: near_i,
+                t0: *t0,
+                t1: near_t1,
+                lanes: near,
+            });
+            *sp += 1;
+        }
+        (*node_i, *mask, *t0) = (far_i, far, far_t0);
+    }
+}
+
 impl Tree<'_> {
     /// Steps from node `node_i` down to the leaf the packet reaches first, pushing the far
     /// children it passes; returns that leaf.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn to_leaf(
+    fn to_leaf<const FAR_FIRST: bool>(
         &self,
         p: &Packet,
         node_i: &mut u32,
@@ -226,7 +272,11 @@ impl Tree<'_> {
             if node.is_leaf() {
                 return self.leaf(node);
             }
-            step4(p, node, node_i, mask, t0, t1, stack, sp);
+            if FAR_FIRST {
+                step4_far_first(p, node, node_i, mask, t0, t1, stack, sp);
+            } else {
+                step4(p, node, node_i, mask, t0, t1, stack, sp);
+            }
         }
     }
 
@@ -268,7 +318,7 @@ impl Tree<'_> {
         let mut sp = 0;
         let (mut node_i, mut mask, mut t0, mut t1) = (0u32, p.live, p.t0, p.t1);
         loop {
-            let leaf = self.to_leaf(
+            let leaf = self.to_leaf::<false>(
                 p,
                 &mut node_i,
                 &mut mask,
@@ -324,10 +374,11 @@ impl Tree<'_> {
         }
     }
 
-    /// Whether each of four rays is blocked: lane `l` is `any(&rays[l], blocks for l)`,
-    /// `blocks` asked with the lane first. A lane leaves the walk at its first blocker.
+    /// Whether each of four rays is blocked: lane `l` is
+    /// `any::<FAR_FIRST>(&rays[l], blocks for l)`, `blocks` asked with the lane first. A
+    /// lane leaves the walk at its first blocker.
     #[inline(always)]
-    pub fn any4<F: FnMut(usize, &Hit, bool) -> bool>(
+    pub fn any4<const FAR_FIRST: bool, F: FnMut(usize, &Hit, bool) -> bool>(
         &self,
         rays: &[Ray; LANES],
         mut blocks: F,
@@ -336,22 +387,22 @@ impl Tree<'_> {
             Walk::Together(p) => p,
             Walk::Alone => {
                 return std::array::from_fn(|l| {
-                    self.any(&rays[l], |h, front| blocks(l, h, front), &mut ())
+                    self.any::<FAR_FIRST, _, _>(&rays[l], |h, front| blocks(l, h, front), &mut ())
                 })
             }
             Walk::Nowhere => return [false; LANES],
         };
         let blocked = match p.pre.rays[0].kz {
-            0 => self.any4_along::<0, F>(rays, &p, &mut blocks),
-            1 => self.any4_along::<1, F>(rays, &p, &mut blocks),
-            _ => self.any4_along::<2, F>(rays, &p, &mut blocks),
+            0 => self.any4_along::<0, FAR_FIRST, F>(rays, &p, &mut blocks),
+            1 => self.any4_along::<1, FAR_FIRST, F>(rays, &p, &mut blocks),
+            _ => self.any4_along::<2, FAR_FIRST, F>(rays, &p, &mut blocks),
         };
         std::array::from_fn(|l| blocked >> l & 1 != 0)
     }
 
     /// The lanes blocked, as a mask.
     #[inline(always)]
-    fn any4_along<const KZ: usize, F: FnMut(usize, &Hit, bool) -> bool>(
+    fn any4_along<const KZ: usize, const FAR_FIRST: bool, F: FnMut(usize, &Hit, bool) -> bool>(
         &self,
         rays: &[Ray; LANES],
         p: &Packet,
@@ -362,7 +413,7 @@ impl Tree<'_> {
         let mut sp = 0;
         let (mut node_i, mut mask, mut t0, mut t1) = (0u32, p.live, p.t0, p.t1);
         loop {
-            let leaf = self.to_leaf(
+            let leaf = self.to_leaf::<FAR_FIRST>(
                 p,
                 &mut node_i,
                 &mut mask,
