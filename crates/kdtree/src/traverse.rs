@@ -1,4 +1,6 @@
-//! Front-to-back k-d tree traversal with a fixed-size stack.
+//! k-d tree traversal with a fixed-size stack: front to back for closest hits and for
+//! filtered any-hit queries, far child first for plain any-hit queries
+//! ([`take_step_far_first`]).
 //!
 //! Robustness rules (docs/ROBUSTNESS.md):
 //! * A direction component that is ±0 (or so small that its reciprocal overflows) makes
