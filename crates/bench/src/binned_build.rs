@@ -10,6 +10,7 @@ use glam::Vec3;
 use kdtree::aabb::Aabb;
 use kdtree::build::clip::clipped_bounds;
 use kdtree::build::sah::AxisCost;
+use kdtree::build::{Costs, Part, Subtree};
 use rayon::prelude::*;
 
 /// Subtrees of at least this many references are built as parallel tasks.
@@ -27,46 +28,9 @@ struct Ref {
 
 struct Ctx<'a> {
     tris: &'a [[Vec3; 3]],
-    kt: f64,
-    ki: f64,
-    bonus: f64,
-    leaf_size: usize,
+    costs: Costs,
     max_depth: u32,
     bins: usize,
-}
-
-/// A subtree: flat below `JOIN_MIN`, linked above it (children built as separate tasks).
-enum Part {
-    Flat(Vec<KdNode>, Vec<u32>),
-    Node(u32, f32, Box<[Part; 2]>),
-}
-
-impl Part {
-    /// Depth-first, below before above, into one pair of arrays.
-    fn flatten_into(self, nodes: &mut Vec<KdNode>, leaf_tris: &mut Vec<u32>) {
-        match self {
-            Part::Flat(n, t) => {
-                let (nb, tb) = (nodes.len() as u32, leaf_tris.len() as u32);
-                nodes.extend(n.into_iter().map(|n| {
-                    if n.is_leaf() {
-                        KdNode::leaf(n.count(), n.offset() + tb)
-                    } else {
-                        KdNode::interior(n.axis() as u32, n.split(), n.above_child() + nb)
-                    }
-                }));
-                leaf_tris.extend(t);
-            }
-            Part::Node(axis, pos, children) => {
-                let at = nodes.len();
-                nodes.push(KdNode::leaf(0, 0));
-                let [below, above] = *children;
-                below.flatten_into(nodes, leaf_tris);
-                let above_at = nodes.len() as u32;
-                above.flatten_into(nodes, leaf_tris);
-                nodes[at] = KdNode::interior(axis, pos, above_at);
-            }
-        }
-    }
 }
 
 /// Build with `bins` slabs per axis (at least 2) and the product's other parameters.
@@ -92,47 +56,23 @@ pub fn build_binned(
         .reduce(|| Aabb::EMPTY, |a, b| a.union(&b));
     let ctx = Ctx {
         tris: triangles,
-        kt: params.traversal_cost.max(0.0) as f64,
-        ki: (params.intersect_cost as f64).max(1e-6),
-        bonus: (params.empty_bonus as f64).clamp(0.0, 1.0),
-        leaf_size: params.leaf_size.max(1) as usize,
+        costs: Costs::of(params),
         max_depth: kdtree::depth_bound(params, refs.len()),
         bins: bins.max(2),
     };
-    let (mut nodes, mut leaf_tris) = (Vec::new(), Vec::new());
-    if refs.is_empty() {
-        nodes.push(KdNode::leaf(0, 0));
-    } else {
-        build_part(&ctx, refs, cell, 0).flatten_into(&mut nodes, &mut leaf_tris);
-    }
-    let mut kd = KdFile {
-        geometry_hash,
-        params: *params,
-        stats: Default::default(),
-        bounds: if cell.is_empty() {
-            [Vec3::ZERO; 2]
-        } else {
-            cell.to_vec3()
-        },
-        nodes,
-        leaf_tris,
-    };
-    kd.stats = kdtree::build::stats::measure(&kd, triangles.len() as u64, params);
-    kd.stats.build_seconds = start.elapsed().as_secs_f64();
-    kd
+    // No references: one empty leaf, as `find_split` refuses to split them.
+    let tree = build_part(&ctx, refs, cell, 0).flatten();
+    kdtree::build::finish(triangles.len(), params, geometry_hash, cell, tree, start)
 }
 
 fn build_part(ctx: &Ctx, refs: Vec<Ref>, cell: Aabb, depth: u32) -> Part {
     if refs.len() < JOIN_MIN {
-        let (mut nodes, mut leaf_tris) = (Vec::new(), Vec::new());
-        build_rec(ctx, refs, cell, depth, &mut nodes, &mut leaf_tris);
-        return Part::Flat(nodes, leaf_tris);
+        let mut out = Subtree::default();
+        build_rec(ctx, refs, cell, depth, &mut out);
+        return Part::Flat(out);
     }
     match find_split(ctx, &refs, &cell, depth) {
-        None => Part::Flat(
-            vec![KdNode::leaf(refs.len() as u32, 0)],
-            refs.iter().map(|r| r.tri).collect(),
-        ),
+        None => Part::leaf(refs.iter().map(|r| r.tri).collect()),
         Some((axis, pos)) => {
             let ([rb, ra], [cb, ca]) = split(ctx, &refs, &cell, axis, pos);
             drop(refs);
@@ -140,32 +80,30 @@ fn build_part(ctx: &Ctx, refs: Vec<Ref>, cell: Aabb, depth: u32) -> Part {
                 || build_part(ctx, rb, cb, depth + 1),
                 || build_part(ctx, ra, ca, depth + 1),
             );
-            Part::Node(axis as u32, pos, Box::new([b, a]))
+            Part::Node {
+                axis: axis as u32,
+                pos,
+                children: Box::new([b, a]),
+            }
         }
     }
 }
 
-fn build_rec(
-    ctx: &Ctx,
-    refs: Vec<Ref>,
-    cell: Aabb,
-    depth: u32,
-    nodes: &mut Vec<KdNode>,
-    leaf_tris: &mut Vec<u32>,
-) {
+fn build_rec(ctx: &Ctx, refs: Vec<Ref>, cell: Aabb, depth: u32, out: &mut Subtree) {
     let Some((axis, pos)) = find_split(ctx, &refs, &cell, depth) else {
-        nodes.push(KdNode::leaf(refs.len() as u32, leaf_tris.len() as u32));
-        leaf_tris.extend(refs.iter().map(|r| r.tri));
+        out.nodes
+            .push(KdNode::leaf(refs.len() as u32, out.leaf_tris.len() as u32));
+        out.leaf_tris.extend(refs.iter().map(|r| r.tri));
         return;
     };
     let ([rb, ra], [cb, ca]) = split(ctx, &refs, &cell, axis, pos);
     drop(refs);
-    let at = nodes.len();
-    nodes.push(KdNode::leaf(0, 0)); // placeholder until `above` has an index
-    build_rec(ctx, rb, cb, depth + 1, nodes, leaf_tris);
-    let above_at = nodes.len() as u32;
-    build_rec(ctx, ra, ca, depth + 1, nodes, leaf_tris);
-    nodes[at] = KdNode::interior(axis as u32, pos, above_at);
+    let at = out.nodes.len();
+    out.nodes.push(KdNode::leaf(0, 0)); // placeholder until `above` has an index
+    build_rec(ctx, rb, cb, depth + 1, out);
+    let above_at = out.nodes.len() as u32;
+    build_rec(ctx, ra, ca, depth + 1, out);
+    out.nodes[at] = KdNode::interior(axis as u32, pos, above_at);
 }
 
 /// Per axis and slab: how many boxes start there, then how many end there.
@@ -200,14 +138,14 @@ fn histogram(ctx: &Ctx, refs: &[Ref], cell: &Aabb) -> Vec<u32> {
 fn find_split(ctx: &Ctx, refs: &[Ref], cell: &Aabb, depth: u32) -> Option<(usize, f32)> {
     let n = refs.len();
     let area = cell.area();
-    if n <= ctx.leaf_size || depth >= ctx.max_depth || !(area > 0.0 && area.is_finite()) {
+    if n <= ctx.costs.leaf_size || depth >= ctx.max_depth || !(area > 0.0 && area.is_finite()) {
         return None;
     }
     let h = histogram(ctx, refs, cell);
     let b = ctx.bins;
     let mut best: Option<(f64, usize, f32)> = None;
     for a in 0..3 {
-        let Some(ax) = AxisCost::new(cell, a, ctx.bonus, n) else {
+        let Some(ax) = AxisCost::new(cell, a, ctx.costs.bonus, n) else {
             continue;
         };
         let width = (cell.hi[a] - cell.lo[a]) / b as f32;
@@ -227,7 +165,8 @@ fn find_split(ctx: &Ctx, refs: &[Ref], cell: &Aabb, depth: u32) -> Option<(usize
         }
     }
     let (rank, axis, pos) = best?;
-    (AxisCost::cost(rank, ctx.kt, ctx.ki, area) < ctx.ki * n as f64).then_some((axis, pos))
+    (AxisCost::cost(rank, ctx.costs.kt, ctx.costs.ki, area) < ctx.costs.ki * n as f64)
+        .then_some((axis, pos))
 }
 
 /// The two children's references and cells. A box on one side of the plane (or touching

@@ -161,11 +161,12 @@ impl Packet {
 
 /// `traverse::take_step` in four lanes at once, the same operations on each lane's
 /// numbers: only the first child, only the second, or both, split at the plane. The packet
-/// goes where any of the lanes in `mask` goes, and a far child visited by some waits on
-/// the stack with their intervals.
+/// goes where any of the lanes in `mask` goes, and a child visited by some waits on the
+/// stack with their intervals: the far one front to back, the near one with `FAR_FIRST`
+/// (`traverse::take_step_far_first` in four lanes).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn step4(
+fn step4<const FAR_FIRST: bool>(
     p: &Packet,
     node: KdNode,
     node_i: &mut u32,
@@ -191,66 +192,42 @@ fn step4(
     // `near_end` and `far_start`: a NaN plane distance keeps the whole interval.
     let near_t1 = Vec4::select(both & tp.cmple(*t1), tp, *t1);
     let far_t0 = Vec4::select(both & tp.cmpge(*t0), tp, *t0);
-    if near == 0 {
+    if FAR_FIRST {
+        if far == 0 {
+            (*node_i, *mask, *t1) = (first, near, near_t1);
+        } else {
+            if near != 0 {
+                push(stack, sp, first, near, *t0, near_t1);
+            }
+            (*node_i, *mask, *t0) = (second, far, far_t0);
+        }
+    } else if near == 0 {
         (*node_i, *mask, *t0) = (second, far, far_t0);
     } else {
         if far != 0 {
-            stack[*sp] = MaybeUninit::new(Waiting {
-                node: second,
-                t0: far_t0,
-                t1: *t1,
-                lanes: far,
-            });
-            *sp += 1;
+            push(stack, sp, second, far, far_t0, *t1);
         }
         (*node_i, *mask, *t1) = (first, near, near_t1);
     }
 }
 
-/// [`step4`] for walks that take the far child first (`traverse::take_step_far_first` in
-/// four lanes): the packet goes where any lane goes, the far child first, and the near
-/// child waits with the intervals of the lanes that visit it.
-#[allow(clippy::too_many_arguments)]
+/// A child waiting for `lanes`, over their intervals `t0`–`t1`, on top of the stack.
 #[inline(always)]
-fn step4_far_first(
-    p: &Packet,
-    node: KdNode,
-    node_i: &mut u32,
-    mask: &mut u8,
-    t0: &mut Vec4,
-    t1: &mut Vec4,
+fn push(
     stack: &mut [MaybeUninit<Waiting>; STACK],
     sp: &mut usize,
+    node: u32,
+    lanes: u8,
+    t0: Vec4,
+    t1: Vec4,
 ) {
-    let a = node.axis();
-    let (below, above) = (*node_i + 1, node.above_child());
-    let (near_i, far_i) = if p.forward[a] {
-        (below, above)
-    } else {
-        (above, below)
-    };
-    let tp = (Vec4::splat(node.split()) - p.o[a]) * p.inv[a];
-    let only_near = tp.cmpgt(up4(*t1));
-    let only_far = tp.cmplt(down4(*t0)) & !only_near;
-    let both = !(only_near | only_far);
-    let near = (!only_far).bitmask() as u8 & *mask;
-    let far = (!only_near).bitmask() as u8 & *mask;
-    let near_t1 = Vec4::select(both & tp.cmple(*t1), tp, *t1);
-    let far_t0 = Vec4::select(both & tp.cmpge(*t0), tp, *t0);
-    if far == 0 {
-        (*node_i, *mask, *t1) = (near_i, near, near_t1);
-    } else {
-        if near != 0 {
-            stack[*sp] = MaybeUninit::new(Waiting {
-                node: near_i,
-                t0: *t0,
-                t1: near_t1,
-                lanes: near,
-            });
-            *sp += 1;
-        }
-        (*node_i, *mask, *t0) = (far_i, far, far_t0);
-    }
+    stack[*sp] = MaybeUninit::new(Waiting {
+        t0,
+        t1,
+        node,
+        lanes,
+    });
+    *sp += 1;
 }
 
 impl Tree<'_> {
@@ -273,11 +250,7 @@ impl Tree<'_> {
             if node.is_leaf() {
                 return self.leaf(node);
             }
-            if FAR_FIRST {
-                step4_far_first(p, node, node_i, mask, t0, t1, stack, sp);
-            } else {
-                step4(p, node, node_i, mask, t0, t1, stack, sp);
-            }
+            step4::<FAR_FIRST>(p, node, node_i, mask, t0, t1, stack, sp);
         }
     }
 

@@ -308,24 +308,19 @@ fn take_step_far_first(
     stack: &mut Stack,
     sp: &mut usize,
 ) {
-    let a = node.axis();
-    let below = *node_i + 1;
-    let above = node.above_child();
-    let tp = (node.split() - s.o[a]) * s.inv[a];
-    let (near, far) = if s.inv[a] > 0.0 {
-        (below, above)
-    } else {
-        (above, below)
-    };
-    if tp > pad_up(t1) {
-        *node_i = near;
-    } else if tp < pad_down(*t0) {
-        *node_i = far;
-    } else {
-        stack[*sp] = MaybeUninit::new((near, *t0, near_end(tp, t1)));
-        *sp += 1;
-        *node_i = far;
-        *t0 = far_start(tp, *t0);
+    // `step` names the children in front-to-back order: `first` is the near one.
+    match step(s, *node_i, node, *t0, t1) {
+        Step::One(c) => *node_i = c,
+        Step::Two {
+            first,
+            second,
+            t_split,
+        } => {
+            stack[*sp] = MaybeUninit::new((first, *t0, near_end(t_split, t1)));
+            *sp += 1;
+            *node_i = second;
+            *t0 = far_start(t_split, *t0);
+        }
     }
 }
 

@@ -20,24 +20,17 @@ pub fn build_median(
         .iter()
         .fold(Aabb::EMPTY, |a, &i| a.union(&boxes[i as usize]));
     let max_depth = super::depth_bound(params, ids.len());
-    let mut nodes = Vec::new();
-    let mut leaf_tris = Vec::new();
-    rec(&boxes, ids, cell, 0, max_depth, &mut nodes, &mut leaf_tris);
-    let mut kd = KdFile {
-        geometry_hash,
-        params: *params,
-        stats: Default::default(),
-        bounds: if cell.is_empty() {
-            [Vec3::ZERO; 2]
-        } else {
-            cell.to_vec3()
-        },
-        nodes,
-        leaf_tris,
-    };
-    kd.stats = super::stats::measure(&kd, triangles.len() as u64, params);
-    kd.stats.build_seconds = start.elapsed().as_secs_f64();
-    kd
+    let mut tree = super::Subtree::default();
+    rec(
+        &boxes,
+        ids,
+        cell,
+        0,
+        max_depth,
+        &mut tree.nodes,
+        &mut tree.leaf_tris,
+    );
+    super::finish(triangles.len(), params, geometry_hash, cell, tree, start)
 }
 
 fn rec(

@@ -57,6 +57,57 @@ pub fn depth_bound(params: &BuildParams, n: usize) -> u32 {
     d.min(MAX_DEPTH_LIMIT)
 }
 
+/// The SAH's constants as every builder and [`stats::measure`] price with them: the
+/// parameters clamped to where the cost model means something.
+#[derive(Clone, Copy, Debug)]
+pub struct Costs {
+    /// Cost of a traversal step.
+    pub kt: f64,
+    /// Cost of a triangle test.
+    pub ki: f64,
+    /// Share of a split's cost waived when one side is empty.
+    pub bonus: f64,
+    pub leaf_size: usize,
+}
+
+impl Costs {
+    pub fn of(params: &BuildParams) -> Costs {
+        Costs {
+            kt: params.traversal_cost.max(0.0) as f64,
+            ki: (params.intersect_cost as f64).max(1e-6),
+            bonus: (params.empty_bonus as f64).clamp(0.0, 1.0),
+            leaf_size: params.leaf_size.max(1) as usize,
+        }
+    }
+}
+
+/// A tree file around a builder's finished arrays: its bounds (`cell`, the finite
+/// triangles' box), the statistics measured by walking it, and the time since `start`.
+pub fn finish(
+    triangles: usize,
+    params: &BuildParams,
+    geometry_hash: formats::Digest,
+    cell: Aabb,
+    tree: Subtree,
+    start: std::time::Instant,
+) -> KdFile {
+    let mut kd = KdFile {
+        geometry_hash,
+        params: *params,
+        stats: Default::default(),
+        bounds: if cell.is_empty() {
+            [Vec3::ZERO; 2]
+        } else {
+            cell.to_vec3()
+        },
+        nodes: tree.nodes,
+        leaf_tris: tree.leaf_tris,
+    };
+    kd.stats = stats::measure(&kd, triangles as u64, params);
+    kd.stats.build_seconds = start.elapsed().as_secs_f64();
+    kd
+}
+
 struct Ctx<'a> {
     tris: &'a [[Vec3; 3]],
     kt: f64,
@@ -86,9 +137,9 @@ struct Split {
 
 /// A flattened subtree: node indices and leaf offsets relative to its own arrays.
 #[derive(Default)]
-struct Subtree {
-    nodes: Vec<KdNode>,
-    leaf_tris: Vec<u32>,
+pub struct Subtree {
+    pub nodes: Vec<KdNode>,
+    pub leaf_tris: Vec<u32>,
 }
 
 impl Subtree {
@@ -109,7 +160,7 @@ impl Subtree {
 
 /// A subtree as the parallel tasks return it: serial parts already flat, the nodes above
 /// them (whose children were built as separate tasks) still linked.
-enum Part {
+pub enum Part {
     Flat(Subtree),
     Node {
         axis: u32,
@@ -119,7 +170,7 @@ enum Part {
 }
 
 impl Part {
-    fn leaf(tris: Vec<u32>) -> Part {
+    pub fn leaf(tris: Vec<u32>) -> Part {
         Part::Flat(Subtree {
             nodes: vec![KdNode::leaf(tris.len() as u32, 0)],
             leaf_tris: tris,
@@ -157,7 +208,7 @@ impl Part {
     }
 
     /// One copy of every node and leaf list, into arrays of their final size.
-    fn flatten(self) -> Subtree {
+    pub fn flatten(self) -> Subtree {
         let (nodes, leaf_tris) = self.sizes();
         let mut out = Subtree {
             nodes: Vec::with_capacity(nodes),
@@ -188,12 +239,18 @@ fn build_with(
 ) -> KdFile {
     let start = std::time::Instant::now();
     let n = triangles.len();
+    let Costs {
+        kt,
+        ki,
+        bonus,
+        leaf_size,
+    } = Costs::of(params);
     let ctx = Ctx {
         tris: triangles,
-        kt: params.traversal_cost.max(0.0) as f64,
-        ki: (params.intersect_cost as f64).max(1e-6),
-        bonus: (params.empty_bonus as f64).clamp(0.0, 1.0),
-        leaf_size: params.leaf_size.max(1) as usize,
+        kt,
+        ki,
+        bonus,
+        leaf_size,
         max_depth: depth_bound(params, n),
         event_max,
     };
@@ -232,22 +289,7 @@ fn build_with(
     } else {
         build_refs(&ctx, refs, cell, 0).flatten()
     };
-    let bounds = if cell.is_empty() {
-        [Vec3::ZERO; 2]
-    } else {
-        cell.to_vec3()
-    };
-    let mut kd = KdFile {
-        geometry_hash,
-        params: *params,
-        stats: Default::default(),
-        bounds,
-        nodes: tree.nodes,
-        leaf_tris: tree.leaf_tris,
-    };
-    kd.stats = stats::measure(&kd, n as u64, params);
-    kd.stats.build_seconds = start.elapsed().as_secs_f64();
-    kd
+    finish(n, params, geometry_hash, cell, tree, start)
 }
 
 fn build_refs(ctx: &Ctx, refs: Vec<Ref>, cell: Aabb, depth: u32) -> Part {

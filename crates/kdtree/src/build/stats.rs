@@ -16,8 +16,7 @@ pub fn measure(kd: &KdFile, triangles: u64, params: &BuildParams) -> TreeStats {
         hi: kd.bounds[1].to_array(),
     };
     let root_area = root.area();
-    let kt = params.traversal_cost.max(0.0) as f64;
-    let ki = (params.intersect_cost as f64).max(1e-6);
+    let super::Costs { kt, ki, .. } = super::Costs::of(params);
     let mut cost = 0.0;
     let mut stack = vec![(0usize, root, 0u32)];
     while let Some((i, cell, depth)) = stack.pop() {
