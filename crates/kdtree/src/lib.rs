@@ -205,11 +205,22 @@ impl Accel {
     }
 
     /// Whether a hit that `blocks` takes lies in [tmin, tmax]; stops at the first one.
-    /// Hits reach `blocks` front to back cell by cell (not sorted by t within a cell), with
-    /// the side as for [`Accel::intersect_filtered`]: filters that gather along the ray (a
-    /// product of transmittances, a closed piece entered) see the surfaces in order, unlike
-    /// [`Accel::occluded`]'s walk.
+    /// `blocks` is asked about hits in no set order (the walk takes the far child first, as
+    /// [`Accel::occluded`]'s does), with the side as for [`Accel::intersect_filtered`], so
+    /// it must judge each hit on its own: a face that casts from that side, a texel that
+    /// is solid.
     pub fn occluded_filtered(&self, ray: &Ray, blocks: impl FnMut(&Hit, bool) -> bool) -> bool {
+        self.tree().any::<true, _, _>(ray, blocks, &mut ())
+    }
+
+    /// [`Accel::occluded_filtered`] with the hits reaching `blocks` front to back, cell by
+    /// cell (not sorted by t within a cell): for filters that gather along the ray, such as
+    /// a product of transmittances that should round in the order the layers lie.
+    pub fn occluded_filtered_in_order(
+        &self,
+        ray: &Ray,
+        blocks: impl FnMut(&Hit, bool) -> bool,
+    ) -> bool {
         self.tree().any::<false, _, _>(ray, blocks, &mut ())
     }
 
@@ -221,6 +232,16 @@ impl Accel {
 
     /// [`Accel::occluded_filtered`] on four rays at once; `blocks` is told the lane too.
     pub fn occluded4_filtered(
+        &self,
+        rays: &[Ray; LANES],
+        blocks: impl FnMut(usize, &Hit, bool) -> bool,
+    ) -> [bool; LANES] {
+        self.tree().any4::<true, _>(rays, blocks)
+    }
+
+    /// [`Accel::occluded_filtered_in_order`] on four rays at once; `blocks` is told the
+    /// lane too, and each lane's hits reach it in that lane's front-to-back order.
+    pub fn occluded4_filtered_in_order(
         &self,
         rays: &[Ray; LANES],
         blocks: impl FnMut(usize, &Hit, bool) -> bool,

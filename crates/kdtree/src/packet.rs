@@ -11,7 +11,7 @@
 //! best hit after the previous triangle rather than after the previous group of four, which
 //! refuses earlier only hits that the exact comparison would refuse anyway. At a node a
 //! lane goes to the first child, the second or both by the single walk's rule (front to
-//! back, or far child first for plain any-hit queries, as the single walk), with the
+//! back, or far child first for any-hit queries that allow it, as the single walk), with the
 //! single walk's intervals; the packet goes where any of its lanes goes and carries a mask
 //! of the lanes that go there. A closest-hit lane skips a waiting cell that starts beyond
 //! its best hit, an any-hit lane leaves the walk at its first blocker, as in the single

@@ -1,6 +1,6 @@
 //! k-d tree traversal with a fixed-size stack: front to back for closest hits and for
-//! filtered any-hit queries, far child first for plain any-hit queries
-//! ([`take_step_far_first`]).
+//! any-hit queries whose filter gathers along the ray, far child first for the other
+//! any-hit queries ([`take_step_far_first`]).
 //!
 //! Robustness rules (docs/ROBUSTNESS.md):
 //! * A direction component that is ±0 (or so small that its reciprocal overflows) makes
@@ -486,7 +486,7 @@ impl Tree<'_> {
     /// stops at the first one found. `FAR_FIRST` walks the far child of each node first
     /// ([`take_step_far_first`]), for queries whose answer cannot depend on the order;
     /// otherwise the walk goes front to back, the order filters that gather along the ray
-    /// (a product of transmittances, a closed piece entered) rely on.
+    /// (a product of transmittances) rely on.
     #[inline(always)]
     pub fn any<const FAR_FIRST: bool, F: FnMut(&Hit, bool) -> bool, C: Counter>(
         &self,

@@ -17,12 +17,6 @@ pub struct RayCounts {
     /// Hits that shadow rays passed through: surfaces that cast no shadow that way and
     /// cut-out holes.
     pub shadow_pass_through: u64,
-    /// Shadow rays taken as blocked where they passed into a closed piece of an object:
-    /// the face they would leave it by casts (see `render::solid`). With this and
-    /// `shadow_pass_through`, how the work splits varies a little from run to run (an
-    /// object's pieces are found once enough rays, from any thread, have entered it); the
-    /// pixels do not.
-    pub shadow_solid: u64,
     /// Camera and reflection rays continued past a blended (Transparent/Fade) surface for
     /// the light behind it: each a query from the hit onwards.
     pub blend_continuation: u64,
@@ -49,7 +43,6 @@ impl RayCounts {
         self.reflection += o.reflection;
         self.pass_through += o.pass_through;
         self.shadow_pass_through += o.shadow_pass_through;
-        self.shadow_solid += o.shadow_solid;
         self.blend_continuation += o.blend_continuation;
         self.shadow_blend += o.shadow_blend;
         self.shadow_reuse += o.shadow_reuse;
@@ -71,7 +64,6 @@ pub struct SharedCounts {
     reflection: AtomicU64,
     pass_through: AtomicU64,
     shadow_pass_through: AtomicU64,
-    shadow_solid: AtomicU64,
     blend_continuation: AtomicU64,
     shadow_blend: AtomicU64,
     shadow_reuse: AtomicU64,
@@ -89,7 +81,6 @@ impl SharedCounts {
         self.pass_through.fetch_add(c.pass_through, Relaxed);
         self.shadow_pass_through
             .fetch_add(c.shadow_pass_through, Relaxed);
-        self.shadow_solid.fetch_add(c.shadow_solid, Relaxed);
         self.blend_continuation
             .fetch_add(c.blend_continuation, Relaxed);
         self.shadow_blend.fetch_add(c.shadow_blend, Relaxed);
@@ -106,7 +97,6 @@ impl SharedCounts {
             reflection: self.reflection.load(Relaxed),
             pass_through: self.pass_through.load(Relaxed),
             shadow_pass_through: self.shadow_pass_through.load(Relaxed),
-            shadow_solid: self.shadow_solid.load(Relaxed),
             blend_continuation: self.blend_continuation.load(Relaxed),
             shadow_blend: self.shadow_blend.load(Relaxed),
             shadow_reuse: self.shadow_reuse.load(Relaxed),

@@ -33,7 +33,6 @@ use crate::offset::{
 use crate::plan::{colour_mapped, Plan, ShadowMode};
 use crate::sampling::{disc_sample, Rng};
 use crate::soft::SoftCone;
-use crate::solid::Solids;
 use crate::texture::{cone_footprint, Sampler};
 use crate::TextureFilter;
 use formats::{CastShadows, Hit, Light, Soup, Tiling};
@@ -211,8 +210,11 @@ pub struct Integrator<'a> {
     samplers: Vec<Sampler>,
     /// One per material (empty when textures and alpha are off).
     surfacing: Vec<Surfacing>,
-    /// Closed pieces of objects, asked about by opaque shadow rays passing into them.
-    solids: Solids<'a>,
+    /// Some material is blended: shadow rays through cut-out and blended casters meet
+    /// them front to back, so that the light left, a product, rounds in the order the
+    /// layers lie. Without blending every hit is judged on its own and the walk takes the
+    /// far child first, which finds a blocker sooner.
+    blend: bool,
     /// Per triangle, the sides it is drawn and casts from ([`DRAWN_FRONT`] …): what the
     /// traversals' filters ask, one byte instead of the object's and the material's records
     /// (empty when no face is culled and every object casts).
@@ -309,6 +311,7 @@ impl<'a> Integrator<'a> {
             (Vec::new(), Vec::new())
         };
         let shadow_filter = plan.shadow_casting.enabled || alpha;
+        let blend = surfacing.iter().any(|s| s.alpha == AlphaUse::Blend);
         Integrator {
             soup,
             accel,
@@ -328,11 +331,7 @@ impl<'a> Integrator<'a> {
             filter,
             samplers,
             surfacing,
-            solids: if shadow_filter && !alpha {
-                Solids::new(soup)
-            } else {
-                Solids::none(soup)
-            },
+            blend,
             sides: if plan.culling.enabled || shadow_filter {
                 sides(soup)
             } else {
@@ -1086,7 +1085,7 @@ impl<'a> Integrator<'a> {
         if !self.alpha {
             let blocked = self
                 .accel
-                .occluded_filtered(&ray, |hit, front| self.blocks(&ray, hit, front, counts));
+                .occluded_filtered(&ray, |hit, front| self.blocks(hit, front, counts));
             return if blocked { 0.0 } else { 1.0 };
         }
         self.transmittance_alpha(&ray, counts)
@@ -1134,7 +1133,7 @@ impl<'a> Integrator<'a> {
         }
         let mut casters = [None; LANES];
         let blocked = self.accel.occluded4_filtered(&rays, |l, hit, front| {
-            let stops = !self.shadow_filter || self.blocks(&rays[l], hit, front, counts);
+            let stops = !self.shadow_filter || self.blocks(hit, front, counts);
             if stops && self.opaque_caster(hit.prim, front) {
                 casters[l] = Some(hit.prim);
             }
@@ -1166,18 +1165,13 @@ impl<'a> Integrator<'a> {
             .is_some_and(|h| self.opaque_caster(prim, h.front))
     }
 
-    /// Whether a hit stops an opaque scene's shadow ray: a face that casts, or the face a
-    /// closed piece is left by (see `solid`); the faces it passes are counted.
+    /// Whether a hit stops an opaque scene's shadow ray: a face that casts from the side
+    /// met. The faces it passes are counted.
     #[inline(always)]
-    fn blocks(&self, ray: &Ray, hit: &Hit, front: bool, counts: &mut RayCounts) -> bool {
-        let prim = hit.prim as usize;
-        if self.casts(prim, front) {
-            return true;
-        }
-        counts.shadow_pass_through += 1;
-        let solid = self.solids.blocks(prim, ray);
-        counts.shadow_solid += solid as u64;
-        solid
+    fn blocks(&self, hit: &Hit, front: bool, counts: &mut RayCounts) -> bool {
+        let casts = self.casts(hit.prim as usize, front);
+        counts.shadow_pass_through += !casts as u64;
+        casts
     }
 
     /// [`Integrator::transmittance`] through cut-out holes and blended casters, out of
@@ -1186,9 +1180,12 @@ impl<'a> Integrator<'a> {
     fn transmittance_alpha(&self, ray: &Ray, counts: &mut RayCounts) -> f32 {
         let mut share = 1.0f32;
         let mut seen = Seen::new();
-        let blocked = self.accel.occluded_filtered(ray, |hit, front| {
-            self.stops(ray, hit, front, &mut share, &mut seen, counts)
-        });
+        let stops = |hit: &Hit, front| self.stops(ray, hit, front, &mut share, &mut seen, counts);
+        let blocked = if self.blend {
+            self.accel.occluded_filtered_in_order(ray, stops)
+        } else {
+            self.accel.occluded_filtered(ray, stops)
+        };
         if blocked {
             0.0
         } else {
@@ -1208,13 +1205,18 @@ impl<'a> Integrator<'a> {
         let mut share = [1.0f32; LANES];
         let mut seen: [Seen; LANES] = std::array::from_fn(|_| Seen::new());
         let mut casters = [None; LANES];
-        let blocked = self.accel.occluded4_filtered(rays, |l, hit, front| {
+        let stops = |l: usize, hit: &Hit, front| {
             let stops = self.stops(&rays[l], hit, front, &mut share[l], &mut seen[l], counts);
             if stops && self.opaque_caster(hit.prim, front) {
                 casters[l] = Some(hit.prim);
             }
             stops
-        });
+        };
+        let blocked = if self.blend {
+            self.accel.occluded4_filtered_in_order(rays, stops)
+        } else {
+            self.accel.occluded4_filtered(rays, stops)
+        };
         keep_last(blocker, casters);
         std::array::from_fn(|l| if blocked[l] { 0.0 } else { share[l] })
     }
@@ -1364,7 +1366,6 @@ pub(crate) fn shadow_ray(origin: Vec3, p: Vec3, dir: Vec3, dist: f32) -> Ray {
 mod tests {
     use super::*;
     use crate::soft::tests::sample;
-    use crate::solid::tests::box_faces;
     use crate::RenderOptions;
     use formats::{Alpha, Cull, LightKind, Material, Object, Shadows};
 
@@ -1399,8 +1400,23 @@ mod tests {
         }
     }
 
+    /// The six faces of the box from `lo` spanning `d`, as (corner, u, v) quads whose
+    /// fronts (u × v) face outwards.
+    fn box_faces(lo: Vec3, d: Vec3) -> [(Vec3, Vec3, Vec3); 6] {
+        let (x, y, z) = (Vec3::X * d.x, Vec3::Y * d.y, Vec3::Z * d.z);
+        [
+            (lo, x, z),
+            (lo + y, z, x),
+            (lo, y, x),
+            (lo + z, x, y),
+            (lo, z, y),
+            (lo + x, y, z),
+        ]
+    }
+
     /// A floor under a one-sided occluder, a closed one-sided box and, with `blend`, a
-    /// half-transparent pane: casters that the shadow filter passes, solids and blending.
+    /// half-transparent pane: casters that the shadow filter passes, a closed surface's
+    /// culled entry face and blending.
     fn scene(blend: bool) -> (Soup, Accel) {
         let mut soup = Soup::empty();
         soup.materials = vec![

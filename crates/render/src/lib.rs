@@ -34,7 +34,6 @@ pub mod preview;
 pub mod render;
 pub mod sampling;
 mod soft;
-pub mod solid;
 pub mod texture;
 
 pub use aov::{Aov, AovSet};

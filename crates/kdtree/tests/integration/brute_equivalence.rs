@@ -30,6 +30,12 @@ fn check(tris: &[[Vec3; 3]], accel: &Accel, ray: &Ray) -> Result<(), TestCaseErr
         "filtered any-hit disagrees with filtered closest-hit for {:?}",
         ray
     );
+    prop_assert_eq!(
+        accel.occluded_filtered_in_order(ray, keep),
+        want.is_some(),
+        "in-order filtered any-hit disagrees with filtered closest-hit for {:?}",
+        ray
+    );
     Ok(())
 }
 

@@ -39,34 +39,48 @@ fn check(accel: &Accel, rays: &[Ray; LANES]) -> usize {
     hits
 }
 
-/// Returns how many lanes are blocked.
+/// Returns how many lanes are blocked. The filtered queries are checked in both orders.
 fn check_any(accel: &Accel, rays: &[Ray; LANES]) -> usize {
     let got = accel.occluded4(rays);
     let blocks =
         |h: &Hit, front: bool| !h.prim.is_multiple_of(3) && (front || !h.prim.is_multiple_of(5));
-    let mut asked4: [Asked; LANES] = Default::default();
-    let got_filtered = accel.occluded4_filtered(rays, |l, h, front| {
-        asked4[l].push((h.prim, h.t.to_bits(), front));
-        blocks(h, front)
-    });
     let mut blocked = 0;
     for (l, ray) in rays.iter().enumerate() {
         let want = accel.occluded(ray);
         assert_eq!(got[l], want, "any hit, lane {l} of {rays:?}");
         blocked += want as usize;
-        let mut asked = Asked::new();
-        let want = accel.occluded_filtered(ray, |h, front| {
-            asked.push((h.prim, h.t.to_bits(), front));
+    }
+    for in_order in [false, true] {
+        let mut asked4: [Asked; LANES] = Default::default();
+        let ask4 = |l: usize, h: &Hit, front: bool| {
+            asked4[l].push((h.prim, h.t.to_bits(), front));
             blocks(h, front)
-        });
-        assert_eq!(
-            got_filtered[l], want,
-            "filtered any hit, lane {l} of {rays:?}"
-        );
-        assert_eq!(
-            asked4[l], asked,
-            "any-hit filter questions, lane {l} of {rays:?}"
-        );
+        };
+        let got_filtered = if in_order {
+            accel.occluded4_filtered_in_order(rays, ask4)
+        } else {
+            accel.occluded4_filtered(rays, ask4)
+        };
+        for (l, ray) in rays.iter().enumerate() {
+            let mut asked = Asked::new();
+            let ask = |h: &Hit, front: bool| {
+                asked.push((h.prim, h.t.to_bits(), front));
+                blocks(h, front)
+            };
+            let want = if in_order {
+                accel.occluded_filtered_in_order(ray, ask)
+            } else {
+                accel.occluded_filtered(ray, ask)
+            };
+            assert_eq!(
+                got_filtered[l], want,
+                "filtered any hit (in order: {in_order}), lane {l} of {rays:?}"
+            );
+            assert_eq!(
+                asked4[l], asked,
+                "any-hit filter questions (in order: {in_order}), lane {l} of {rays:?}"
+            );
+        }
     }
     blocked
 }
@@ -229,31 +243,42 @@ fn shadow_rays_of_neighbouring_pixels_get_their_single_answers() {
     );
 }
 
+/// `n` triangles across the z axis at z = 1, 2, …, two corners raised by `tilt` and twice
+/// `tilt`.
+fn walls(n: u32, tilt: f32) -> Vec<[Vec3; 3]> {
+    (1..=n)
+        .map(|z| {
+            let z = z as f32;
+            [
+                Vec3::new(-1.0, -1.0, z),
+                Vec3::new(2.0, -1.0, z + 2.0 * tilt),
+                Vec3::new(-1.0, 2.0, z + tilt),
+            ]
+        })
+        .collect()
+}
+
+/// Four rays from near the origin that pass through every one of [`walls`].
+fn through_walls() -> [Ray; LANES] {
+    std::array::from_fn(|l| {
+        let o = Vec3::new(0.1 * l as f32, 0.05 * l as f32, 0.0);
+        Ray::new(o, Vec3::new(0.01, 0.02, 1.0), 0.0, f32::INFINITY)
+    })
+}
+
 /// Three triangles in one leaf, all passed by the filter: each ray is asked about each
 /// triangle once, alone and in a packet, closest hit and any hit. (A short four-wide group
 /// repeats its last triangle in its spare lane; that lane's hit must not be asked about
 /// again, or a face passed would count twice.)
 #[test]
 fn a_leaf_asks_about_each_triangle_once() {
-    let tris: Vec<[Vec3; 3]> = (1..=3)
-        .map(|z| {
-            let z = z as f32;
-            [
-                Vec3::new(-1.0, -1.0, z),
-                Vec3::new(2.0, -1.0, z),
-                Vec3::new(-1.0, 2.0, z),
-            ]
-        })
-        .collect();
+    let tris = walls(3, 0.0);
     let params = BuildParams {
         leaf_size: 8,
         ..BuildParams::default()
     };
     let accel = Accel::build(&tris, &params);
-    let rays: [Ray; LANES] = std::array::from_fn(|l| {
-        let o = Vec3::new(0.1 * l as f32, 0.05 * l as f32, 0.0);
-        Ray::new(o, Vec3::new(0.01, 0.02, 1.0), 0.0, f32::INFINITY)
-    });
+    let rays = through_walls();
     let sorted = |mut asked: Vec<u32>| {
         asked.sort_unstable();
         asked
@@ -289,4 +314,60 @@ fn a_leaf_asks_about_each_triangle_once() {
     });
     assert_eq!(got, [false; LANES]);
     assert_eq!(asked.map(sorted), [[0, 1, 2]; LANES], "any hit, packet");
+    let mut asked: [Vec<u32>; LANES] = Default::default();
+    let got = accel.occluded4_filtered_in_order(&rays, |l, h, _| {
+        asked[l].push(h.prim);
+        false
+    });
+    assert_eq!(got, [false; LANES]);
+    assert_eq!(
+        asked.map(sorted),
+        [[0, 1, 2]; LANES],
+        "any hit in order, packet"
+    );
+}
+
+/// Ten walls one behind the other, each in a leaf of its own, and a filter that passes
+/// them all: the in-order query asks about them nearest first, the other query farthest
+/// first (its walk takes each far child first), alone and in a packet.
+#[test]
+fn filtered_any_hit_queries_meet_the_walls_in_their_order() {
+    // Tilted, so that a plane between two walls separates them.
+    let tris = walls(10, 0.1);
+    // Triangle tests priced far above steps: the build splits between every two walls.
+    let params = BuildParams {
+        traversal_cost: 1.0,
+        intersect_cost: 100.0,
+        ..BuildParams::default()
+    };
+    let accel = Accel::build(&tris, &params);
+    let rays = through_walls();
+    let nearest_first: Vec<u32> = (0..10).collect();
+    let farthest_first: Vec<u32> = (0..10).rev().collect();
+    for ray in &rays {
+        let mut asked = vec![];
+        assert!(!accel.occluded_filtered_in_order(ray, |h, _| {
+            asked.push(h.prim);
+            false
+        }));
+        assert_eq!(asked, nearest_first, "in order, {ray:?}");
+        let mut asked = vec![];
+        assert!(!accel.occluded_filtered(ray, |h, _| {
+            asked.push(h.prim);
+            false
+        }));
+        assert_eq!(asked, farthest_first, "far child first, {ray:?}");
+    }
+    let mut asked: [Vec<u32>; LANES] = Default::default();
+    accel.occluded4_filtered_in_order(&rays, |l, h, _| {
+        asked[l].push(h.prim);
+        false
+    });
+    assert!(asked.iter().all(|a| *a == nearest_first), "{asked:?}");
+    let mut asked: [Vec<u32>; LANES] = Default::default();
+    accel.occluded4_filtered(&rays, |l, h, _| {
+        asked[l].push(h.prim);
+        false
+    });
+    assert!(asked.iter().all(|a| *a == farthest_first), "{asked:?}");
 }

@@ -278,7 +278,7 @@ fn run(a: RenderArgs) -> Result<()> {
         opts.width, opts.height, window, opts.spp, opts.depth, out.seconds, mrays, load_seconds, write_seconds
     );
     eprintln!(
-        "kd2exr: rays: camera {}, shadow {}, soft_shadow {}, reflection {}, blend_continuation {}, pass_through {}, shadow_pass_through {}, shadow_solid {}, shadow_blend {}, shadow_reuse {} (total {})",
+        "kd2exr: rays: camera {}, shadow {}, soft_shadow {}, reflection {}, blend_continuation {}, pass_through {}, shadow_pass_through {}, shadow_blend {}, shadow_reuse {} (total {})",
         c.camera,
         c.shadow,
         c.soft_shadow,
@@ -286,7 +286,6 @@ fn run(a: RenderArgs) -> Result<()> {
         c.blend_continuation,
         c.pass_through,
         c.shadow_pass_through,
-        c.shadow_solid,
         c.shadow_blend,
         c.shadow_reuse,
         c.total()
