@@ -127,12 +127,18 @@ fn srgb_table() -> &'static [f32; 256] {
     })
 }
 
+/// 8-bit code → code / 255, computed once (a table read instead of a division per texel).
+fn linear_table() -> &'static [f32; 256] {
+    static TABLE: std::sync::OnceLock<[f32; 256]> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| std::array::from_fn(|i| i as f32 / 255.0))
+}
+
 /// An 8-bit channel as a linear value.
 pub fn decode_u8(code: u8, srgb: bool) -> f32 {
     if srgb {
         srgb_table()[code as usize]
     } else {
-        code as f32 / 255.0
+        linear_table()[code as usize]
     }
 }
 
@@ -164,34 +170,36 @@ impl Texture {
     }
 
     /// Texel (x, y) as linear RGBA (y = 0 is the bottom row).
+    #[inline]
     pub fn texel(&self, x: u32, y: u32) -> [f32; 4] {
         let i = ((y as usize) * (self.width as usize) + x as usize) * 4;
         let t = &self.texels[i..i + 4];
+        let colour = if self.srgb {
+            srgb_table()
+        } else {
+            linear_table()
+        };
+        let alpha = linear_table();
         [
-            decode_u8(t[0], self.srgb),
-            decode_u8(t[1], self.srgb),
-            decode_u8(t[2], self.srgb),
-            decode_u8(t[3], false),
+            colour[t[0] as usize],
+            colour[t[1] as usize],
+            colour[t[2] as usize],
+            alpha[t[3] as usize],
         ]
     }
 
-    /// Level 0 and, when mip-mapped, every halving down to 1×1. Each texel of a level is
-    /// the mean of the (2×2, or 3 wide/high where a side is odd) texels it covers, summed
-    /// in f64 so that a constant texture stays exactly constant at every level.
-    pub fn mips(&self) -> Vec<Level> {
-        let mut levels = vec![Level {
-            width: self.width,
-            height: self.height,
-            texels: (0..self.height)
-                .flat_map(|y| (0..self.width).map(move |x| (x, y)))
-                .map(|(x, y)| self.texel(x, y))
-                .collect(),
-        }];
-        if !self.mipmaps {
+    /// When mip-mapped, every halving of the image down to 1×1 (level 1 first; level 0 is
+    /// the image itself, read through [`Texture::texel`]). Each texel of a level is the
+    /// mean of the (2×2, or 3 wide/high where a side is odd) texels it covers, summed in
+    /// f64 so that a constant texture stays exactly constant at every level.
+    pub fn halvings(&self) -> Vec<Level> {
+        let mut levels: Vec<Level> = Vec::new();
+        if !self.mipmaps || (self.width == 1 && self.height == 1) {
             return levels;
         }
+        levels.push(halve(self.width, self.height, |x, y| self.texel(x, y)));
         while let Some(prev) = levels.last().filter(|l| l.width > 1 || l.height > 1) {
-            levels.push(halve(prev));
+            levels.push(halve(prev.width, prev.height, |x, y| prev.texel(x, y)));
         }
         levels
     }
@@ -212,17 +220,18 @@ fn span(i: u32, src: u32, dst: u32) -> (u32, u32) {
     (first, last)
 }
 
-fn halve(src: &Level) -> Level {
-    let (w, h) = ((src.width / 2).max(1), (src.height / 2).max(1));
+/// The halving of a `width`×`height` level whose texels `texel` reads.
+fn halve(width: u32, height: u32, texel: impl Fn(u32, u32) -> [f32; 4]) -> Level {
+    let (w, h) = ((width / 2).max(1), (height / 2).max(1));
     let mut texels = Vec::with_capacity(w as usize * h as usize);
     for y in 0..h {
-        let (y0, y1) = span(y, src.height, h);
+        let (y0, y1) = span(y, height, h);
         for x in 0..w {
-            let (x0, x1) = span(x, src.width, w);
+            let (x0, x1) = span(x, width, w);
             let mut sum = [0f64; 4];
             for sy in y0..=y1 {
                 for sx in x0..=x1 {
-                    let t = src.texel(sx, sy);
+                    let t = texel(sx, sy);
                     for c in 0..4 {
                         sum[c] += t[c] as f64;
                     }
@@ -278,9 +287,9 @@ mod tests {
     #[test]
     fn mip_chain_sizes_and_constant_levels() {
         let t = tex(5, 3, [200, 10, 77, 255].repeat(15));
-        let mips = t.mips();
+        let mips = t.halvings();
         let sizes: Vec<_> = mips.iter().map(|l| (l.width, l.height)).collect();
-        assert_eq!(sizes, vec![(5, 3), (2, 1), (1, 1)]);
+        assert_eq!(sizes, vec![(2, 1), (1, 1)]);
         let c = t.texel(0, 0);
         for l in &mips {
             assert!(l.texels.iter().all(|&x| x == c), "{}x{}", l.width, l.height);
@@ -291,10 +300,10 @@ mod tests {
     fn mip_averages_in_linear() {
         let mut t = tex(2, 1, vec![255, 255, 255, 255, 0, 0, 0, 0]);
         t.srgb = true;
-        let m = t.mips();
-        assert_eq!(m[1].texels, vec![[0.5, 0.5, 0.5, 0.5]]);
+        let m = t.halvings();
+        assert_eq!(m[0].texels, vec![[0.5, 0.5, 0.5, 0.5]]);
         t.mipmaps = false;
-        assert_eq!(t.mips().len(), 1);
+        assert!(t.halvings().is_empty());
     }
 
     #[test]

@@ -39,6 +39,7 @@ use formats::{CastShadows, Hit, Light, Soup, Tiling};
 use glam::{Vec2, Vec3, Vec4};
 use kdtree::triangle::RayPre;
 use kdtree::{Accel, Ray, LANES};
+use rayon::prelude::*;
 
 /// What the first hit of a camera ray tells the AOVs.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -207,7 +208,7 @@ pub struct Integrator<'a> {
     alpha: bool,
     filter: TextureFilter,
     /// One per soup texture, built when textures or alpha are on (else empty).
-    samplers: Vec<Sampler>,
+    samplers: Vec<Option<Sampler<'a>>>,
     /// One per material (empty when textures and alpha are off).
     surfacing: Vec<Surfacing>,
     /// Some material is blended: shadow rays through cut-out and blended casters meet
@@ -306,7 +307,14 @@ impl<'a> Integrator<'a> {
                     opacity: m.opacity,
                 })
                 .collect();
-            (soup.textures.iter().map(Sampler::new).collect(), surfacing)
+            // Only the textures a used material reads get mip levels, each on a thread.
+            let samplers = soup
+                .textures
+                .par_iter()
+                .zip(&plan.textures.read)
+                .map(|(t, &read)| read.then(|| Sampler::new(t)))
+                .collect();
+            (samplers, surfacing)
         } else {
             (Vec::new(), Vec::new())
         };
@@ -342,7 +350,7 @@ impl<'a> Integrator<'a> {
 
     /// Bytes of the texture samplers this render built (mip chains included).
     pub fn texture_bytes(&self) -> u64 {
-        self.samplers.iter().map(Sampler::bytes).sum()
+        self.samplers.iter().flatten().map(Sampler::bytes).sum()
     }
 
     /// The interpolated UV of triangle `prim` at barycentrics (u, v): corner 0 weighs
@@ -366,7 +374,10 @@ impl<'a> Integrator<'a> {
         } else {
             0.0
         };
-        self.samplers[map.0].lookup(self.filter, &map.1, uv, w)
+        self.samplers[map.0]
+            .as_ref()
+            .expect("the plan reads every texture a lookup can reach")
+            .lookup(self.filter, &map.1, uv, w)
     }
 
     /// α of a cut-out or blended surface at a hit (its opacity without a map).

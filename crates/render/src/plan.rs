@@ -88,10 +88,15 @@ pub struct TexturePlan {
     pub textured_materials: usize,
     /// Distinct textures those materials (and the alpha lookups) read.
     pub textures: usize,
-    /// Bytes of those textures' samplers, mip levels included (linear RGBA f32).
+    /// Bytes of those textures' mip levels below the full-size images, which the soup
+    /// holds (linear RGBA f32).
     pub bytes: u64,
     pub filter: TextureFilter,
     pub reason: String,
+    /// Which of the soup's textures those are: the renderer builds mip levels for these
+    /// alone.
+    #[serde(skip)]
+    pub read: Vec<bool>,
 }
 
 /// Alpha: on when a used material is cut out where its α can fall below the cut-off, or
@@ -396,7 +401,7 @@ fn texturing(soup: &Soup, mats: &[&Material], filter: TextureFilter) -> (Texture
         reason: if textured_materials > 0 {
             format!(
                 "{textured_materials} materials with albedo maps, {textures} textures \
-                 ({:.1} MiB with mips): {how}",
+                 ({:.1} MiB of mip levels): {how}",
                 bytes as f64 / (1u64 << 20) as f64
             )
         } else if mats.iter().any(|m| m.albedo_map.is_some()) {
@@ -404,6 +409,7 @@ fn texturing(soup: &Soup, mats: &[&Material], filter: TextureFilter) -> (Texture
         } else {
             "no material has an albedo map".into()
         },
+        read,
     };
     let alpha_plan = AlphaPlan {
         enabled: alpha_on,

@@ -18,6 +18,9 @@ pub struct Rendered {
     pub counts: RayCounts,
     /// Wall-clock time of the tracing itself (not loading or writing).
     pub seconds: f64,
+    /// Wall-clock time of what the tracing needs first: the textures' mip levels and the
+    /// per-triangle tables the plan calls for.
+    pub setup_seconds: f64,
 }
 
 /// Tiles of at most `edge`×`edge` pixels covering the window, row by row.
@@ -67,11 +70,22 @@ pub fn render(
 ) -> Result<Rendered, RenderError> {
     opts.validate()?;
     let camera = CameraModel::new(&soup.camera, opts.width, opts.height)?;
-    let integrator = Integrator::new(soup, accel, plan, opts.soft_samples, opts.texture_filter);
     let window = opts.window();
-    let run = || render_tiles(&camera, &integrator, opts, window, progress);
-    let start = Instant::now();
-    let (frame, counts) = match opts.threads {
+    // The samplers are built on the render's own threads too.
+    let run = || {
+        let setup = Instant::now();
+        let integrator = Integrator::new(soup, accel, plan, opts.soft_samples, opts.texture_filter);
+        let setup_seconds = setup.elapsed().as_secs_f64();
+        let start = Instant::now();
+        let (frame, counts) = render_tiles(&camera, &integrator, opts, window, progress);
+        Rendered {
+            frame,
+            counts,
+            seconds: start.elapsed().as_secs_f64(),
+            setup_seconds,
+        }
+    };
+    Ok(match opts.threads {
         Some(n) => rayon::ThreadPoolBuilder::new()
             .num_threads(n)
             .build()
@@ -81,11 +95,6 @@ pub fn render(
             })?
             .install(run),
         None => run(),
-    };
-    Ok(Rendered {
-        frame,
-        counts,
-        seconds: start.elapsed().as_secs_f64(),
     })
 }
 

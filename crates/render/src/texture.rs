@@ -9,12 +9,40 @@ use crate::options::TextureFilter;
 use formats::texture::{Filter, Level, Texture, Tiling, Wrap};
 use glam::{Vec2, Vec3, Vec4};
 
-/// A texture ready to sample: its mip chain, built once.
-pub struct Sampler {
-    levels: Vec<Level>,
+/// A texture ready to sample: level 0 is the soup's own 8-bit image, decoded texel by
+/// texel as it is read (a table read per channel), so that the full-size image is not
+/// copied into linear floats; the smaller levels are built once, in linear RGBA f32.
+pub struct Sampler<'a> {
+    image: &'a Texture,
+    mips: Vec<Level>,
     wrap_u: Wrap,
     wrap_v: Wrap,
     filter: Filter,
+}
+
+/// One level of a [`Sampler`]'s chain.
+#[derive(Clone, Copy)]
+enum LevelRef<'a> {
+    Image(&'a Texture),
+    Mip(&'a Level),
+}
+
+impl LevelRef<'_> {
+    #[inline(always)]
+    fn size(self) -> (u32, u32) {
+        match self {
+            LevelRef::Image(t) => (t.width, t.height),
+            LevelRef::Mip(l) => (l.width, l.height),
+        }
+    }
+
+    #[inline(always)]
+    fn texel(self, x: u32, y: u32) -> Vec4 {
+        Vec4::from_array(match self {
+            LevelRef::Image(t) => t.texel(x, y),
+            LevelRef::Mip(l) => l.texel(x, y),
+        })
+    }
 }
 
 /// `a + (b − a)·f`: unlike `Vec4::lerp`'s `a(1 − f) + bf`, exactly `a` when `a == b`, so a
@@ -45,10 +73,11 @@ fn wrap(i: i64, n: u32, mode: Wrap) -> u32 {
     }) as u32
 }
 
-impl Sampler {
-    pub fn new(texture: &Texture) -> Sampler {
+impl<'a> Sampler<'a> {
+    pub fn new(texture: &'a Texture) -> Sampler<'a> {
         Sampler {
-            levels: texture.mips(),
+            image: texture,
+            mips: texture.halvings(),
             wrap_u: texture.wrap_u,
             wrap_v: texture.wrap_v,
             filter: texture.filter,
@@ -56,15 +85,21 @@ impl Sampler {
     }
 
     pub fn levels(&self) -> usize {
-        self.levels.len()
+        1 + self.mips.len()
+    }
+
+    fn level(&self, k: usize) -> LevelRef<'_> {
+        match k {
+            0 => LevelRef::Image(self.image),
+            _ => LevelRef::Mip(&self.mips[k - 1]),
+        }
     }
 
     /// The continuous mip level for a footprint `width` in uv units: log2 of the footprint
     /// in level-0 texels along the larger side, clamped to the chain.
     pub fn lod(&self, width: f32) -> f32 {
-        let l0 = &self.levels[0];
-        let texels = width * l0.width.max(l0.height) as f32;
-        let max = (self.levels.len() - 1) as f32;
+        let texels = width * self.image.width.max(self.image.height) as f32;
+        let max = self.mips.len() as f32;
         if texels.is_nan() || texels <= 1.0 {
             0.0
         } else {
@@ -83,7 +118,7 @@ impl Sampler {
                 let lo = lod.floor() as usize;
                 let f = lod - lo as f32;
                 let a = self.bilinear(lo, uv);
-                if f == 0.0 || lo + 1 >= self.levels.len() {
+                if f == 0.0 || lo + 1 >= self.levels() {
                     a
                 } else {
                     mix(a, self.bilinear(lo + 1, uv), f)
@@ -106,9 +141,9 @@ impl Sampler {
         }
     }
 
-    /// Bytes the mip chain holds (linear RGBA f32 per texel, every level).
+    /// Bytes the mip levels below the image hold (linear RGBA f32 per texel).
     pub fn bytes(&self) -> u64 {
-        self.levels
+        self.mips
             .iter()
             .map(|l| l.texels.len() as u64 * std::mem::size_of::<[f32; 4]>() as u64)
             .sum()
@@ -121,54 +156,39 @@ impl Sampler {
     }
 
     fn nearest(&self, lod: f32) -> usize {
-        ((lod + 0.5).floor() as usize).min(self.levels.len() - 1)
-    }
-
-    fn fetch(&self, level: &Level, x: i64, y: i64) -> Vec4 {
-        let x = wrap(x, level.width, self.wrap_u);
-        let y = wrap(y, level.height, self.wrap_v);
-        Vec4::from_array(level.texel(x, y))
-    }
-
-    /// The texel at wrapped coordinates (x, y).
-    fn at(level: &Level, x: u32, y: u32) -> Vec4 {
-        Vec4::from_array(level.texel(x, y))
+        ((lod + 0.5).floor() as usize).min(self.mips.len())
     }
 
     fn point(&self, level: usize, uv: Vec2) -> Vec4 {
-        let l = &self.levels[level];
-        let x = (uv.x as f64 * l.width as f64).floor() as i64;
-        let y = (uv.y as f64 * l.height as f64).floor() as i64;
-        self.fetch(l, x, y)
+        let l = self.level(level);
+        let (w, h) = l.size();
+        let x = (uv.x as f64 * w as f64).floor() as i64;
+        let y = (uv.y as f64 * h as f64).floor() as i64;
+        l.texel(wrap(x, w, self.wrap_u), wrap(y, h, self.wrap_v))
     }
 
     fn bilinear(&self, level: usize, uv: Vec2) -> Vec4 {
-        let l = &self.levels[level];
-        let x = uv.x as f64 * l.width as f64 - 0.5;
-        let y = uv.y as f64 * l.height as f64 - 0.5;
+        let l = self.level(level);
+        let (w, h) = l.size();
+        let x = uv.x as f64 * w as f64 - 0.5;
+        let y = uv.y as f64 * h as f64 - 0.5;
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
         let (x0, y0) = (x0 as i64, y0 as i64);
         // Each of the four coordinates wrapped once, not once per texel read.
-        let (xa, xb) = (
-            wrap(x0, l.width, self.wrap_u),
-            wrap(x0 + 1, l.width, self.wrap_u),
-        );
-        let (ya, yb) = (
-            wrap(y0, l.height, self.wrap_v),
-            wrap(y0 + 1, l.height, self.wrap_v),
-        );
-        let bottom = mix(Self::at(l, xa, ya), Self::at(l, xb, ya), fx);
-        let top = mix(Self::at(l, xa, yb), Self::at(l, xb, yb), fx);
+        let (xa, xb) = (wrap(x0, w, self.wrap_u), wrap(x0 + 1, w, self.wrap_u));
+        let (ya, yb) = (wrap(y0, h, self.wrap_v), wrap(y0 + 1, h, self.wrap_v));
+        let bottom = mix(l.texel(xa, ya), l.texel(xb, ya), fx);
+        let top = mix(l.texel(xa, yb), l.texel(xb, yb), fx);
         mix(bottom, top, fy)
     }
 }
 
-/// Bytes a [`Sampler`] of `t` will hold, without building it: level 0 and, when
-/// mip-mapped, every halving down to 1×1, 16 bytes per texel.
+/// Bytes a [`Sampler`] of `t` will hold beside the soup's image, without building it:
+/// when mip-mapped, every halving down to 1×1, 16 bytes per texel.
 pub fn sampler_bytes(t: &Texture) -> u64 {
     let (mut w, mut h) = (t.width.max(1) as u64, t.height.max(1) as u64);
-    let mut texels = w * h;
+    let mut texels = 0;
     while t.mipmaps && (w > 1 || h > 1) {
         (w, h) = ((w / 2).max(1), (h / 2).max(1));
         texels += w * h;
@@ -218,9 +238,14 @@ mod tests {
         }
     }
 
+    /// A sampler of a texture that lives as long as the test.
+    fn sampler(t: Texture) -> Sampler<'static> {
+        Sampler::new(Box::leak(Box::new(t)))
+    }
+
     /// Bottom row: red, green; top row: blue, white.
-    fn two_by_two(filter: Filter, wrap: Wrap) -> Sampler {
-        Sampler::new(&texture(
+    fn two_by_two(filter: Filter, wrap: Wrap) -> Sampler<'static> {
+        sampler(texture(
             2,
             2,
             &[
@@ -299,7 +324,7 @@ mod tests {
 
     #[test]
     fn mip_level_for_footprint() {
-        let s = Sampler::new(&texture(
+        let s = sampler(texture(
             16,
             16,
             &vec![[9, 9, 9, 9]; 256],
@@ -347,7 +372,7 @@ mod tests {
         );
         let tex = texture(5, 3, &[[0, 0, 0, 7]; 15], Filter::Bilinear, Wrap::Repeat);
         assert_eq!(sampler_bytes(&tex), Sampler::new(&tex).bytes());
-        assert_eq!(sampler_bytes(&tex), (15 + 2 + 1) * 16);
+        assert_eq!(sampler_bytes(&tex), (2 + 1) * 16);
         assert_eq!(min_alpha(&tex), 7.0 / 255.0);
     }
 

@@ -274,8 +274,8 @@ fn run(a: RenderArgs) -> Result<()> {
     let c = out.counts;
     let mrays = c.total() as f64 / out.seconds.max(1e-9) / 1e6;
     eprintln!(
-        "kd2exr: rendered {}×{} (window {}) at {} spp, depth {} in {:.3} s ({:.2} Mrays/s; loading took {:.3} s, writing {:.3} s)",
-        opts.width, opts.height, window, opts.spp, opts.depth, out.seconds, mrays, load_seconds, write_seconds
+        "kd2exr: rendered {}×{} (window {}) at {} spp, depth {} in {:.3} s ({:.2} Mrays/s; loading took {:.3} s, setting up {:.3} s, writing {:.3} s)",
+        opts.width, opts.height, window, opts.spp, opts.depth, out.seconds, mrays, load_seconds, out.setup_seconds, write_seconds
     );
     eprintln!(
         "kd2exr: rays: camera {}, shadow {}, soft_shadow {}, reflection {}, blend_continuation {}, pass_through {}, shadow_pass_through {}, shadow_blend {}, shadow_reuse {} (total {})",
@@ -315,6 +315,7 @@ fn run(a: RenderArgs) -> Result<()> {
             "texture_filter": opts.texture_filter,
             "seconds": out.seconds,
             "load_seconds": load_seconds,
+            "setup_seconds": out.setup_seconds,
             "write_seconds": write_seconds,
             "total_seconds": start.elapsed().as_secs_f64(),
             "rays": c,

@@ -92,13 +92,40 @@ fn each_texel_lands_in_its_image_corner_not_mirrored() {
     assert_eq!(out.counts.texture_lookups, 16);
     assert_eq!(out.counts.alpha_lookups, 0);
     assert_eq!(plan.textures.textures, 1);
-    // 2×2, 1×1: five texels of 16 bytes.
-    assert_eq!(plan.textures.bytes, 5 * 16);
+    // The 2×2 image is the soup's; its 1×1 mip level is one texel of 16 bytes.
+    assert_eq!(plan.textures.bytes, 16);
     assert!(
         plan.describe().contains("textures       on "),
         "{}",
         plan.describe()
     );
+}
+
+/// The full-size image is sampled where the soup holds it; mip levels are built for the
+/// textures a used material reads, and for no other.
+#[test]
+fn only_the_textures_a_used_material_reads_get_mip_levels() {
+    let mut s = textured_quad(
+        four_colours(Wrap::Clamp),
+        Tiling::default(),
+        1.0,
+        [Vec2::ZERO, Vec2::ONE],
+    );
+    // A 4×4 texture of a material no triangle uses.
+    let unread = s.texture(texture(4, 4, &[GREEN; 16], Wrap::Repeat));
+    s.material(mapped(unread, Tiling::default()));
+    let (soup, kd) = s.build();
+    let (out, plan) = render(&soup, &kd, &opts(4, 4));
+    assert_eq!(out.frame.pixel(0, 3), rgb(RED));
+    assert_eq!(
+        (plan.textures.textures, plan.textures.read.clone()),
+        (1, vec![true, false])
+    );
+    let accel = kdtree::Accel::new(&soup, kd).expect("tree fits");
+    let it =
+        render::integrator::Integrator::new(&soup, &accel, &plan, 16, render::TextureFilter::Cone);
+    // The 2×2 image's 1×1 level: one texel of linear RGBA f32; none of the 4×4 image's.
+    assert_eq!((plan.textures.bytes, it.texture_bytes()), (16, 16));
 }
 
 #[test]
