@@ -76,7 +76,7 @@ struct RenderArgs {
     /// Seed of the per-pixel random numbers.
     #[arg(long, default_value_t = RenderOptions::default().seed)]
     seed: u64,
-    /// Worker threads (default: one per core).
+    /// Threads for loading, tracing and writing (default: one per core).
     #[arg(long)]
     threads: Option<usize>,
     /// Print one JSON object on stdout.
@@ -206,6 +206,13 @@ fn run(a: RenderArgs) -> Result<()> {
     finite_exposure(a.exposure)?;
     // Everything that can be refused is refused before loading or tracing anything.
     opts.validate()?;
+    // Loading and writing run on the same number of threads as the tracing.
+    if let Some(n) = opts.threads {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+            .context("cannot start the thread pool")?;
+    }
     memory::check(&opts, memory::available_bytes())?;
     for p in std::iter::once(&out_path).chain(a.preview.as_ref()) {
         writable_folder(p)?;
