@@ -267,8 +267,8 @@ pub fn sanitize(v: &mut Vec3) -> bool {
 }
 
 impl<'a> Integrator<'a> {
-    /// Builds every texture's sampler (mip chain) when the plan reads textures, so this
-    /// is the render's texture loading step.
+    /// Builds a sampler (the mip levels below the full-size image) for each texture the
+    /// plan reads, so this is the render's texture setup step (`setup_seconds`).
     pub fn new(
         soup: &'a Soup,
         accel: &'a Accel,
@@ -348,7 +348,7 @@ impl<'a> Integrator<'a> {
         }
     }
 
-    /// Bytes of the texture samplers this render built (mip chains included).
+    /// Bytes of the mip levels this render built (the full-size images are the soup's).
     pub fn texture_bytes(&self) -> u64 {
         self.samplers.iter().flatten().map(Sampler::bytes).sum()
     }
