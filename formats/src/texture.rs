@@ -7,8 +7,9 @@
 //! holds exactly the values Unity samples, at a quarter of the size of linear `f32`, and
 //! the lookup through [`decode_u8`] is exact (a table, not a re-quantisation).
 //!
-//! Mip levels are not stored: they follow from the texels, so the renderer builds them
-//! once at load ([`Texture::mips`]), in linear `f32` so averaging conserves energy.
+//! Mip levels are not stored: they follow from the texels, so the renderer builds the
+//! levels below the full-size image once before tracing ([`Texture::halvings`]), in linear
+//! `f32` so averaging conserves energy, and reads the full-size image from these bytes.
 
 use serde::{Deserialize, Serialize};
 
