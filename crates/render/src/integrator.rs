@@ -22,7 +22,7 @@
 //! its mask. Passing through is the same ray again with `tmin` just above the hit's t:
 //! the same ray parameters give the same t for that triangle, so it is never found again.
 
-use crate::alpha::{alpha_use, min_alphas, AlphaUse};
+use crate::alpha::{alpha_use, AlphaUse};
 use crate::cone::RayCone;
 use crate::counters::RayCounts;
 use crate::environment;
@@ -289,7 +289,6 @@ impl<'a> Integrator<'a> {
         let textures = plan.textures.enabled;
         let alpha = plan.alpha.enabled;
         let (samplers, surfacing) = if textures || alpha {
-            let min_alpha = min_alphas(&soup.textures);
             let surfacing = soup
                 .materials
                 .iter()
@@ -300,7 +299,7 @@ impl<'a> Integrator<'a> {
                         .filter(|_| textures || alpha),
                     colour: textures && colour_mapped(m),
                     alpha: if alpha {
-                        alpha_use(m, &min_alpha)
+                        alpha_use(m, &plan.alpha.min_alpha)
                     } else {
                         AlphaUse::Opaque
                     },

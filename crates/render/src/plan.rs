@@ -107,6 +107,10 @@ pub struct AlphaPlan {
     pub cutout_materials: usize,
     pub blend_materials: usize,
     pub reason: String,
+    /// Each soup texture's least texel alpha (0–1), which decides how a material with a
+    /// map uses alpha ([`alpha_use`]); found once, here, for the renderer too.
+    #[serde(skip)]
+    pub min_alpha: Vec<f32>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -425,6 +429,7 @@ fn texturing(soup: &Soup, mats: &[&Material], filter: TextureFilter) -> (Texture
         } else {
             "every material is opaque".into()
         },
+        min_alpha,
     };
     (texture_plan, alpha_plan)
 }
