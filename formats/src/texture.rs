@@ -134,13 +134,18 @@ fn linear_table() -> &'static [f32; 256] {
     TABLE.get_or_init(|| std::array::from_fn(|i| i as f32 / 255.0))
 }
 
+/// Every 8-bit code's linear value, for sRGB-encoded or linear channels.
+fn table(srgb: bool) -> &'static [f32; 256] {
+    if srgb {
+        srgb_table()
+    } else {
+        linear_table()
+    }
+}
+
 /// An 8-bit channel as a linear value.
 pub fn decode_u8(code: u8, srgb: bool) -> f32 {
-    if srgb {
-        srgb_table()[code as usize]
-    } else {
-        linear_table()[code as usize]
-    }
+    table(srgb)[code as usize]
 }
 
 impl Texture {
@@ -175,12 +180,7 @@ impl Texture {
     pub fn texel(&self, x: u32, y: u32) -> [f32; 4] {
         let i = ((y as usize) * (self.width as usize) + x as usize) * 4;
         let t = &self.texels[i..i + 4];
-        let colour = if self.srgb {
-            srgb_table()
-        } else {
-            linear_table()
-        };
-        let alpha = linear_table();
+        let (colour, alpha) = (table(self.srgb), table(false));
         [
             colour[t[0] as usize],
             colour[t[1] as usize],
