@@ -299,7 +299,7 @@ fn run(a: RenderArgs) -> Result<()> {
     );
     if c.texture_lookups + c.alpha_lookups > 0 {
         eprintln!(
-            "kd2exr: texture lookups {}, alpha lookups {} ({:.1} MiB of textures with mips)",
+            "kd2exr: texture lookups {}, alpha lookups {} ({:.1} MiB of mip levels)",
             c.texture_lookups,
             c.alpha_lookups,
             plan.textures.bytes as f64 / (1u64 << 20) as f64
