@@ -179,14 +179,7 @@ impl Texture {
     #[inline]
     pub fn texel(&self, x: u32, y: u32) -> [f32; 4] {
         let i = ((y as usize) * (self.width as usize) + x as usize) * 4;
-        let t = &self.texels[i..i + 4];
-        let (colour, alpha) = (table(self.srgb), table(false));
-        [
-            colour[t[0] as usize],
-            colour[t[1] as usize],
-            colour[t[2] as usize],
-            alpha[t[3] as usize],
-        ]
+        decode_rgba(&self.texels[i..i + 4], table(self.srgb), table(false))
     }
 
     /// When mip-mapped, every halving of the image down to 1×1 (level 1 first; level 0 is
@@ -203,12 +196,7 @@ impl Texture {
         levels.push(halve(self.width, self.height, |y, row| {
             let bytes = &self.texels[y as usize * row_bytes..][..row_bytes];
             for (t, b) in row.iter_mut().zip(bytes.chunks_exact(4)) {
-                *t = [
-                    colour[b[0] as usize],
-                    colour[b[1] as usize],
-                    colour[b[2] as usize],
-                    alpha[b[3] as usize],
-                ];
+                *t = decode_rgba(b, colour, alpha);
             }
         }));
         while let Some(prev) = levels.last().filter(|l| l.width > 1 || l.height > 1) {
@@ -219,6 +207,17 @@ impl Texture {
         }
         levels
     }
+}
+
+/// One texel's four bytes as linear RGBA, through the colour and alpha tables.
+#[inline]
+fn decode_rgba(b: &[u8], colour: &[f32; 256], alpha: &[f32; 256]) -> [f32; 4] {
+    [
+        colour[b[0] as usize],
+        colour[b[1] as usize],
+        colour[b[2] as usize],
+        alpha[b[3] as usize],
+    ]
 }
 
 /// Source index range [first, last] that destination index `i` covers along one axis.
@@ -251,21 +250,21 @@ fn halve(width: u32, height: u32, mut fill_row: impl FnMut(u32, &mut [[f32; 4]])
         }
         // Most texels cover a 2×2 block: summed straight from two row pairs, in the order
         // the general loop below sums them.
-        let pairs = if rows.len() == 2 && width > 1 {
-            (width / 2 - width % 2) as usize
-        } else {
-            0
+        let pairs = match &*rows {
+            [upper, lower] if width > 1 => {
+                let pairs = (width / 2 - width % 2) as usize;
+                let blocks = upper.chunks_exact(2).zip(lower.chunks_exact(2));
+                for (a, b) in blocks.take(pairs) {
+                    texels.push(std::array::from_fn(|c| {
+                        let sum =
+                            0.0 + a[0][c] as f64 + a[1][c] as f64 + b[0][c] as f64 + b[1][c] as f64;
+                        (sum / 4.0) as f32
+                    }));
+                }
+                pairs
+            }
+            _ => 0,
         };
-        let (upper, lower) = rows.split_at(1);
-        let blocks = upper[0]
-            .chunks_exact(2)
-            .zip(lower.iter().flat_map(|r| r.chunks_exact(2)));
-        for (a, b) in blocks.take(pairs) {
-            texels.push(std::array::from_fn(|c| {
-                let sum = 0.0 + a[0][c] as f64 + a[1][c] as f64 + b[0][c] as f64 + b[1][c] as f64;
-                (sum / 4.0) as f32
-            }));
-        }
         for x in pairs as u32..w {
             let (x0, x1) = span(x, width, w);
             let mut sum = [0f64; 4];
