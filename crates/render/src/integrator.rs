@@ -31,7 +31,7 @@ use crate::offset::{
     hit_point, intersector_margin, offset_origin, SHADOW_TMAX_FRACTION, SPAWN_TMIN,
 };
 use crate::plan::{colour_mapped, Plan, ShadowMode};
-use crate::sampling::{disc_sample, Rng};
+use crate::sampling::{DiscSpiral, Rng};
 use crate::soft::SoftCone;
 use crate::texture::{cone_footprint, Sampler};
 use crate::TextureFilter;
@@ -1281,7 +1281,7 @@ impl<'a> Integrator<'a> {
         counts: &mut RayCounts,
     ) -> f32 {
         let n = self.soft_samples;
-        let rotation = rng.next_f32() * std::f32::consts::TAU;
+        let mut spiral = DiscSpiral::new(n, rng.next_f32() * std::f32::consts::TAU);
         // A spawned origin depends on the side of the surface a ray leaves by, not on its
         // direction: two origins serve every sample.
         let above = surf.spawn(surf.ng);
@@ -1295,8 +1295,8 @@ impl<'a> Integrator<'a> {
         for first in (0..n).step_by(LANES) {
             let (mut dx, mut dy) = ([0.0; LANES], [0.0; LANES]);
             let mut drawn = [false; LANES];
-            for (l, i) in (first..n.min(first + LANES as u32)).enumerate() {
-                (dx[l], dy[l]) = disc_sample(i, n, rng.next_f32(), rotation);
+            for l in 0..(n - first).min(LANES as u32) as usize {
+                (dx[l], dy[l]) = spiral.next(rng.next_f32());
                 counts.soft_shadow += 1;
                 drawn[l] = true;
             }
@@ -1547,11 +1547,12 @@ mod tests {
                             it.soft_visibility(&surf, light, &inc, &mut rng_a, &mut counts_a);
 
                         let (mut rng_b, mut counts_b) = (Rng::new(seed), RayCounts::default());
-                        let rotation = rng_b.next_f32() * std::f32::consts::TAU;
+                        let mut spiral =
+                            DiscSpiral::new(n, rng_b.next_f32() * std::f32::consts::TAU);
                         let cone = SoftCone::new(light, p, inc.dir, surf.ng, p, p);
                         let mut alone = 0.0f32;
-                        for s in 0..n {
-                            let (dx, dy) = disc_sample(s, n, rng_b.next_f32(), rotation);
+                        for _ in 0..n {
+                            let (dx, dy) = spiral.next(rng_b.next_f32());
                             counts_b.soft_shadow += 1;
                             if let Some((dir, dist)) = sample(&cone, dx, dy) {
                                 let v = it.transmittance(&surf, dir, dist, &mut counts_b);

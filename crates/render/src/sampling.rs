@@ -97,17 +97,44 @@ pub fn pixel_samples(spp: u32, rng: &mut Rng) -> Vec<(f32, f32)> {
 /// Largest f32 below 1.
 pub const ONE_MINUS: f32 = 1.0 - f32::EPSILON / 2.0;
 
-/// Golden angle in radians: consecutive Vogel-spiral points turn by it.
-const GOLDEN_ANGLE: f32 = 2.399_963_2;
+/// The golden angle, π(3 − √5), as the unit vector (cos, sin): consecutive Vogel-spiral
+/// points turn by it.
+const GOLDEN_TURN: (f64, f64) = (-0.737_368_878_078_319_7, 0.675_490_294_261_523_8);
 
-/// Sample `i` of `n` on the unit disc: a Vogel spiral whose radius is stratified in area
-/// (stratum i of n, jittered by `jitter`) and whose angle is rotated by `rotation`
-/// (random per shading point, so neighbouring pixels do not share one pattern).
-pub fn disc_sample(i: u32, n: u32, jitter: f32, rotation: f32) -> (f32, f32) {
-    let area = ((i as f32 + jitter) / n as f32).min(1.0);
-    let r = area.sqrt();
-    let phi = i as f32 * GOLDEN_ANGLE + rotation;
-    (r * phi.cos(), r * phi.sin())
+/// A shading point's `n` samples on the unit disc, drawn in order: a Vogel spiral whose
+/// radius is stratified in area (sample i in stratum i of n, jittered) and whose angle starts
+/// at `rotation` (random per point, so neighbouring pixels do not share one pattern) and
+/// turns by the golden angle from each sample to the next.
+///
+/// The turn multiplies a unit vector rather than calling a sine and a cosine per sample
+/// (they were about 2.7 % of a soft-shadow frame). In f64 the vector drifts from the exact
+/// angle i × golden angle + rotation by far less than an f32 rounding, whatever `n`.
+pub struct DiscSpiral {
+    i: u32,
+    n: u32,
+    angle: (f64, f64),
+}
+
+impl DiscSpiral {
+    pub fn new(n: u32, rotation: f32) -> Self {
+        let (sin, cos) = rotation.sin_cos();
+        DiscSpiral {
+            i: 0,
+            n,
+            angle: (cos as f64, sin as f64),
+        }
+    }
+
+    /// The next sample, its radius jittered within its stratum by `jitter` in [0, 1).
+    pub fn next(&mut self, jitter: f32) -> (f32, f32) {
+        let area = ((self.i as f32 + jitter) / self.n as f32).min(1.0);
+        let r = area.sqrt();
+        let (c, s) = self.angle;
+        let (gc, gs) = GOLDEN_TURN;
+        self.angle = (c * gc - s * gs, c * gs + s * gc);
+        self.i += 1;
+        (r * c as f32, r * s as f32)
+    }
 }
 
 #[cfg(test)]
@@ -159,9 +186,35 @@ mod tests {
 
     #[test]
     fn disc_samples_stay_in_the_disc() {
-        for i in 0..64 {
-            let (x, y) = disc_sample(i, 64, 0.999, 1.0);
+        let mut spiral = DiscSpiral::new(64, 1.0);
+        for _ in 0..64 {
+            let (x, y) = spiral.next(0.999);
             assert!(x * x + y * y <= 1.0 + 1e-6);
         }
+    }
+
+    /// The turned vector keeps to the spiral's definition, the angle i × golden angle +
+    /// rotation, to within f32 rounding even after thousands of turns.
+    #[test]
+    fn disc_spiral_angles_follow_the_golden_angle() {
+        let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+        for rotation in [0.0f32, 1.0, 3.5, 6.2] {
+            let n = 4096;
+            let mut spiral = DiscSpiral::new(n, rotation);
+            for i in 0..n {
+                let jitter = 0.5;
+                let (x, y) = spiral.next(jitter);
+                let r = ((i as f64 + 0.5) / n as f64).sqrt();
+                let phi = i as f64 * golden + rotation as f64;
+                let (ex, ey) = (r * phi.cos(), r * phi.sin());
+                assert!(
+                    (x as f64 - ex).abs() < 3e-7 && (y as f64 - ey).abs() < 3e-7,
+                    "sample {i}, rotation {rotation}: ({x}, {y}) against ({ex}, {ey})"
+                );
+            }
+        }
+        // The first sample of one is the disc's centre stratum at the rotation itself.
+        let (x, y) = DiscSpiral::new(1, 0.0).next(0.25);
+        assert_eq!((x, y), (0.5, 0.0));
     }
 }

@@ -156,7 +156,7 @@ fn cos_half(light: &Light) -> f32 {
 pub(crate) mod tests {
     use super::*;
     use crate::integrator::shadow_ray;
-    use crate::sampling::{disc_sample, Rng};
+    use crate::sampling::{DiscSpiral, Rng};
     use formats::Shadows;
 
     /// The rule one sample at a time, as the renderer ran it before samples were built
@@ -247,13 +247,13 @@ pub(crate) mod tests {
             let ng = if case % 2 == 0 { Vec3::Y } else { -Vec3::Y };
             let (above, below) = (p + ng * 1e-4, p - ng * 1e-4);
             let cone = SoftCone::new(&l, p, towards, ng, above, below);
-            let rotation = u(0.0, std::f32::consts::TAU);
             let n = [1, 4, 16, 3][case / 3 % 4];
+            let mut spiral = DiscSpiral::new(n, u(0.0, std::f32::consts::TAU));
             let draws: Vec<(f32, f32)> = (0..n)
-                .map(|i| match case % 11 {
+                .map(|_| match case % 11 {
                     0 => (0.0, 0.0),
                     1 => (1.0, 0.0),
-                    _ => disc_sample(i, n, u(0.0, 1.0), rotation),
+                    _ => spiral.next(u(0.0, 1.0)),
                 })
                 .collect();
             for group in draws.chunks(LANES) {
