@@ -122,6 +122,17 @@ impl<'a> SoftCone<'a> {
         let (above, below) = (splat(self.above), splat(self.below));
         let origin: Lanes3 =
             std::array::from_fn(|a| Vec4::select(leaves_below, below[a], above[a]));
+        let lane = |v: &Lanes3, l: usize| Vec3::new(v[0][l], v[1][l], v[2][l]);
+        if self.light.kind == LightKind::Directional {
+            // Unbounded rays along the sample's direction: nothing to re-aim.
+            let rays = std::array::from_fn(|l| Ray {
+                origin: lane(&origin, l),
+                dir: lane(&dir, l),
+                tmin: SPAWN_TMIN,
+                tmax: f32::INFINITY,
+            });
+            return (rays, live);
+        }
         // Towards a light at a distance, re-aimed and re-measured from the spawned origin
         // and stopped short of the light (`integrator::shadow_ray`).
         let p = splat(self.p);
@@ -129,7 +140,8 @@ impl<'a> SoftCone<'a> {
         let d = sqrt(dot(&to, &to));
         let aimed: Lanes3 = std::array::from_fn(|a| to[a] / d);
         let tmax = d * SHADOW_TMAX_FRACTION;
-        let lane = |v: &Lanes3, l: usize| Vec3::new(v[0][l], v[1][l], v[2][l]);
+        // A distance that overflowed to infinity leaves the ray unbounded, as a directional
+        // light's.
         let rays = std::array::from_fn(|l| {
             let far = dist[l].is_infinite();
             Ray {
