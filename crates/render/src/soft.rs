@@ -122,34 +122,29 @@ impl<'a> SoftCone<'a> {
         let (above, below) = (splat(self.above), splat(self.below));
         let origin: Lanes3 =
             std::array::from_fn(|a| Vec4::select(leaves_below, below[a], above[a]));
-        let lane = |v: &Lanes3, l: usize| Vec3::new(v[0][l], v[1][l], v[2][l]);
-        if self.light.kind == LightKind::Directional {
-            // Unbounded rays along the sample's direction: nothing to re-aim.
-            let rays = std::array::from_fn(|l| Ray {
-                origin: lane(&origin, l),
-                dir: lane(&dir, l),
-                tmin: SPAWN_TMIN,
-                tmax: f32::INFINITY,
-            });
-            return (rays, live);
-        }
         // Towards a light at a distance, re-aimed and re-measured from the spawned origin
-        // and stopped short of the light (`integrator::shadow_ray`).
-        let p = splat(self.p);
-        let to: Lanes3 = std::array::from_fn(|a| p[a] + dir[a] * dist - origin[a]);
-        let d = sqrt(dot(&to, &to));
-        let aimed: Lanes3 = std::array::from_fn(|a| to[a] / d);
-        let tmax = d * SHADOW_TMAX_FRACTION;
-        // A distance that overflowed to infinity leaves the ray unbounded, as a directional
-        // light's.
-        let rays = std::array::from_fn(|l| {
-            let far = dist[l].is_infinite();
-            Ray {
-                origin: lane(&origin, l),
-                dir: lane(if far { &dir } else { &aimed }, l),
-                tmin: SPAWN_TMIN,
-                tmax: if far { f32::INFINITY } else { tmax[l] },
-            }
+        // and stopped short of the light (`integrator::shadow_ray`). An infinite distance (a
+        // directional light, or a point light's that overflowed) leaves the ray unbounded
+        // along the sample's direction, so a directional light skips the re-aim.
+        let (aimed, tmax) = if self.light.kind == LightKind::Directional {
+            (dir, Vec4::INFINITY)
+        } else {
+            let p = splat(self.p);
+            let to: Lanes3 = std::array::from_fn(|a| p[a] + dir[a] * dist - origin[a]);
+            let d = sqrt(dot(&to, &to));
+            // `dist` is a square root: +∞ when infinite, never −∞.
+            let far = dist.cmpeq(Vec4::INFINITY);
+            (
+                std::array::from_fn(|a| Vec4::select(far, dir[a], to[a] / d)),
+                Vec4::select(far, Vec4::INFINITY, d * SHADOW_TMAX_FRACTION),
+            )
+        };
+        let lane = |v: &Lanes3, l: usize| Vec3::new(v[0][l], v[1][l], v[2][l]);
+        let rays = std::array::from_fn(|l| Ray {
+            origin: lane(&origin, l),
+            dir: lane(&aimed, l),
+            tmin: SPAWN_TMIN,
+            tmax: tmax[l],
         });
         (rays, live)
     }
