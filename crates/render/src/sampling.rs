@@ -44,6 +44,23 @@ impl Rng {
         xorshifted.rotate_right(rot)
     }
 
+    /// Skips `n` draws in O(log n) steps (PCG's jump ahead: `n` steps of the LCG composed
+    /// by repeated squaring), so that work skipped does not shift the numbers drawn after it.
+    pub fn advance(&mut self, mut n: u64) {
+        let (mut mul, mut inc) = (Self::MUL, Self::INC);
+        let (mut acc_mul, mut acc_inc) = (1u64, 0u64);
+        while n > 0 {
+            if n & 1 == 1 {
+                acc_mul = acc_mul.wrapping_mul(mul);
+                acc_inc = acc_inc.wrapping_mul(mul).wrapping_add(inc);
+            }
+            inc = mul.wrapping_add(1).wrapping_mul(inc);
+            mul = mul.wrapping_mul(mul);
+            n >>= 1;
+        }
+        self.state = acc_mul.wrapping_mul(self.state).wrapping_add(acc_inc);
+    }
+
     /// Uniform in [0, 1): 24 random bits, so the result is exactly representable.
     pub fn next_f32(&mut self) -> f32 {
         (self.next_u32() >> 8) as f32 * (1.0 / 16_777_216.0)
@@ -113,6 +130,8 @@ pub struct DiscSpiral {
     i: u32,
     n: u32,
     angle: (f64, f64),
+    /// (cos, sin) of the rotation.
+    start: (f32, f32),
 }
 
 impl DiscSpiral {
@@ -122,7 +141,15 @@ impl DiscSpiral {
             i: 0,
             n,
             angle: (cos as f64, sin as f64),
+            start: (cos, sin),
         }
+    }
+
+    /// Four points of the disc's rim a quarter turn apart, the first at the rotation, as
+    /// (x, y) lanes: the probe that asks whether a light's whole extent is seen alike.
+    pub fn rim4(&self) -> ([f32; 4], [f32; 4]) {
+        let (c, s) = self.start;
+        ([c, -s, -c, s], [s, c, -s, -c])
     }
 
     /// The next sample, its radius jittered within its stratum by `jitter` in [0, 1).
@@ -182,6 +209,28 @@ mod tests {
     #[test]
     fn one_sample_is_the_pixel_centre() {
         assert_eq!(pixel_samples(1, &mut Rng::new(1)), vec![(0.5, 0.5)]);
+    }
+
+    #[test]
+    fn advance_skips_as_many_draws() {
+        for n in [0u64, 1, 2, 3, 16, 17, 1000] {
+            let (mut a, mut b) = (Rng::new(42), Rng::new(42));
+            for _ in 0..n {
+                a.next_u32();
+            }
+            b.advance(n);
+            assert_eq!(a.next_u32(), b.next_u32(), "n {n}");
+        }
+    }
+
+    #[test]
+    fn rim_probe_is_a_quarter_turn_apart_on_the_rim() {
+        let rotation = 0.7f32;
+        let (x, y) = DiscSpiral::new(16, rotation).rim4();
+        for k in 0..4 {
+            let phi = rotation + k as f32 * std::f32::consts::FRAC_PI_2;
+            assert!((x[k] - phi.cos()).abs() < 1e-6 && (y[k] - phi.sin()).abs() < 1e-6);
+        }
     }
 
     #[test]
