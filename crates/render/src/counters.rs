@@ -25,6 +25,9 @@ pub struct RayCounts {
     /// Soft-shadow samples (counted in `soft_shadow`) found blocked by the opaque caster
     /// that blocked an earlier sample of the same point: one triangle test, no walk.
     pub shadow_reuse: u64,
+    /// Soft shadows decided by their four rim probes (counted in `soft_shadow`), which
+    /// let the same share of the light through, so that no sample was traced.
+    pub soft_decided: u64,
     /// Albedo lookups at shaded points.
     pub texture_lookups: u64,
     /// Alpha lookups: cut-out tests inside the traversals and blended surfaces' alpha where
@@ -46,6 +49,7 @@ impl RayCounts {
         self.blend_continuation += o.blend_continuation;
         self.shadow_blend += o.shadow_blend;
         self.shadow_reuse += o.shadow_reuse;
+        self.soft_decided += o.soft_decided;
         self.texture_lookups += o.texture_lookups;
         self.alpha_lookups += o.alpha_lookups;
         self.sanitized += o.sanitized;
@@ -67,6 +71,7 @@ pub struct SharedCounts {
     blend_continuation: AtomicU64,
     shadow_blend: AtomicU64,
     shadow_reuse: AtomicU64,
+    soft_decided: AtomicU64,
     texture_lookups: AtomicU64,
     alpha_lookups: AtomicU64,
     sanitized: AtomicU64,
@@ -85,6 +90,7 @@ impl SharedCounts {
             .fetch_add(c.blend_continuation, Relaxed);
         self.shadow_blend.fetch_add(c.shadow_blend, Relaxed);
         self.shadow_reuse.fetch_add(c.shadow_reuse, Relaxed);
+        self.soft_decided.fetch_add(c.soft_decided, Relaxed);
         self.texture_lookups.fetch_add(c.texture_lookups, Relaxed);
         self.alpha_lookups.fetch_add(c.alpha_lookups, Relaxed);
         self.sanitized.fetch_add(c.sanitized, Relaxed);
@@ -100,6 +106,7 @@ impl SharedCounts {
             blend_continuation: self.blend_continuation.load(Relaxed),
             shadow_blend: self.shadow_blend.load(Relaxed),
             shadow_reuse: self.shadow_reuse.load(Relaxed),
+            soft_decided: self.soft_decided.load(Relaxed),
             texture_lookups: self.texture_lookups.load(Relaxed),
             alpha_lookups: self.alpha_lookups.load(Relaxed),
             sanitized: self.sanitized.load(Relaxed),

@@ -564,12 +564,13 @@ fn zip_chunk(scratch: &mut ZipScratch, headers: &[Header], index: BlockIndex) ->
 /// pixels, the scene (its geometry, and the soup's checksum, which also covers materials,
 /// lights and camera), the tree's build parameters and the renderer's version. Crops that
 /// differ in any of them may still cover the image without a gap or a disagreeing overlap.
-const SAME_RENDER: [&str; 10] = [
+const SAME_RENDER: [&str; 11] = [
     "spp",
     "depth",
     "seed",
     "geometryHash",
     "softSamples",
+    "softProbe",
     "cutoff",
     "textureFilter",
     "soupDigest",
@@ -1050,9 +1051,15 @@ mod tests {
     }
 
     #[test]
-    fn merge_names_the_input_of_another_soup_tree_or_texture_filter() {
+    fn merge_names_the_input_of_another_soup_tree_texture_filter_or_probe() {
         let (left, right) = halves();
-        for key in ["soupDigest", "treeParams", "version", "textureFilter"] {
+        for key in [
+            "soupDigest",
+            "treeParams",
+            "version",
+            "textureFilter",
+            "softProbe",
+        ] {
             let a = crop(left, &[(key, "1")]);
             let b = crop(right, &[(key, "2")]);
             let err = merge_labelled(&[("a.exr".into(), &a), ("b.exr".into(), &b)])

@@ -61,6 +61,7 @@ pub fn header_attributes(
     a.insert(format!("{p}depth"), opts.depth.to_string());
     a.insert(format!("{p}seed"), opts.seed.to_string());
     a.insert(format!("{p}softSamples"), opts.soft_samples.to_string());
+    a.insert(format!("{p}softProbe"), opts.soft_probe.to_string());
     a.insert(format!("{p}cutoff"), opts.cutoff.to_string());
     a.insert(format!("{p}textureFilter"), opts.texture_filter.to_string());
     a.insert(format!("{p}renderSeconds"), format!("{seconds:.6}"));

@@ -110,6 +110,9 @@ pub struct RenderOptions {
     pub seed: u64,
     /// Shadow rays per soft-shadow light per shading point.
     pub soft_samples: u32,
+    /// Ask four rays towards the rim of a soft-shadow light's extent first, and take their
+    /// answer when all four let the same share of light through.
+    pub soft_probe: bool,
     /// Reflection rays are traced only while the path weight (the product of the
     /// reflectances met so far, largest channel) is at least this.
     pub cutoff: f32,
@@ -134,6 +137,7 @@ impl Default for RenderOptions {
             spp: 1,
             seed: 0,
             soft_samples: 16,
+            soft_probe: true,
             cutoff: 0.004,
             crop: None,
             aovs: AovSet::default(),

@@ -583,12 +583,17 @@ fn light_plan(l: &formats::Light, diffuse: bool, opts: &RenderOptions) -> LightP
             ShadowMode::Soft,
             opts.soft_samples,
             format!(
-                "soft shadows: {} samples over a {}",
+                "soft shadows: {} samples over a {}{}",
                 opts.soft_samples,
                 if matches!(l.kind, LightKind::Directional) {
                     format!("{}° cone", l.shadow_radius)
                 } else {
                     format!("disc of radius {} m", l.shadow_radius)
+                },
+                if opts.soft_probe && opts.soft_samples > 4 {
+                    ", where 4 probes of its rim disagree"
+                } else {
+                    ""
                 }
             ),
         ),

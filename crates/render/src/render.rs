@@ -74,7 +74,7 @@ pub fn render(
     // The samplers are built on the render's own threads too.
     let run = || {
         let setup = Instant::now();
-        let integrator = Integrator::new(soup, accel, plan, opts.soft_samples, opts.texture_filter);
+        let integrator = Integrator::new(soup, accel, plan, opts);
         let setup_seconds = setup.elapsed().as_secs_f64();
         let start = Instant::now();
         let (frame, counts) = render_tiles(&camera, &integrator, opts, window, progress);

@@ -3,11 +3,12 @@
 use super::sweep::SceneResult;
 use plotters::prelude::*;
 
-const KNOBS: [(&str, RGBColor); 6] = [
+const KNOBS: [(&str, RGBColor); 7] = [
     ("spp", RGBColor(31, 119, 180)),
     ("depth", RGBColor(255, 127, 14)),
     ("cutoff", RGBColor(44, 160, 44)),
     ("soft", RGBColor(214, 39, 40)),
+    ("probe", RGBColor(23, 190, 207)),
     ("tree", RGBColor(148, 103, 189)),
     ("texture", RGBColor(140, 86, 75)),
 ];

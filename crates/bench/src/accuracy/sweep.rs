@@ -70,6 +70,7 @@ pub fn reference_options(cfg: &Config) -> RenderOptions {
         spp: cfg.reference_spp,
         depth: cfg.reference_depth,
         soft_samples: cfg.reference_soft,
+        soft_probe: false,
         cutoff: 0.0,
         seed: 0x0005_eed0_f4ef,
         texture_filter: TextureFilter::Bilinear,
@@ -81,7 +82,7 @@ pub fn reference_options(cfg: &Config) -> RenderOptions {
 #[derive(Clone, Debug)]
 pub struct Point {
     pub scene: String,
-    /// `spp`, `depth`, `cutoff`, `soft`, `texture`, `tree`.
+    /// `spp`, `depth`, `cutoff`, `soft`, `probe`, `texture`, `tree`.
     pub knob: &'static str,
     pub value: String,
     /// Whether this point is the renderer's default setting of the knob.
@@ -255,8 +256,11 @@ pub fn measure(scene: &Scene, cfg: &Config, log: &dyn Fn(&str)) -> Result<SceneR
         depth: cfg.reference_depth,
         ..base.clone()
     };
+    // Soft samples are swept with every sample traced; the rim probe is the `probe` knob,
+    // at the default sample count, against that count with every sample traced.
     let soft_opts = |soft_samples| RenderOptions {
         soft_samples,
+        soft_probe: false,
         ..base.clone()
     };
     let anchor = |o: RenderOptions| render_once(scene, &accel, &o).map(|r| r.0);
@@ -277,6 +281,16 @@ pub fn measure(scene: &Scene, cfg: &Config, log: &dyn Fn(&str)) -> Result<SceneR
         let o = soft_opts(soft);
         let d = soft == base.soft_samples;
         point("soft", soft.to_string(), d, &accel, &o, None, Some(&a))?;
+    }
+    let a = anchor(soft_opts(base.soft_samples))?;
+    for soft_probe in [true, false] {
+        let o = RenderOptions {
+            soft_probe,
+            ..base.clone()
+        };
+        let v = if soft_probe { "on" } else { "off" };
+        let d = soft_probe == base.soft_probe;
+        point("probe", v.into(), d, &accel, &o, None, Some(&a))?;
     }
     if Plan::derive(&scene.soup, &base).textures.enabled {
         for &f in &cfg.texture_filter {

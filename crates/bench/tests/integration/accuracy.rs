@@ -95,6 +95,7 @@ fn bias_is_measured_against_the_sweeps_most_accurate_setting() {
     assert_eq!(bias("depth", "8"), 0.0);
     assert_eq!(bias("cutoff", "0"), 0.0);
     assert_eq!(bias("soft", "64"), 0.0);
+    assert_eq!(bias("probe", "off"), 0.0);
     // The floor is a mirror: without reflections it shows no reflection of the wall; one
     // soft-shadow sample is noisier than 64.
     assert!(bias("depth", "0") > bias("depth", "1"), "{:?}", r.points);

@@ -97,6 +97,10 @@ struct RenderArgs {
     /// Shadow rays per soft-shadow light per shading point.
     #[arg(long, default_value_t = RenderOptions::default().soft_samples)]
     soft_samples: u32,
+    /// Trace every soft-shadow sample, even where four probe rays towards the rim of the
+    /// light's extent all let the same share of light through (wholly lit or in shadow).
+    #[arg(long)]
+    soft_all: bool,
     /// Stop reflection rays when the path weight falls below this.
     #[arg(long, default_value_t = RenderOptions::default().cutoff)]
     cutoff: f32,
@@ -193,6 +197,7 @@ fn run(a: RenderArgs) -> Result<()> {
         spp: a.spp,
         seed: a.seed,
         soft_samples: a.soft_samples,
+        soft_probe: !a.soft_all,
         cutoff: a.cutoff,
         crop: a.crop,
         aovs: match &a.aov {
@@ -285,7 +290,7 @@ fn run(a: RenderArgs) -> Result<()> {
         opts.width, opts.height, window, opts.spp, opts.depth, out.seconds, mrays, load_seconds, out.setup_seconds, write_seconds
     );
     eprintln!(
-        "kd2exr: rays: camera {}, shadow {}, soft_shadow {}, reflection {}, blend_continuation {}, pass_through {}, shadow_pass_through {}, shadow_blend {}, shadow_reuse {} (total {})",
+        "kd2exr: rays: camera {}, shadow {}, soft_shadow {}, reflection {}, blend_continuation {}, pass_through {}, shadow_pass_through {}, shadow_blend {}, shadow_reuse {}, soft_decided {} (total {})",
         c.camera,
         c.shadow,
         c.soft_shadow,
@@ -295,6 +300,7 @@ fn run(a: RenderArgs) -> Result<()> {
         c.shadow_pass_through,
         c.shadow_blend,
         c.shadow_reuse,
+        c.soft_decided,
         c.total()
     );
     if c.texture_lookups + c.alpha_lookups > 0 {

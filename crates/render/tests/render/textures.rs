@@ -122,8 +122,12 @@ fn only_the_textures_a_used_material_reads_get_mip_levels() {
         (1, vec![true, false])
     );
     let accel = kdtree::Accel::new(&soup, kd).expect("tree fits");
-    let it =
-        render::integrator::Integrator::new(&soup, &accel, &plan, 16, render::TextureFilter::Cone);
+    let it = render::integrator::Integrator::new(
+        &soup,
+        &accel,
+        &plan,
+        &render::RenderOptions::default(),
+    );
     // The 2×2 image's 1×1 level: one texel of linear RGBA f32; none of the 4×4 image's.
     assert_eq!((plan.textures.bytes, it.texture_bytes()), (16, 16));
 }
