@@ -1275,7 +1275,8 @@ impl<'a> Integrator<'a> {
     /// sample is traced. Most points are wholly lit or wholly in shadow, and an edge that
     /// hides part of the extent hides part of its rim too unless it cuts off less than a
     /// tenth of the disc (the largest segment that misses four rim points a quarter turn
-    /// apart) or a caster lies wholly inside it. Otherwise the samples are traced as
+    /// apart) or a caster or a gap narrower than the disc slips between the probes: those
+    /// are the probe's errors (`--soft-all` has none). Otherwise the samples are traced as
     /// without the probe, which does not count in the answer; the samples' random numbers
     /// are skipped when the probe decides, so every other point draws what it draws
     /// without the probe.
