@@ -530,6 +530,24 @@ fn is_square(n: u32) -> bool {
     k * k == n
 }
 
+/// Where a soft light's samples are probed at its rim first (`soft::probe_fits`): a
+/// clause for the plan's reason, empty where they never are.
+fn rim_probe(l: &formats::Light, opts: &RenderOptions) -> String {
+    if !opts.soft_probe || opts.soft_samples <= 4 {
+        return String::new();
+    }
+    match l.kind {
+        LightKind::Directional if crate::soft::probe_fits(l, f32::INFINITY) => {
+            ", where 4 probes of its rim disagree".into()
+        }
+        LightKind::Directional => String::new(),
+        LightKind::Point | LightKind::Spot { .. } => format!(
+            ", where 4 probes of its rim disagree at points {:.2} m away or more",
+            crate::soft::probe_distance(l)
+        ),
+    }
+}
+
 fn light_plan(l: &formats::Light, diffuse: bool, opts: &RenderOptions) -> LightPlan {
     let kind = match l.kind {
         LightKind::Point => "point",
@@ -590,11 +608,7 @@ fn light_plan(l: &formats::Light, diffuse: bool, opts: &RenderOptions) -> LightP
                 } else {
                     format!("disc of radius {} m", l.shadow_radius)
                 },
-                if opts.soft_probe && opts.soft_samples > 4 {
-                    ", where 4 probes of its rim disagree"
-                } else {
-                    ""
-                }
+                rim_probe(l, opts)
             ),
         ),
     };

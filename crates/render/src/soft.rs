@@ -150,6 +150,32 @@ impl<'a> SoftCone<'a> {
     }
 }
 
+/// The widest angular radius of a light's extent, seen from the shaded point, that the
+/// soft-shadow rim probe is asked about, in degrees. A caster, or a gap between casters,
+/// can slip between the four probes only if it is narrower than the extent, so the probe
+/// can miss only features under 4° across as seen from the point; from wider extents (a
+/// large lamp close by) it would miss the shadows of whole objects, and every sample is
+/// traced. The sun is 0.53° across; Unity's directional soft lights import as 1° cones
+/// unless they set an angle.
+pub(crate) const PROBE_MAX_DEGREES: f32 = 2.0;
+
+/// tan(`PROBE_MAX_DEGREES`), for lights at a distance.
+const PROBE_MAX_TAN: f32 = 0.034_920_77;
+
+/// Whether a light's extent seen from a point `dist` away (infinite: directional) is
+/// narrow enough for the rim probe.
+pub(crate) fn probe_fits(light: &Light, dist: f32) -> bool {
+    match light.kind {
+        LightKind::Directional => light.shadow_radius * 0.5 <= PROBE_MAX_DEGREES,
+        LightKind::Point | LightKind::Spot { .. } => light.shadow_radius <= dist * PROBE_MAX_TAN,
+    }
+}
+
+/// The distance from which a point or spot light's disc is narrow enough for the probe.
+pub(crate) fn probe_distance(light: &Light) -> f32 {
+    light.shadow_radius / PROBE_MAX_TAN
+}
+
 /// The cosine of the half angle of a directional light's soft-shadow cone (its
 /// `shadow_radius` is the cone's angular diameter in degrees, at most a hemisphere).
 fn cos_half(light: &Light) -> f32 {
@@ -195,6 +221,19 @@ pub(crate) mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn the_probe_asks_extents_up_to_two_degrees_in_radius() {
+        let tan = (PROBE_MAX_DEGREES as f64).to_radians().tan();
+        assert!((PROBE_MAX_TAN as f64 - tan).abs() < 1e-8);
+        let point = light(LightKind::Point, Vec3::ZERO, 0.1);
+        assert!(probe_fits(&point, 2.9) && !probe_fits(&point, 2.8));
+        assert!((probe_distance(&point) - 2.8636).abs() < 1e-3);
+        let mut sun = light(LightKind::Directional, Vec3::ZERO, 4.0);
+        assert!(probe_fits(&sun, f32::INFINITY));
+        sun.shadow_radius = 4.1;
+        assert!(!probe_fits(&sun, f32::INFINITY));
     }
 
     fn light(kind: LightKind, position: Vec3, shadow_radius: f32) -> Light {

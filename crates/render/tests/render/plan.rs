@@ -172,10 +172,9 @@ fn no_soft_light_means_no_soft_shadow_rays_and_soft_lights_blur_the_edge() {
     let (soft, plan) = render(&soup, &kd, &o);
     assert_eq!(plan.lights[0].shadows, ShadowMode::Soft);
     assert_eq!(soft.counts.shadow, 0);
-    // Four rim probes at every point; 16 samples where they disagree.
-    let probed = 1600 - soft.counts.soft_decided;
-    assert_eq!(soft.counts.soft_shadow, 1600 * 4 + probed * 16);
-    assert!(probed > 20 && probed < 400, "{probed} points sampled");
+    // A 0.5 m disc 4 m away is wider than the rim probe asks about: every sample traced.
+    assert_eq!(soft.counts.soft_shadow, 1600 * 16);
+    assert_eq!(soft.counts.soft_decided, 0);
 
     // Unshadowed reference: the same scene without shadows.
     let (soup_n, kd_n) = shadow_scene(Shadows::None, 0.0).build();
@@ -211,9 +210,8 @@ fn soft_directional_shadows_sample_a_cone() {
     o.soft_samples = 9;
     let (out, plan) = render(&soup, &kd, &o);
     assert_eq!(plan.lights[0].shadow_rays, 9);
-    let probed = 1600 - out.counts.soft_decided;
-    assert_eq!(out.counts.soft_shadow, 1600 * 4 + probed * 9);
-    assert!(probed > 10 && probed < 400, "{probed} points sampled");
+    // A 10° cone is wider than the rim probe asks about.
+    assert_eq!(out.counts.soft_shadow, 1600 * 9);
     let full = 0.5 * 0.8;
     let partial = out
         .frame
