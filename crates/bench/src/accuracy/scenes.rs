@@ -301,6 +301,29 @@ pub fn with_checker(scene: &Scene) -> Scene {
     }
 }
 
+/// `scene` lit by a sun with soft shadows over a cone `cone` degrees across instead of its
+/// own lights: at 4° the widest light the renderer's soft-shadow rim probe is asked about,
+/// so the sweep measures what the probe costs in accuracy where it can cost most.
+pub fn with_sun(scene: &Scene, name: &str, cone: f32) -> Scene {
+    let mut soup = scene.soup.clone();
+    soup.lights = vec![Light {
+        name: "sun".into(),
+        kind: LightKind::Directional,
+        position: Vec3::ZERO,
+        direction: Vec3::new(-0.4, -1.0, 0.3).normalize(),
+        color: Vec3::ONE,
+        intensity: 1.0,
+        range: 0.0,
+        shadows: Shadows::Soft,
+        shadow_radius: cone,
+        culling_mask: u32::MAX,
+    }];
+    Scene {
+        name: name.into(),
+        soup,
+    }
+}
+
 /// A tiny scene for tests: a mirror floor, a diffuse box-less wall and a floating
 /// triangle casting a soft shadow from a point light.
 pub fn tiny() -> Scene {

@@ -31,7 +31,7 @@ struct Args {
     /// (baseline-textured).
     #[arg(long, value_name = "DIR")]
     export: Option<PathBuf>,
-    /// Sweep only these scenes (comma-separated names: baseline, shadows-soft,
+    /// Sweep only these scenes (comma-separated names: baseline, shadows-soft, sun-soft,
     /// spot-on-mirror, checkerboard).
     #[arg(long, value_delimiter = ',')]
     only: Vec<String>,
@@ -65,6 +65,7 @@ fn run() -> Result<()> {
                 .join("scenes/shadows-soft/Assets/Scenes/ShadowsSoft.unity"),
         )?,
     ];
+    list.push(scenes::with_sun(&list[1], "sun-soft", 4.0));
     let spot = a.root.join("../shared/corpus/meshes/spot.obj");
     if spot.exists() {
         list.push(scenes::mesh_on_mirror(&spot)?);
