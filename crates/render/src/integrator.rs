@@ -32,7 +32,7 @@ use crate::offset::{
 };
 use crate::plan::{colour_mapped, Plan, ShadowMode};
 use crate::sampling::{DiscSpiral, Rng};
-use crate::soft::{probe_fits, SoftCone};
+use crate::soft::{probe_asked, probe_fits, SoftCone};
 use crate::texture::{cone_footprint, Sampler};
 use crate::RenderOptions;
 use crate::TextureFilter;
@@ -201,6 +201,7 @@ pub struct Integrator<'a> {
     max_depth: u32,
     cutoff: f32,
     soft_samples: u32,
+    /// The render probes soft shadows at their rim (`soft::probe_asked`).
     soft_probe: bool,
     /// Camera and reflection rays check their hits against the culling rules.
     culling: bool,
@@ -328,7 +329,7 @@ impl<'a> Integrator<'a> {
             },
             cutoff: plan.reflections.cutoff,
             soft_samples: opts.soft_samples,
-            soft_probe: opts.soft_probe,
+            soft_probe: probe_asked(opts),
             culling: plan.culling.enabled,
             shadow_filter,
             alpha,
@@ -1270,9 +1271,10 @@ impl<'a> Integrator<'a> {
     /// diameter `shadow_radius` degrees around the light direction (directional).
     ///
     /// With the probe on, more samples than one packet and an extent at most 2° in angular
-    /// radius ([`crate::soft::PROBE_MAX_DEGREES`]), four rays towards the rim of the extent go first: if all four let the same share of the light through (all reach
-    /// it, all are stopped, or all pass the same blended layers), that is the answer and no
-    /// sample is traced. Most points are wholly lit or wholly in shadow, and an edge that
+    /// radius ([`crate::soft::PROBE_MAX_DEGREES`]), four rays towards the rim of the extent
+    /// go first: if all four let the same share of the light through (all reach it, all
+    /// are stopped, or all pass the same blended layers), that is the answer and no sample
+    /// is traced. Most points are wholly lit or wholly in shadow, and an edge that
     /// hides part of the extent hides part of its rim too unless it cuts off less than a
     /// tenth of the disc (the largest segment that misses four rim points a quarter turn
     /// apart) or a caster or a gap narrower than the disc slips between the probes: those
@@ -1299,7 +1301,7 @@ impl<'a> Integrator<'a> {
         let mut visible = 0.0f32;
         // An opaque caster that stopped a probe is a good first guess for the samples.
         let mut blocker = None;
-        if self.soft_probe && n > LANES as u32 && probe_fits(light, inc.dist) {
+        if self.soft_probe && probe_fits(light, inc.dist) {
             let (dx, dy) = spiral.rim4();
             let (rays, traced) = cone.rays4(dx, dy);
             counts.soft_shadow += LANES as u64;

@@ -533,7 +533,7 @@ fn is_square(n: u32) -> bool {
 /// Where a soft light's samples are probed at its rim first (`soft::probe_fits`): a
 /// clause for the plan's reason, empty where they never are.
 fn rim_probe(l: &formats::Light, opts: &RenderOptions) -> String {
-    if !opts.soft_probe || opts.soft_samples <= 4 {
+    if !crate::soft::probe_asked(opts) {
         return String::new();
     }
     match l.kind {

@@ -12,6 +12,7 @@
 
 use crate::lights::basis;
 use crate::offset::{SHADOW_TMAX_FRACTION, SPAWN_TMIN};
+use crate::RenderOptions;
 use formats::{Light, LightKind};
 use glam::{Vec3, Vec4};
 use kdtree::{Ray, LANES};
@@ -161,6 +162,11 @@ pub(crate) const PROBE_MAX_DEGREES: f32 = 2.0;
 
 /// tan(`PROBE_MAX_DEGREES`), for lights at a distance.
 const PROBE_MAX_TAN: f32 = 0.034_920_77;
+
+/// Whether a render probes at all: asked to, with more samples than the probe's one packet.
+pub(crate) fn probe_asked(opts: &RenderOptions) -> bool {
+    opts.soft_probe && opts.soft_samples > LANES as u32
+}
 
 /// Whether a light's extent seen from a point `dist` away (infinite: directional) is
 /// narrow enough for the rim probe.
