@@ -9,6 +9,7 @@ pub mod error;
 pub mod kd;
 pub mod rays;
 pub mod soup;
+pub mod srgb;
 pub mod texture;
 
 pub use envelope::write_atomic;
