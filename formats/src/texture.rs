@@ -8,8 +8,10 @@
 //! the lookup through [`decode_u8`] is exact (a table, not a re-quantisation).
 //!
 //! Mip levels are not stored: they follow from the texels, so the renderer builds the
-//! levels below the full-size image once before tracing ([`Texture::halvings`]), in linear
-//! `f32` so averaging conserves energy, and reads the full-size image from these bytes.
+//! levels below the full-size image once before tracing ([`Texture::halvings`]). Each is
+//! averaged in linear `f32`, so averaging conserves energy, and kept in the image's own
+//! 8-bit encoding, as Unity keeps a texture's mip maps: a quarter of the memory of linear
+//! `f32`, and one way of reading every level.
 
 use serde::{Deserialize, Serialize};
 
@@ -97,18 +99,13 @@ impl Tiling {
     }
 }
 
-/// One mip level: linear RGBA, bottom row first.
+/// One mip level: RGBA, 8 bits per channel in its texture's encoding ([`Texture::srgb`]
+/// for the colour channels, alpha linear), bottom row first, as [`Texture::texels`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct Level {
     pub width: u32,
     pub height: u32,
-    pub texels: Vec<[f32; 4]>,
-}
-
-impl Level {
-    pub fn texel(&self, x: u32, y: u32) -> [f32; 4] {
-        self.texels[(y as usize) * (self.width as usize) + x as usize]
-    }
+    pub texels: Vec<u8>,
 }
 
 /// sRGB → linear for every 8-bit code, computed once.
@@ -148,6 +145,33 @@ pub fn decode_u8(code: u8, srgb: bool) -> f32 {
     table(srgb)[code as usize]
 }
 
+/// A linear value in [0, 1] as an 8-bit channel (clamped, NaN to 0): the nearest code
+/// of linear channels, the transfer function's rounded code of sRGB ones. Every code
+/// comes back from [`decode_u8`] as itself.
+pub fn encode_u8(linear: f32, srgb: bool) -> u8 {
+    if srgb {
+        crate::srgb::encode(linear)
+    } else {
+        encode_linear(linear)
+    }
+}
+
+#[inline]
+fn encode_linear(v: f32) -> u8 {
+    if v.is_nan() {
+        0
+    } else {
+        (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
+    }
+}
+
+/// Texel (x, y) of RGBA bytes `width` texels wide, as linear RGBA.
+#[inline]
+pub fn decode_texel(texels: &[u8], width: u32, x: u32, y: u32, srgb: bool) -> [f32; 4] {
+    let i = ((y as usize) * (width as usize) + x as usize) * 4;
+    decode_rgba(&texels[i..i + 4], table(srgb), table(false))
+}
+
 impl Texture {
     pub fn validate(&self) -> Result<(), String> {
         if self.width == 0 || self.height == 0 {
@@ -178,34 +202,148 @@ impl Texture {
     /// Texel (x, y) as linear RGBA (y = 0 is the bottom row).
     #[inline]
     pub fn texel(&self, x: u32, y: u32) -> [f32; 4] {
-        let i = ((y as usize) * (self.width as usize) + x as usize) * 4;
-        decode_rgba(&self.texels[i..i + 4], table(self.srgb), table(false))
+        decode_texel(&self.texels, self.width, x, y, self.srgb)
     }
 
     /// When mip-mapped, every halving of the image down to 1×1 (level 1 first; level 0 is
     /// the image itself, read through [`Texture::texel`]). Each texel of a level is the
-    /// mean of the (2×2, or 3 wide/high where a side is odd) texels it covers, summed in
-    /// f64 so that a constant texture stays exactly constant at every level.
+    /// mean of the (2×2, or 3 wide/high where a side is odd) linear texels it covers in the
+    /// level above, summed in f64, then encoded to 8 bits ([`encode_u8`]). The means are
+    /// taken before the level above is encoded, so rounding never compounds down the chain,
+    /// and a constant texture stays exactly constant at every level.
     pub fn halvings(&self) -> Vec<Level> {
-        let mut levels: Vec<Level> = Vec::new();
-        if !self.mipmaps || (self.width == 1 && self.height == 1) {
-            return levels;
+        let mut chain: Vec<Halving> = Vec::new();
+        let (mut w, mut h) = (self.width, self.height);
+        while self.mipmaps && (w > 1 || h > 1) {
+            chain.push(Halving::new(w, h));
+            (w, h) = ((w / 2).max(1), (h / 2).max(1));
         }
+        // The image's rows go in one by one; each row a level completes goes on into the
+        // next, so no level is ever held whole in f32, only its last two or three rows.
         let (colour, alpha) = (table(self.srgb), table(false));
         let row_bytes = self.width as usize * 4;
-        levels.push(halve(self.width, self.height, |y, row| {
-            let bytes = &self.texels[y as usize * row_bytes..][..row_bytes];
-            for (t, b) in row.iter_mut().zip(bytes.chunks_exact(4)) {
+        for y in 0..self.height as usize {
+            let Some((first, rest)) = chain.split_first_mut() else {
+                break;
+            };
+            let bytes = &self.texels[y * row_bytes..][..row_bytes];
+            for (t, b) in first.next_row().iter_mut().zip(bytes.chunks_exact(4)) {
                 *t = decode_rgba(b, colour, alpha);
             }
-        }));
-        while let Some(prev) = levels.last().filter(|l| l.width > 1 || l.height > 1) {
-            let w = prev.width as usize;
-            levels.push(halve(prev.width, prev.height, |y, row| {
-                row.copy_from_slice(&prev.texels[y as usize * w..][..w]);
-            }));
+            let mut done = first.row_filled(self.srgb);
+            for next in rest.iter_mut() {
+                let Some(row) = done else { break };
+                next.next_row().copy_from_slice(row);
+                done = next.row_filled(self.srgb);
+            }
         }
-        levels
+        chain.into_iter().map(|h| h.level).collect()
+    }
+}
+
+/// One halving while the chain is built: the rows of the level above arrive one by one
+/// (linear RGBA), and each destination row is averaged as soon as its two (or, for an odd
+/// height's last, three) source rows are in, then kept linear for the next halving and
+/// encoded into the level.
+struct Halving {
+    /// Size of the level above.
+    src: (u32, u32),
+    /// The source rows of the destination row in progress, and how many have arrived.
+    rows: [Vec<[f32; 4]>; 3],
+    arrived: usize,
+    /// The last destination row, linear, and how many rows are done.
+    row: Vec<[f32; 4]>,
+    done: u32,
+    level: Level,
+}
+
+impl Halving {
+    fn new(width: u32, height: u32) -> Halving {
+        let (w, h) = ((width / 2).max(1), (height / 2).max(1));
+        let src_row = || vec![[0f32; 4]; width as usize];
+        Halving {
+            src: (width, height),
+            rows: [src_row(), src_row(), src_row()],
+            arrived: 0,
+            row: Vec::with_capacity(w as usize),
+            done: 0,
+            level: Level {
+                width: w,
+                height: h,
+                texels: vec![0; w as usize * h as usize * 4],
+            },
+        }
+    }
+
+    /// Where the next source row goes.
+    fn next_row(&mut self) -> &mut [[f32; 4]] {
+        &mut self.rows[self.arrived]
+    }
+
+    /// Counts the row written at [`Halving::next_row`]; once a destination row's source rows
+    /// are all in, averages it (each texel sums its source texels row by row, left to right,
+    /// in f64), appends it encoded to the level and returns it linear.
+    fn row_filled(&mut self, srgb: bool) -> Option<&[[f32; 4]]> {
+        let (
+            (width, height),
+            Level {
+                width: w,
+                height: h,
+                texels,
+            },
+        ) = (self.src, &mut self.level);
+        let (y0, y1) = span(self.done, height, *h);
+        self.arrived += 1;
+        if y0 + self.arrived as u32 <= y1 {
+            return None;
+        }
+        let rows = &self.rows[..self.arrived];
+        self.arrived = 0;
+        self.row.clear();
+        // Most texels cover a 2×2 block: summed straight from two row pairs, in the order
+        // the general loop below sums them.
+        let pairs = match rows {
+            [upper, lower] if width > 1 => {
+                let pairs = (width / 2 - width % 2) as usize;
+                let blocks = upper.chunks_exact(2).zip(lower.chunks_exact(2));
+                for (a, b) in blocks.take(pairs) {
+                    self.row.push(std::array::from_fn(|c| {
+                        let sum =
+                            0.0 + a[0][c] as f64 + a[1][c] as f64 + b[0][c] as f64 + b[1][c] as f64;
+                        (sum / 4.0) as f32
+                    }));
+                }
+                pairs
+            }
+            _ => 0,
+        };
+        for x in pairs as u32..*w {
+            let (x0, x1) = span(x, width, *w);
+            let mut sum = [0f64; 4];
+            for row in rows {
+                for t in &row[x0 as usize..=x1 as usize] {
+                    for c in 0..4 {
+                        sum[c] += t[c] as f64;
+                    }
+                }
+            }
+            let n = ((x1 - x0 + 1) * (y1 - y0 + 1)) as f64;
+            self.row.push(sum.map(|s| (s / n) as f32));
+        }
+        let sr = crate::srgb::Encoder::get();
+        let colour = |v| if srgb { sr.encode(v) } else { encode_linear(v) };
+        let row_bytes = *w as usize * 4;
+        let out = &mut texels[self.done as usize * row_bytes..][..row_bytes];
+        for (b, t) in out.chunks_exact_mut(4).zip(&self.row) {
+            b.copy_from_slice(&[
+                colour(t[0]),
+                colour(t[1]),
+                colour(t[2]),
+                encode_linear(t[3]),
+            ]);
+        }
+        self.done += 1;
+        Some(&self.row)
     }
 }
 
@@ -233,57 +371,6 @@ fn span(i: u32, src: u32, dst: u32) -> (u32, u32) {
         first + 1
     };
     (first, last)
-}
-
-/// The halving of a `width`×`height` level whose rows `fill_row(y, row)` writes as linear
-/// RGBA. Each destination texel sums its source texels row by row, left to right, in f64.
-fn halve(width: u32, height: u32, mut fill_row: impl FnMut(u32, &mut [[f32; 4]])) -> Level {
-    let (w, h) = ((width / 2).max(1), (height / 2).max(1));
-    let mut texels = Vec::with_capacity(w as usize * h as usize);
-    // At most three source rows feed a destination row (an odd height's last one).
-    let mut rows = vec![vec![[0f32; 4]; width as usize]; 3.min(height as usize)];
-    for y in 0..h {
-        let (y0, y1) = span(y, height, h);
-        let rows = &mut rows[..(y1 - y0 + 1) as usize];
-        for (sy, row) in (y0..=y1).zip(rows.iter_mut()) {
-            fill_row(sy, row);
-        }
-        // Most texels cover a 2×2 block: summed straight from two row pairs, in the order
-        // the general loop below sums them.
-        let pairs = match &*rows {
-            [upper, lower] if width > 1 => {
-                let pairs = (width / 2 - width % 2) as usize;
-                let blocks = upper.chunks_exact(2).zip(lower.chunks_exact(2));
-                for (a, b) in blocks.take(pairs) {
-                    texels.push(std::array::from_fn(|c| {
-                        let sum =
-                            0.0 + a[0][c] as f64 + a[1][c] as f64 + b[0][c] as f64 + b[1][c] as f64;
-                        (sum / 4.0) as f32
-                    }));
-                }
-                pairs
-            }
-            _ => 0,
-        };
-        for x in pairs as u32..w {
-            let (x0, x1) = span(x, width, w);
-            let mut sum = [0f64; 4];
-            for row in rows.iter() {
-                for t in &row[x0 as usize..=x1 as usize] {
-                    for c in 0..4 {
-                        sum[c] += t[c] as f64;
-                    }
-                }
-            }
-            let n = ((x1 - x0 + 1) * (y1 - y0 + 1)) as f64;
-            texels.push(sum.map(|s| (s / n) as f32));
-        }
-    }
-    Level {
-        width: w,
-        height: h,
-        texels,
-    }
 }
 
 #[cfg(test)]
@@ -328,9 +415,13 @@ mod tests {
         let mips = t.halvings();
         let sizes: Vec<_> = mips.iter().map(|l| (l.width, l.height)).collect();
         assert_eq!(sizes, vec![(2, 1), (1, 1)]);
-        let c = t.texel(0, 0);
         for l in &mips {
-            assert!(l.texels.iter().all(|&x| x == c), "{}x{}", l.width, l.height);
+            assert!(
+                l.texels.chunks(4).all(|x| x == [200, 10, 77, 255]),
+                "{}x{}",
+                l.width,
+                l.height
+            );
         }
     }
 
@@ -339,14 +430,17 @@ mod tests {
         let mut t = tex(2, 1, vec![255, 255, 255, 255, 0, 0, 0, 0]);
         t.srgb = true;
         let m = t.halvings();
-        assert_eq!(m[0].texels, vec![[0.5, 0.5, 0.5, 0.5]]);
+        // Linear 0.5 is sRGB 0.7354 (187.5 rounds to 188); alpha is linear.
+        assert_eq!(m[0].texels, vec![188, 188, 188, 128]);
+        assert_eq!(decode_u8(188, true), 0.5028865);
         t.mipmaps = false;
         assert!(t.halvings().is_empty());
     }
 
-    /// Each level's texel is the mean, summed in f64 row by row, of the texels of the level
-    /// above that it covers: two per axis, three where that axis's side is odd and the
-    /// texel is the last. Checked bit for bit on odd and even sides, both encodings.
+    /// Each level's texel is the mean, summed in f64 row by row, of the linear texels of the
+    /// level above that it covers (two per axis, three where that axis's side is odd and
+    /// the texel is the last) before that level was encoded, then encoded to 8 bits.
+    /// Checked bit for bit on odd and even sides, both encodings.
     #[test]
     fn every_mip_texel_is_the_mean_of_the_texels_it_covers() {
         let mut seed = 0x9e37_79b9u32;
@@ -362,7 +456,11 @@ mod tests {
                 t.srgb = srgb;
                 let levels = t.halvings();
                 let (mut pw, mut ph) = (w, h);
-                let mut prev: Option<&Level> = None;
+                // The level above, linear and unrounded.
+                let mut prev: Vec<[f32; 4]> = (0..h)
+                    .flat_map(|y| (0..w).map(move |x| (x, y)))
+                    .map(|(x, y)| t.texel(x, y))
+                    .collect();
                 for l in &levels {
                     assert_eq!((l.width, l.height), ((pw / 2).max(1), (ph / 2).max(1)));
                     let cover = |i: u32, src: u32, dst: u32| -> std::ops::RangeInclusive<u32> {
@@ -374,6 +472,7 @@ mod tests {
                             2 * i..=2 * i + 1
                         }
                     };
+                    let mut means = Vec::new();
                     for y in 0..l.height {
                         for x in 0..l.width {
                             let (xs, ys) = (cover(x, pw, l.width), cover(y, ph, l.height));
@@ -381,25 +480,41 @@ mod tests {
                             let mut sum = [0f64; 4];
                             for sy in ys.clone() {
                                 for sx in xs.clone() {
-                                    let v = match prev {
-                                        Some(p) => p.texel(sx, sy),
-                                        None => t.texel(sx, sy),
-                                    };
+                                    let v = prev[(sy * pw + sx) as usize];
                                     for c in 0..4 {
                                         sum[c] += v[c] as f64;
                                     }
                                 }
                             }
-                            let want = sum.map(|s| (s / n) as f32);
-                            assert_eq!(l.texel(x, y), want, "{w}x{h} srgb {srgb}: ({x}, {y})");
+                            let mean = sum.map(|s| (s / n) as f32);
+                            let want = [
+                                encode_u8(mean[0], srgb),
+                                encode_u8(mean[1], srgb),
+                                encode_u8(mean[2], srgb),
+                                encode_u8(mean[3], false),
+                            ];
+                            let i = ((y * l.width + x) * 4) as usize;
+                            assert_eq!(l.texels[i..i + 4], want, "{w}x{h} srgb {srgb}: ({x}, {y})");
+                            means.push(mean);
                         }
                     }
                     (pw, ph) = (l.width, l.height);
-                    prev = Some(l);
+                    prev = means;
                 }
                 assert_eq!((pw, ph), (1, 1));
             }
         }
+    }
+
+    #[test]
+    fn every_linear_code_survives_decoding_and_encoding() {
+        for code in 0..=255u8 {
+            assert_eq!(encode_u8(decode_u8(code, false), false), code);
+            assert_eq!(encode_u8(decode_u8(code, true), true), code);
+        }
+        assert_eq!(encode_u8(f32::NAN, false), 0);
+        assert_eq!(encode_u8(-1.0, false), 0);
+        assert_eq!(encode_u8(2.0, false), 255);
     }
 
     #[test]

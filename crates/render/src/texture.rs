@@ -6,12 +6,12 @@
 //! lookup at a border blends the two texels the wrap mode makes neighbours.
 
 use crate::options::TextureFilter;
-use formats::texture::{Filter, Level, Texture, Tiling, Wrap};
+use formats::texture::{decode_texel, Filter, Level, Texture, Tiling, Wrap};
 use glam::{Vec2, Vec3, Vec4};
 
-/// A texture ready to sample: level 0 is the soup's own 8-bit image, decoded texel by
-/// texel as it is read (a table read per channel), so that the full-size image is not
-/// copied into linear floats; the smaller levels are built once, in linear RGBA f32.
+/// A texture ready to sample: level 0 is the soup's own 8-bit image, the smaller levels
+/// are built once in the same encoding ([`Texture::halvings`]); every level is decoded
+/// texel by texel as it is read (a table read per channel).
 pub struct Sampler<'a> {
     image: &'a Texture,
     mips: Vec<Level>,
@@ -20,28 +20,24 @@ pub struct Sampler<'a> {
     filter: Filter,
 }
 
-/// One level of a [`Sampler`]'s chain.
+/// One level of a [`Sampler`]'s chain: RGBA bytes in the image's encoding.
 #[derive(Clone, Copy)]
-enum LevelRef<'a> {
-    Image(&'a Texture),
-    Mip(&'a Level),
+struct LevelRef<'a> {
+    width: u32,
+    height: u32,
+    texels: &'a [u8],
+    srgb: bool,
 }
 
 impl LevelRef<'_> {
     #[inline(always)]
     fn size(self) -> (u32, u32) {
-        match self {
-            LevelRef::Image(t) => (t.width, t.height),
-            LevelRef::Mip(l) => (l.width, l.height),
-        }
+        (self.width, self.height)
     }
 
     #[inline(always)]
     fn texel(self, x: u32, y: u32) -> Vec4 {
-        Vec4::from_array(match self {
-            LevelRef::Image(t) => t.texel(x, y),
-            LevelRef::Mip(l) => l.texel(x, y),
-        })
+        Vec4::from_array(decode_texel(self.texels, self.width, x, y, self.srgb))
     }
 }
 
@@ -89,9 +85,18 @@ impl<'a> Sampler<'a> {
     }
 
     fn level(&self, k: usize) -> LevelRef<'_> {
-        match k {
-            0 => LevelRef::Image(self.image),
-            _ => LevelRef::Mip(&self.mips[k - 1]),
+        let (width, height, texels) = match k {
+            0 => (self.image.width, self.image.height, &self.image.texels),
+            _ => {
+                let l = &self.mips[k - 1];
+                (l.width, l.height, &l.texels)
+            }
+        };
+        LevelRef {
+            width,
+            height,
+            texels,
+            srgb: self.image.srgb,
         }
     }
 
@@ -141,12 +146,9 @@ impl<'a> Sampler<'a> {
         }
     }
 
-    /// Bytes the mip levels below the image hold (linear RGBA f32 per texel).
+    /// Bytes the mip levels below the image hold (four per texel).
     pub fn bytes(&self) -> u64 {
-        self.mips
-            .iter()
-            .map(|l| l.texels.len() as u64 * std::mem::size_of::<[f32; 4]>() as u64)
-            .sum()
+        self.mips.iter().map(|l| l.texels.len() as u64).sum()
     }
 
     /// [`Sampler::sample`] at a mesh uv through a material's tiling.
@@ -185,7 +187,7 @@ impl<'a> Sampler<'a> {
 }
 
 /// Bytes a [`Sampler`] of `t` will hold beside the soup's image, without building it:
-/// when mip-mapped, every halving down to 1×1, 16 bytes per texel.
+/// when mip-mapped, every halving down to 1×1, four bytes per texel.
 pub fn sampler_bytes(t: &Texture) -> u64 {
     let (mut w, mut h) = (t.width.max(1) as u64, t.height.max(1) as u64);
     let mut texels = 0;
@@ -193,7 +195,7 @@ pub fn sampler_bytes(t: &Texture) -> u64 {
         (w, h) = ((w / 2).max(1), (h / 2).max(1));
         texels += w * h;
     }
-    texels * std::mem::size_of::<[f32; 4]>() as u64
+    texels * 4
 }
 
 /// The smallest alpha of any texel of `t` (0–1): a material whose opacity times this
@@ -359,7 +361,7 @@ mod tests {
         let s = two_by_two(Filter::Trilinear, Wrap::Clamp);
         let t = Tiling::default();
         // Half-way between texel centres: point picks one, bilinear blends, and a footprint
-        // of the whole texture reads the 1×1 level.
+        // of the whole texture reads the 1×1 level, the mean 0.5 kept as the code 128.
         let uv = Vec2::new(0.5, 0.25);
         assert_eq!(s.lookup(TextureFilter::Point, &t, uv, 1.0), GREEN);
         assert_eq!(
@@ -368,11 +370,11 @@ mod tests {
         );
         assert_eq!(
             s.lookup(TextureFilter::Cone, &t, uv, 2.0),
-            Vec4::new(0.5, 0.5, 0.5, 1.0)
+            Vec4::new(128.0 / 255.0, 128.0 / 255.0, 128.0 / 255.0, 1.0)
         );
         let tex = texture(5, 3, &[[0, 0, 0, 7]; 15], Filter::Bilinear, Wrap::Repeat);
         assert_eq!(sampler_bytes(&tex), Sampler::new(&tex).bytes());
-        assert_eq!(sampler_bytes(&tex), (2 + 1) * 16);
+        assert_eq!(sampler_bytes(&tex), (2 + 1) * 4);
         assert_eq!(min_alpha(&tex), 7.0 / 255.0);
     }
 

@@ -92,8 +92,8 @@ fn each_texel_lands_in_its_image_corner_not_mirrored() {
     assert_eq!(out.counts.texture_lookups, 16);
     assert_eq!(out.counts.alpha_lookups, 0);
     assert_eq!(plan.textures.textures, 1);
-    // The 2×2 image is the soup's; its 1×1 mip level is one texel of 16 bytes.
-    assert_eq!(plan.textures.bytes, 16);
+    // The 2×2 image is the soup's; its 1×1 mip level is one texel of 4 bytes.
+    assert_eq!(plan.textures.bytes, 4);
     assert!(
         plan.describe().contains("textures       on "),
         "{}",
@@ -128,8 +128,8 @@ fn only_the_textures_a_used_material_reads_get_mip_levels() {
         &plan,
         &render::RenderOptions::default(),
     );
-    // The 2×2 image's 1×1 level: one texel of linear RGBA f32; none of the 4×4 image's.
-    assert_eq!((plan.textures.bytes, it.texture_bytes()), (16, 16));
+    // The 2×2 image's 1×1 level: one 8-bit RGBA texel; none of the 4×4 image's.
+    assert_eq!((plan.textures.bytes, it.texture_bytes()), (4, 4));
 }
 
 #[test]
