@@ -11,7 +11,8 @@ fn srgb_oetf(c: f32) -> f32 {
     }
 }
 
-/// A linear value's 8-bit sRGB code: clamped to [0, 1] (NaN to 0), encoded, rounded.
+/// A linear value's 8-bit sRGB code: clamped to [0, 1] (infinities too; NaN to 0),
+/// encoded, rounded.
 pub fn encode(linear: f32) -> u8 {
     Encoder::get().encode(linear)
 }
@@ -91,13 +92,12 @@ impl Encoder {
     /// [`encode`] without looking the tables up: for many values in a row.
     #[inline]
     pub fn encode(&self, v: f32) -> u8 {
-        let v = if v.is_finite() {
-            v.clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        // Exact: the bucket count is a power of two, and v at most 1.
-        let k = self.buckets[(v * BUCKETS as f32) as usize] as usize;
+        // A NaN stays NaN: its index below is 0 and it passes no threshold, so it gives 0.
+        let v = v.clamp(0.0, 1.0);
+        // Exact: the bucket count is a power of two, and v at most 1. Through i32 and
+        // clamped, the index needs neither a 64-bit conversion's fix-ups nor a bounds check.
+        let i = ((v * BUCKETS as f32) as i32).clamp(0, BUCKETS as i32) as usize;
+        let k = self.buckets[i] as usize;
         let above = |j: usize| (v >= self.thresholds[j]) as usize;
         (k + above(k + 1) + above(k + 2)) as u8
     }
@@ -109,12 +109,11 @@ mod tests {
 
     /// [`encode`] through `powf` on every value.
     fn reference(v: f32) -> u8 {
-        let v = if v.is_finite() {
-            v.clamp(0.0, 1.0)
+        if v.is_nan() {
+            0
         } else {
-            0.0
-        };
-        encode_by_powf(v)
+            encode_by_powf(v.clamp(0.0, 1.0))
+        }
     }
 
     #[test]
@@ -126,6 +125,8 @@ mod tests {
         assert_eq!(encode(0.05), 63);
         assert_eq!(encode(f32::NAN), 0);
         assert_eq!(encode(5.0), 255);
+        assert_eq!(encode(f32::INFINITY), 255);
+        assert_eq!(encode(f32::NEG_INFINITY), 0);
     }
 
     #[test]

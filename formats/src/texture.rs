@@ -13,6 +13,7 @@
 //! 8-bit encoding, as Unity keeps a texture's mip maps: a quarter of the memory of linear
 //! `f32`, and one way of reading every level.
 
+use glam::Vec4;
 use serde::{Deserialize, Serialize};
 
 /// Largest width or height accepted (Unity's own import limit).
@@ -208,9 +209,10 @@ impl Texture {
     /// When mip-mapped, every halving of the image down to 1×1 (level 1 first; level 0 is
     /// the image itself, read through [`Texture::texel`]). Each texel of a level is the
     /// mean of the (2×2, or 3 wide/high where a side is odd) linear texels it covers in the
-    /// level above, summed in f64, then encoded to 8 bits ([`encode_u8`]). The means are
-    /// taken before the level above is encoded, so rounding never compounds down the chain,
-    /// and a constant texture stays exactly constant at every level.
+    /// level above, summed in f32 row by row, then encoded to 8 bits ([`encode_u8`]). The
+    /// means are taken before the level above is encoded, so rounding never compounds down
+    /// the chain; a constant texture's means are within a few ulps of its value, far from
+    /// any rounding boundary, so it stays exactly constant at every level.
     pub fn halvings(&self) -> Vec<Level> {
         let mut chain: Vec<Halving> = Vec::new();
         let (mut w, mut h) = (self.width, self.height);
@@ -228,7 +230,7 @@ impl Texture {
             };
             let bytes = &self.texels[y * row_bytes..][..row_bytes];
             for (t, b) in first.next_row().iter_mut().zip(bytes.chunks_exact(4)) {
-                *t = decode_rgba(b, colour, alpha);
+                *t = Vec4::from_array(decode_rgba(b, colour, alpha));
             }
             let mut done = first.row_filled(self.srgb);
             for next in rest.iter_mut() {
@@ -249,10 +251,10 @@ struct Halving {
     /// Size of the level above.
     src: (u32, u32),
     /// The source rows of the destination row in progress, and how many have arrived.
-    rows: [Vec<[f32; 4]>; 3],
+    rows: [Vec<Vec4>; 3],
     arrived: usize,
     /// The last destination row, linear, and how many rows are done.
-    row: Vec<[f32; 4]>,
+    row: Vec<Vec4>,
     done: u32,
     level: Level,
 }
@@ -260,7 +262,7 @@ struct Halving {
 impl Halving {
     fn new(width: u32, height: u32) -> Halving {
         let (w, h) = ((width / 2).max(1), (height / 2).max(1));
-        let src_row = || vec![[0f32; 4]; width as usize];
+        let src_row = || vec![Vec4::ZERO; width as usize];
         Halving {
             src: (width, height),
             rows: [src_row(), src_row(), src_row()],
@@ -276,14 +278,15 @@ impl Halving {
     }
 
     /// Where the next source row goes.
-    fn next_row(&mut self) -> &mut [[f32; 4]] {
+    fn next_row(&mut self) -> &mut [Vec4] {
         &mut self.rows[self.arrived]
     }
 
     /// Counts the row written at [`Halving::next_row`]; once a destination row's source rows
-    /// are all in, averages it (each texel sums its source texels row by row, left to right,
-    /// in f64), appends it encoded to the level and returns it linear.
-    fn row_filled(&mut self, srgb: bool) -> Option<&[[f32; 4]]> {
+    /// are all in, averages it (each texel sums its source texels in f32, row by row, left
+    /// to right, and divides by their count), appends it encoded to the level and returns
+    /// it linear.
+    fn row_filled(&mut self, srgb: bool) -> Option<&[Vec4]> {
         let (
             (width, height),
             Level {
@@ -307,11 +310,7 @@ impl Halving {
                 let pairs = (width / 2 - width % 2) as usize;
                 let blocks = upper.chunks_exact(2).zip(lower.chunks_exact(2));
                 for (a, b) in blocks.take(pairs) {
-                    self.row.push(std::array::from_fn(|c| {
-                        let sum =
-                            0.0 + a[0][c] as f64 + a[1][c] as f64 + b[0][c] as f64 + b[1][c] as f64;
-                        (sum / 4.0) as f32
-                    }));
+                    self.row.push((a[0] + a[1] + b[0] + b[1]) / 4.0);
                 }
                 pairs
             }
@@ -319,16 +318,13 @@ impl Halving {
         };
         for x in pairs as u32..*w {
             let (x0, x1) = span(x, width, *w);
-            let mut sum = [0f64; 4];
+            let mut sum = Vec4::ZERO;
             for row in rows {
                 for t in &row[x0 as usize..=x1 as usize] {
-                    for c in 0..4 {
-                        sum[c] += t[c] as f64;
-                    }
+                    sum += *t;
                 }
             }
-            let n = ((x1 - x0 + 1) * (y1 - y0 + 1)) as f64;
-            self.row.push(sum.map(|s| (s / n) as f32));
+            self.row.push(sum / ((x1 - x0 + 1) * (y1 - y0 + 1)) as f32);
         }
         let sr = crate::srgb::Encoder::get();
         let colour = |v| if srgb { sr.encode(v) } else { encode_linear(v) };
@@ -437,7 +433,7 @@ mod tests {
         assert!(t.halvings().is_empty());
     }
 
-    /// Each level's texel is the mean, summed in f64 row by row, of the linear texels of the
+    /// Each level's texel is the mean, summed in f32 row by row, of the linear texels of the
     /// level above that it covers (two per axis, three where that axis's side is odd and
     /// the texel is the last) before that level was encoded, then encoded to 8 bits.
     /// Checked bit for bit on odd and even sides, both encodings.
@@ -476,17 +472,17 @@ mod tests {
                     for y in 0..l.height {
                         for x in 0..l.width {
                             let (xs, ys) = (cover(x, pw, l.width), cover(y, ph, l.height));
-                            let n = (xs.clone().count() * ys.clone().count()) as f64;
-                            let mut sum = [0f64; 4];
+                            let n = (xs.clone().count() * ys.clone().count()) as f32;
+                            let mut sum = [0f32; 4];
                             for sy in ys.clone() {
                                 for sx in xs.clone() {
                                     let v = prev[(sy * pw + sx) as usize];
                                     for c in 0..4 {
-                                        sum[c] += v[c] as f64;
+                                        sum[c] += v[c];
                                     }
                                 }
                             }
-                            let mean = sum.map(|s| (s / n) as f32);
+                            let mean = sum.map(|s| s / n);
                             let want = [
                                 encode_u8(mean[0], srgb),
                                 encode_u8(mean[1], srgb),
