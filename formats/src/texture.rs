@@ -150,19 +150,18 @@ pub fn decode_u8(code: u8, srgb: bool) -> f32 {
 /// of linear channels, the transfer function's rounded code of sRGB ones. Every code
 /// comes back from [`decode_u8`] as itself.
 pub fn encode_u8(linear: f32, srgb: bool) -> u8 {
-    if srgb {
-        crate::srgb::encode(linear)
-    } else {
-        encode_linear(linear)
-    }
+    encode_with(crate::srgb::Encoder::get(), linear, srgb)
 }
 
+/// [`encode_u8`] with the sRGB tables looked up once for many values.
 #[inline]
-fn encode_linear(v: f32) -> u8 {
-    if v.is_nan() {
+fn encode_with(sr: &crate::srgb::Encoder, linear: f32, srgb: bool) -> u8 {
+    if srgb {
+        sr.encode(linear)
+    } else if linear.is_nan() {
         0
     } else {
-        (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
+        (linear.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
     }
 }
 
@@ -326,16 +325,15 @@ impl Halving {
             }
             self.row.push(sum / ((x1 - x0 + 1) * (y1 - y0 + 1)) as f32);
         }
-        let sr = crate::srgb::Encoder::get();
-        let colour = |v| if srgb { sr.encode(v) } else { encode_linear(v) };
         let row_bytes = *w as usize * 4;
         let out = &mut texels[self.done as usize * row_bytes..][..row_bytes];
+        let sr = crate::srgb::Encoder::get();
         for (b, t) in out.chunks_exact_mut(4).zip(&self.row) {
             b.copy_from_slice(&[
-                colour(t[0]),
-                colour(t[1]),
-                colour(t[2]),
-                encode_linear(t[3]),
+                encode_with(sr, t[0], srgb),
+                encode_with(sr, t[1], srgb),
+                encode_with(sr, t[2], srgb),
+                encode_with(sr, t[3], false),
             ]);
         }
         self.done += 1;

@@ -130,8 +130,6 @@ pub struct DiscSpiral {
     i: u32,
     n: u32,
     angle: (f64, f64),
-    /// (cos, sin) of the rotation.
-    start: (f32, f32),
 }
 
 impl DiscSpiral {
@@ -141,14 +139,15 @@ impl DiscSpiral {
             i: 0,
             n,
             angle: (cos as f64, sin as f64),
-            start: (cos, sin),
         }
     }
 
     /// Four points of the disc's rim a quarter turn apart, the first at the rotation, as
     /// (x, y) lanes: the probe that asks whether a light's whole extent is seen alike.
+    /// Asked before the first sample, while the spiral's angle is still the rotation.
     pub fn rim4(&self) -> ([f32; 4], [f32; 4]) {
-        let (c, s) = self.start;
+        debug_assert_eq!(self.i, 0, "the rim probe goes before the samples");
+        let (c, s) = (self.angle.0 as f32, self.angle.1 as f32);
         ([c, -s, -c, s], [s, c, -s, -c])
     }
 
