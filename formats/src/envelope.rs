@@ -307,7 +307,7 @@ impl PayloadReader<'_> {
                     )
                 })?;
             self.pos += 8 + size;
-            Ok(bytemuck::pod_collect_to_vec(&rest[8..8 + size]))
+            Ok(copy_out(&rest[8..8 + size]))
         }
         #[cfg(not(target_endian = "little"))]
         self.value(what)
@@ -320,6 +320,28 @@ impl PayloadReader<'_> {
         self.pos += used;
         Ok(value)
     }
+}
+
+/// Below this many bytes an array is copied out on one thread.
+const PARALLEL_COPY_MIN: usize = 1 << 20;
+
+/// An array's bytes copied out of the file into a vector of its own, large ones in
+/// blocks on all cores. Most of such a copy's time is the kernel handing out and zeroing
+/// the vector's fresh pages, one fault per page, and those faults run side by side on
+/// two threads.
+fn copy_out<T: bytemuck::Pod>(bytes: &[u8]) -> Vec<T> {
+    if bytes.len() < PARALLEL_COPY_MIN {
+        return bytemuck::pod_collect_to_vec(bytes);
+    }
+    use rayon::prelude::*;
+    // Zeroed memory this large comes fresh from the kernel, which zeroes it on first touch:
+    // the copy below is the only pass over it.
+    let mut out: Vec<T> = bytemuck::zeroed_vec(bytes.len() / std::mem::size_of::<T>());
+    bytemuck::cast_slice_mut::<T, u8>(&mut out)
+        .par_chunks_mut(PARALLEL_COPY_MIN)
+        .zip(bytes.par_chunks(PARALLEL_COPY_MIN))
+        .for_each(|(to, from)| to.copy_from_slice(from));
+    out
 }
 
 /// Decode a payload with a byte limit no smaller than the payload and at most 4× it.
