@@ -470,31 +470,25 @@ impl Soup {
                 self.tri_object.len()
             ));
         }
-        if let Some(i) = self
-            .triangles
-            .iter()
-            .position(|t| t.iter().any(|&i| i as usize >= v))
+        if let Some(i) =
+            crate::first_bad(&self.triangles, |_, t| t.iter().any(|&i| i as usize >= v))
         {
             return Err(format!(
                 "triangle {i} names vertices {:?} of {v}",
                 self.triangles[i]
             ));
         }
-        if let Some(i) = self
-            .tri_material
-            .iter()
-            .position(|&m| m as usize >= self.materials.len())
-        {
+        if let Some(i) = crate::first_bad(&self.tri_material, |_, &m| {
+            m as usize >= self.materials.len()
+        }) {
             return Err(format!(
                 "triangle {i} names material {} of {}",
                 self.tri_material[i],
                 self.materials.len()
             ));
         }
-        if let Some(i) = self
-            .tri_object
-            .iter()
-            .position(|&o| o as usize >= self.objects.len())
+        if let Some(i) =
+            crate::first_bad(&self.tri_object, |_, &o| o as usize >= self.objects.len())
         {
             return Err(format!(
                 "triangle {i} names object {} of {}",
@@ -509,7 +503,7 @@ impl Soup {
                 self.objects[i].layer
             ));
         }
-        if let Some(i) = self.positions.iter().position(|p| !p.is_finite()) {
+        if let Some(i) = crate::first_bad(&self.positions, |_, p| !p.is_finite()) {
             return Err(format!("vertex {i} is not finite"));
         }
         if indexed_geometry_hash(&self.positions, &self.triangles) != self.geometry_hash {
@@ -561,7 +555,7 @@ impl Soup {
                 ));
             }
         }
-        if let Some(i) = self.uvs.iter().position(|uv| !uv.is_finite()) {
+        if let Some(i) = crate::first_bad(&self.uvs, |_, uv| !uv.is_finite()) {
             return Err(format!("vertex {i} has a non-finite UV"));
         }
         Ok(())

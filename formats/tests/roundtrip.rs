@@ -267,6 +267,124 @@ fn large_files_read_through_a_mapping_as_small_ones_do() {
     }
 }
 
+/// `sample_soup` grown to 300,000 triangles: arrays of 1–3.6 MB, copied out and checked
+/// in blocks on all cores.
+fn large_soup() -> Soup {
+    let mut s = sample_soup();
+    for i in 0..300_000 - 2 {
+        let x = i as f32;
+        let corners = [
+            Vec3::new(x, 0.0, 0.0),
+            Vec3::new(x, 1.0, 0.0),
+            Vec3::new(x, 0.0, 1.0),
+        ];
+        s.push_triangle(corners, [Vec3::X; 3], Some([Vec2::ZERO, Vec2::X, Vec2::Y]));
+        s.tri_material.push(0);
+        s.tri_object.push(0);
+    }
+    s.seal();
+    s
+}
+
+/// Large arrays come back as written (blocks of a mebibyte, a short last one), and a check
+/// names the first bad entry, whichever block and thread finds it.
+#[test]
+fn large_arrays_round_trip_and_name_their_first_bad_entry() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("large.soup");
+    let s = large_soup();
+    assert!(s.triangles.len() * 12 > 3 << 20);
+    s.write(&path).unwrap();
+    assert_eq!(Soup::read(&path).unwrap(), s);
+    let p = Path::new("large.soup");
+    type Edit<'a> = (&'a dyn Fn(&mut Soup), &'a str);
+    let cases: [Edit; 4] = [
+        (
+            &|s| {
+                s.triangles[290_000][0] = u32::MAX;
+                s.triangles[200_001][2] = 900_001;
+            },
+            "triangle 200001 names vertices [600002, 600003, 900001] of 899999",
+        ),
+        (
+            &|s| {
+                s.positions[800_000].x = f32::INFINITY;
+                s.positions[70_000].z = f32::NAN;
+            },
+            "vertex 70000 is not finite",
+        ),
+        (
+            &|s| {
+                s.tri_object[299_999] = 3;
+                s.tri_object[131_072] = 1;
+            },
+            "triangle 131072 names object 1 of 1",
+        ),
+        (
+            &|s| s.uvs[899_998].y = f32::NAN,
+            "vertex 899998 has a non-finite UV",
+        ),
+    ];
+    for (edit, want) in cases {
+        let mut bad = s.clone();
+        edit(&mut bad);
+        bad.seal();
+        let msg = Soup::from_bytes(&bad.to_bytes(p).unwrap(), p)
+            .unwrap_err()
+            .to_string();
+        assert!(msg.contains(want), "{want}: {msg}");
+    }
+}
+
+/// A large tree's checks name the first bad node and leaf entry too.
+#[test]
+fn large_trees_name_their_first_bad_node_and_entry() {
+    let p = Path::new("large.kd");
+    let mut k = sample_kd();
+    k.stats.triangles = 2;
+    k.leaf_tris = (0..300_000u32).map(|i| i % 2).collect();
+    // A chain of interior nodes, each with a one-entry leaf below, ending in a leaf.
+    let n = 200_001u32;
+    k.nodes = (0..n)
+        .map(|i| match i {
+            _ if i == n - 1 => KdNode::leaf(1, 0),
+            _ if i % 2 == 0 => KdNode::interior(0, 0.5, i + 2),
+            _ => KdNode::leaf(1, i),
+        })
+        .collect();
+    assert!(KdFile::from_bytes(&k.to_bytes(p).unwrap(), p).is_ok());
+    let mut bad = k.clone();
+    bad.nodes[190_000] = KdNode::interior(0, 0.5, 7);
+    bad.nodes[150_000] = KdNode::interior(1, 0.5, 150_000);
+    let msg = KdFile::from_bytes(&bad.to_bytes(p).unwrap(), p)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        msg.contains("node 150000 points at child 150000 of 200001"),
+        "{msg}"
+    );
+    let mut bad = k.clone();
+    bad.nodes[199_999] = KdNode::leaf(2, 299_999);
+    bad.nodes[70_001] = KdNode::leaf(9, 299_999);
+    let msg = KdFile::from_bytes(&bad.to_bytes(p).unwrap(), p)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        msg.contains("leaf 70001 reaches past the triangle list"),
+        "{msg}"
+    );
+    let mut bad = k;
+    bad.leaf_tris[250_000] = 9;
+    bad.leaf_tris[66_000] = 2;
+    let msg = KdFile::from_bytes(&bad.to_bytes(p).unwrap(), p)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        msg.contains("leaf triangle 2 is out of range (2 triangles)"),
+        "{msg}"
+    );
+}
+
 #[test]
 fn a_length_field_claiming_a_trillion_elements_fails_fast() {
     // A valid frame whose payload claims 10^12 triangles: the checksum is recomputed so
