@@ -91,6 +91,25 @@ pub fn decode<A: Artifact>(bytes: &[u8], path: &Path) -> Result<A, FormatError> 
     Ok(value)
 }
 
+/// The leading fields of an artifact (and any fixed-size last one), read by `read` once
+/// the frame and the checksum of the whole payload are verified, without decoding the rest
+/// or checking its cross-references (what `soup2kd --cache` needs to find a cached tree).
+pub fn decode_part<A: Artifact, T>(
+    bytes: &[u8],
+    path: &Path,
+    read: impl FnOnce(&mut PayloadReader) -> Result<T, String>,
+) -> Result<T, FormatError> {
+    let payload = checked_payload(bytes, A::MAGIC, A::KIND, A::VERSION, path)?;
+    read(&mut PayloadReader {
+        bytes: payload,
+        pos: 0,
+    })
+    .map_err(|detail| FormatError::Corrupt {
+        path: path.to_path_buf(),
+        detail,
+    })
+}
+
 /// The payload of `bytes` once magic, version, length and checksum are right.
 fn checked_payload<'a>(
     bytes: &'a [u8],
@@ -288,29 +307,54 @@ impl PayloadReader<'_> {
     ) -> Result<Vec<T>, String> {
         #[cfg(target_endian = "little")]
         {
-            let at = self.pos;
-            let rest = &self.bytes[at..];
-            let Some(count) = rest.get(..8) else {
-                return Err(format!(
-                    "payload does not decode: it ends at byte {at}, inside the count of {what}"
-                ));
-            };
-            let count = u64::from_le_bytes(count.try_into().expect("8 bytes"));
-            let size = usize::try_from(count)
-                .ok()
-                .and_then(|n| n.checked_mul(std::mem::size_of::<T>()))
-                .filter(|&size| size <= rest.len() - 8)
-                .ok_or_else(|| {
-                    format!(
-                        "payload does not decode: {count} {what} at byte {at} need more than the {} bytes left",
-                        rest.len() - 8
-                    )
-                })?;
-            self.pos += 8 + size;
-            Ok(copy_out(&rest[8..8 + size]))
+            let bytes = self.array_bytes::<T>(what)?;
+            Ok(copy_out(bytes))
         }
         #[cfg(not(target_endian = "little"))]
         self.value(what)
+    }
+
+    /// Steps over what [`PayloadWriter::array`] wrote, returning its length.
+    pub fn skip_array<T: bytemuck::Pod>(&mut self, what: &str) -> Result<usize, String> {
+        Ok(self.array_bytes::<T>(what)?.len() / std::mem::size_of::<T>())
+    }
+
+    /// The elements' bytes of the array at the reader's position (a little-endian u64
+    /// count, then the elements), the reader moved past them.
+    fn array_bytes<T: bytemuck::Pod>(&mut self, what: &str) -> Result<&[u8], String> {
+        let at = self.pos;
+        let rest = &self.bytes[at..];
+        let Some(count) = rest.get(..8) else {
+            return Err(format!(
+                "payload does not decode: it ends at byte {at}, inside the count of {what}"
+            ));
+        };
+        let count = u64::from_le_bytes(count.try_into().expect("8 bytes"));
+        let size = usize::try_from(count)
+            .ok()
+            .and_then(|n| n.checked_mul(std::mem::size_of::<T>()))
+            .filter(|&size| size <= rest.len() - 8)
+            .ok_or_else(|| {
+                format!(
+                    "payload does not decode: {count} {what} at byte {at} need more than the {} bytes left",
+                    rest.len() - 8
+                )
+            })?;
+        self.pos += 8 + size;
+        Ok(&rest[8..8 + size])
+    }
+
+    /// The payload's last `N` bytes, a fixed-size last field, named `what` in errors; they
+    /// must lie beyond the reader's position.
+    pub fn last<const N: usize>(&self, what: &str) -> Result<[u8; N], String> {
+        let len = self.bytes.len();
+        if len < self.pos + N {
+            return Err(format!(
+                "payload does not decode: {len} bytes end before {what}, {N} bytes after byte {}",
+                self.pos
+            ));
+        }
+        Ok(self.bytes[len - N..].try_into().expect("N bytes"))
     }
 
     /// A value bincode's serde route wrote, named `what` in errors.

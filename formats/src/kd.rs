@@ -152,6 +152,27 @@ pub struct KdFile {
     pub leaf_tris: Vec<u32>,
 }
 
+/// A tree file's fields before its nodes ([`KdFile::read_header`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct KdHeader {
+    pub geometry_hash: Digest,
+    pub params: BuildParams,
+    pub stats: TreeStats,
+    pub bounds: [Vec3; 2],
+}
+
+impl KdHeader {
+    fn read(r: &mut envelope::PayloadReader) -> Result<KdHeader, String> {
+        let (geometry_hash, params, stats, bounds) = r.value("the header fields")?;
+        Ok(KdHeader {
+            geometry_hash,
+            params,
+            stats,
+            bounds,
+        })
+    }
+}
+
 /// Where [`KdFile::height`] stops counting.
 pub const HEIGHT_CAP: u32 = u8::MAX as u32;
 
@@ -213,6 +234,13 @@ impl KdFile {
         envelope::encode(self, path)
     }
 
+    /// The leading fields of the tree at `path`, the whole payload's checksum verified,
+    /// without decoding or checking its nodes and lists ([`KdFile::read`] does).
+    pub fn read_header(path: &Path) -> Result<KdHeader, FormatError> {
+        let bytes = envelope::read_file(path)?;
+        envelope::decode_part::<KdFile, _>(&bytes, path, KdHeader::read)
+    }
+
     pub fn from_bytes(bytes: &[u8], path: &Path) -> Result<Self, FormatError> {
         envelope::decode(bytes, path)
     }
@@ -244,7 +272,12 @@ impl envelope::Artifact for KdFile {
     }
 
     fn read_payload(r: &mut envelope::PayloadReader) -> Result<Self, String> {
-        let (geometry_hash, params, stats, bounds) = r.value("the header fields")?;
+        let KdHeader {
+            geometry_hash,
+            params,
+            stats,
+            bounds,
+        } = KdHeader::read(r)?;
         Ok(KdFile {
             geometry_hash,
             params,

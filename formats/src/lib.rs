@@ -14,11 +14,11 @@ pub mod texture;
 
 pub use envelope::write_atomic;
 pub use error::FormatError;
-pub use kd::{BuildParams, KdFile, KdNode, TreeStats};
+pub use kd::{BuildParams, KdFile, KdHeader, KdNode, TreeStats};
 pub use rays::{Hit, RayRecord};
 pub use soup::{
     Alpha, Ambient, AmbientMode, Camera, CastShadows, ClearFlags, Cull, Environment, Light,
-    LightKind, Material, Object, Projection, Shadows, Soup,
+    LightKind, Material, Object, Projection, Shadows, Soup, SoupKey,
 };
 pub use texture::{Texture, TextureRef, Tiling};
 

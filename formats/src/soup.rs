@@ -577,6 +577,32 @@ impl Soup {
     pub fn read(path: &Path) -> Result<Self, FormatError> {
         Self::from_bytes(&envelope::read_file(path)?, path)
     }
+
+    /// The [`SoupKey`] of the soup at `path`: the whole payload's checksum verified, then
+    /// the triangles' count and the last field, without decoding or checking the rest
+    /// ([`Soup::read`] does; a renderer reading the soup refuses one whose geometry hash
+    /// does not match its triangles).
+    pub fn read_key(path: &Path) -> Result<SoupKey, FormatError> {
+        let bytes = envelope::read_file(path)?;
+        envelope::decode_part::<Soup, _>(&bytes, path, |r| {
+            r.skip_array::<Vec3>("positions")?;
+            r.skip_array::<Vec3>("normals")?;
+            r.skip_array::<Vec2>("uvs")?;
+            let triangles = r.skip_array::<[u32; 3]>("triangles")?;
+            let geometry_hash = r.last::<32>("the geometry hash")?;
+            Ok(SoupKey {
+                triangles,
+                geometry_hash,
+            })
+        })
+    }
+}
+
+/// What finding a soup's cached tree takes: its triangle count and geometry hash.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SoupKey {
+    pub triangles: usize,
+    pub geometry_hash: Digest,
 }
 
 /// The fields after the geometry arrays, in payload order.

@@ -336,6 +336,46 @@ fn large_arrays_round_trip_and_name_their_first_bad_entry() {
     }
 }
 
+/// `soup2kd --cache` finds a tree from a soup's key and a tree's header: both read as the
+/// full reads do, and only after the whole payload's checksum.
+#[test]
+fn keys_and_headers_match_the_full_reads() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, soup) in [("small.soup", sample_soup()), ("large.soup", large_soup())] {
+        let path = dir.path().join(name);
+        soup.write(&path).unwrap();
+        let key = Soup::read_key(&path).unwrap();
+        assert_eq!(key.triangles, soup.triangles.len());
+        assert_eq!(key.geometry_hash, soup.geometry_hash);
+        let mut bytes = std::fs::read(&path).unwrap();
+        let at = bytes.len() - 40;
+        bytes[at] ^= 1;
+        std::fs::write(&path, &bytes).unwrap();
+        let msg = Soup::read_key(&path).unwrap_err().to_string();
+        assert!(msg.contains("checksum"), "{msg}");
+    }
+    // A well-framed payload that ends inside the arrays.
+    let path = dir.path().join("short.soup");
+    let good = sample_soup().to_bytes(&path).unwrap();
+    let payload = good[52..60 + 5 * 12].to_vec();
+    let mut bytes = good[..12].to_vec();
+    bytes.extend_from_slice(&(payload.len() as u64).to_le_bytes());
+    bytes.extend_from_slice(blake3::hash(&payload).as_bytes());
+    bytes.extend_from_slice(&payload);
+    std::fs::write(&path, &bytes).unwrap();
+    let msg = Soup::read_key(&path).unwrap_err().to_string();
+    assert!(msg.contains("inside the count of normals"), "{msg}");
+
+    let path = dir.path().join("t.kd");
+    let k = sample_kd();
+    k.write(&path).unwrap();
+    let h = KdFile::read_header(&path).unwrap();
+    assert_eq!(
+        (h.geometry_hash, h.params, h.stats, h.bounds),
+        (k.geometry_hash, k.params, k.stats.clone(), k.bounds)
+    );
+}
+
 /// A large tree's checks name the first bad node and leaf entry too.
 #[test]
 fn large_trees_name_their_first_bad_node_and_entry() {

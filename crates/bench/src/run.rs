@@ -119,7 +119,7 @@ impl Bench<'_> {
                 sah_cost: Some(tree.stats.sah_cost),
                 nodes: Some(tree.nodes.len() as u64),
                 refs_per_triangle: Some(tree.leaf_tris.len() as f64 / n.max(1) as f64),
-                bytes_per_triangle: Some(kdtree::query_bytes(&tree) as f64 / n.max(1) as f64),
+                bytes_per_triangle: Some(kdtree::query_bytes(&tree.stats) as f64 / n.max(1) as f64),
             });
             kd = Some(tree);
         }

@@ -23,7 +23,7 @@ mod traverse;
 pub mod triangle;
 
 use aabb::Aabb;
-use formats::{BuildParams, KdFile, KdNode, Soup};
+use formats::{BuildParams, KdFile, KdNode, Soup, TreeStats};
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -279,12 +279,12 @@ impl Accel {
     }
 }
 
-/// Bytes an [`Accel`] holds for `kd`'s queries: 8 per node, 4 per leaf entry, 36 of
-/// vertices and 4 of soup index per triangle.
-pub fn query_bytes(kd: &KdFile) -> usize {
-    kd.nodes.len() * std::mem::size_of::<KdNode>()
-        + kd.leaf_tris.len() * 4
-        + kd.stats.triangles as usize * (std::mem::size_of::<[[f32; 3]; 3]>() + 4)
+/// Bytes an [`Accel`] holds for the queries of a tree with these statistics: 8 per node,
+/// 4 per leaf entry, 36 of vertices and 4 of soup index per triangle.
+pub fn query_bytes(s: &TreeStats) -> usize {
+    s.nodes as usize * std::mem::size_of::<KdNode>()
+        + s.references as usize * 4
+        + s.triangles as usize * (std::mem::size_of::<[[f32; 3]; 3]>() + 4)
 }
 
 /// A tree's triangles renumbered by first appearance in its leaves (depth-first order),

@@ -2,7 +2,7 @@
 
 use anyhow::{bail, Context, Result};
 use clap::{CommandFactory, Parser};
-use formats::{BuildParams, KdFile, Soup};
+use formats::{BuildParams, KdFile, Soup, TreeStats};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -84,8 +84,8 @@ fn params(cli: &Cli) -> Result<BuildParams> {
 
 /// Bytes a query structure holds per input triangle: 8-byte nodes, 4-byte leaf
 /// references and 36 bytes of vertices per triangle (see `Accel::memory_bytes`).
-fn bytes_per_triangle(kd: &KdFile) -> f64 {
-    kdtree::query_bytes(kd) as f64 / kd.stats.triangles.max(1) as f64
+fn bytes_per_triangle(s: &TreeStats) -> f64 {
+    kdtree::query_bytes(s) as f64 / s.triangles.max(1) as f64
 }
 
 fn print_stats(path: &Path, json: bool) -> Result<()> {
@@ -103,7 +103,7 @@ fn print_stats(path: &Path, json: bool) -> Result<()> {
             "references": s.references, "references_per_triangle": refs,
             "triangles_per_leaf": per_leaf, "max_leaf_triangles": s.max_leaf_triangles,
             "sah_cost": s.sah_cost, "build_seconds": s.build_seconds,
-            "bytes_per_triangle": bytes_per_triangle(&kd),
+            "bytes_per_triangle": bytes_per_triangle(&kd.stats),
             "params": {
                 "traversal_cost": kd.params.traversal_cost,
                 "intersect_cost": kd.params.intersect_cost,
@@ -132,7 +132,7 @@ fn print_stats(path: &Path, json: bool) -> Result<()> {
         println!("  build time           {:.3} s", s.build_seconds);
         println!(
             "  bytes per triangle   {:.1} (nodes + leaf lists + vertices)",
-            bytes_per_triangle(&kd)
+            bytes_per_triangle(&kd.stats)
         );
         println!(
             "  params               traversal {} intersect {} empty bonus {} max depth {} leaf size {}",
@@ -167,6 +167,28 @@ fn run(cli: Cli) -> Result<()> {
     }
     let params = params(&cli)?;
     let start = Instant::now();
+    let (path, cache) = match (&cli.output, &cli.cache) {
+        (Some(out), _) => (out.clone(), "none"),
+        (None, Some(dir)) => {
+            std::fs::create_dir_all(dir)
+                .with_context(|| format!("cannot create cache folder {}", dir.display()))?;
+            // A hit reads only what names and matches the tree; both files' checksums are
+            // verified, and the renderer checks the rest when it loads them.
+            let key = Soup::read_key(soup_path)?;
+            let path = dir.join(params.cache_name(&key.geometry_hash));
+            let cached = path
+                .exists()
+                .then(|| KdFile::read_header(&path).ok())
+                .flatten();
+            if let Some(h) =
+                cached.filter(|h| h.geometry_hash == key.geometry_hash && h.params == params)
+            {
+                return report(&cli, key.triangles, &h.stats, &path, "hit", start);
+            }
+            (path, "miss")
+        }
+        (None, None) => unreachable!("checked above"),
+    };
     let soup = Soup::read(soup_path)?;
     if soup.triangles.len() >= kdtree::MAX_TRIANGLES {
         bail!(
@@ -176,44 +198,27 @@ fn run(cli: Cli) -> Result<()> {
             kdtree::MAX_TRIANGLES
         );
     }
-    let (path, cache) = match (&cli.output, &cli.cache) {
-        (Some(out), _) => (out.clone(), "none"),
-        (None, Some(dir)) => {
-            std::fs::create_dir_all(dir)
-                .with_context(|| format!("cannot create cache folder {}", dir.display()))?;
-            let path = dir.join(params.cache_name(&soup.geometry_hash));
-            let cached = path.exists().then(|| KdFile::read(&path).ok()).flatten();
-            if let Some(kd) =
-                cached.filter(|kd| kd.geometry_hash == soup.geometry_hash && kd.params == params)
-            {
-                return report(&cli, &soup, &kd, &path, "hit", start);
-            }
-            (path, "miss")
-        }
-        (None, None) => unreachable!("checked above"),
-    };
     let kd = kdtree::build(&soup.triangle_positions(), &params, soup.geometry_hash);
     // Atomic (temp file + rename): concurrent builders of one cache entry both succeed.
     kd.write(&path)?;
-    report(&cli, &soup, &kd, &path, cache, start)
+    report(&cli, soup.triangles.len(), &kd.stats, &path, cache, start)
 }
 
 fn report(
     cli: &Cli,
-    soup: &Soup,
-    kd: &KdFile,
+    triangles: usize,
+    s: &TreeStats,
     path: &Path,
     cache: &str,
     start: Instant,
 ) -> Result<()> {
-    let s = &kd.stats;
     let seconds = start.elapsed().as_secs_f64();
     if cli.json {
         let v = serde_json::json!({
-            "triangles": soup.triangles.len(), "nodes": s.nodes, "leaves": s.leaves,
+            "triangles": triangles, "nodes": s.nodes, "leaves": s.leaves,
             "max_depth": s.max_depth, "sah_cost": s.sah_cost, "seconds": seconds,
             "build_seconds": if cache == "hit" { 0.0 } else { s.build_seconds },
-            "bytes_per_triangle": bytes_per_triangle(kd),
+            "bytes_per_triangle": bytes_per_triangle(s),
             "cache": cache, "path": path.display().to_string(),
         });
         println!("{v}");
@@ -222,14 +227,14 @@ fn report(
     } else {
         eprintln!(
             "soup2kd: {} triangles -> {} nodes, {} leaves ({} empty), depth {}, {:.2} refs/triangle, SAH {:.2}, {:.1} bytes/triangle; built in {:.3} s{}",
-            soup.triangles.len(),
+            triangles,
             s.nodes,
             s.leaves,
             s.empty_leaves,
             s.max_depth,
             s.references as f64 / s.triangles.max(1) as f64,
             s.sah_cost,
-            bytes_per_triangle(kd),
+            bytes_per_triangle(s),
             s.build_seconds,
             if cache == "miss" { " (cache miss)" } else { "" }
         );

@@ -94,6 +94,7 @@ fn builds_caches_and_reports() {
         err.contains(&format!("cache hit: {}", path.display())),
         "{err}"
     );
+    let miss = v;
     let v = json(
         &soup2kd()
             .arg(&soup)
@@ -104,6 +105,18 @@ fn builds_caches_and_reports() {
             .unwrap(),
     );
     assert_eq!(v["cache"], "hit");
+    assert_eq!(v["path"], miss["path"]);
+    for field in [
+        "triangles",
+        "nodes",
+        "leaves",
+        "max_depth",
+        "sah_cost",
+        "bytes_per_triangle",
+    ] {
+        assert_eq!(v[field], miss[field], "{field}");
+    }
+    assert_eq!(v["build_seconds"], 0.0);
 
     // Other parameters: another cache entry.
     let v = json(
