@@ -235,7 +235,7 @@ const CASTS_BACK: u8 = 8;
 /// Each triangle's [`Integrator::sides`] bits, from its object's and material's rules.
 fn sides(soup: &Soup) -> Vec<u8> {
     soup.tri_object
-        .iter()
+        .par_iter()
         .zip(&soup.tri_material)
         .map(|(&o, &m)| {
             let obj = &soup.objects[o as usize];
