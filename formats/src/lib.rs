@@ -18,7 +18,7 @@ pub use kd::{BuildParams, KdFile, KdHeader, KdNode, TreeStats};
 pub use rays::{Hit, RayRecord};
 pub use soup::{
     Alpha, Ambient, AmbientMode, Camera, CastShadows, ClearFlags, Cull, Environment, Light,
-    LightKind, Material, Object, Projection, Shadows, Soup, SoupKey,
+    LightKind, Material, Object, Projection, Shadows, Soup, SoupGeometry, SoupKey,
 };
 pub use texture::{Texture, TextureRef, Tiling};
 

@@ -426,12 +426,7 @@ impl Soup {
 
     /// Every triangle's corners, in soup order: what the k-d tree is built from.
     pub fn triangle_positions(&self) -> Vec<[Vec3; 3]> {
-        use rayon::prelude::*;
-        self.triangles
-            .par_iter()
-            .with_min_len(1 << 14)
-            .map(|t| t.map(|v| self.positions[v as usize]))
-            .collect()
+        corners(&self.positions, &self.triangles)
     }
 
     /// Append a triangle with three vertices of its own, and its UVs when the soup has
@@ -470,14 +465,7 @@ impl Soup {
                 self.tri_object.len()
             ));
         }
-        if let Some(i) =
-            crate::first_bad(&self.triangles, |_, t| t.iter().any(|&i| i as usize >= v))
-        {
-            return Err(format!(
-                "triangle {i} names vertices {:?} of {v}",
-                self.triangles[i]
-            ));
-        }
+        check_geometry(&self.positions, &self.triangles, &self.geometry_hash)?;
         if let Some(i) = crate::first_bad(&self.tri_material, |_, &m| {
             m as usize >= self.materials.len()
         }) {
@@ -502,12 +490,6 @@ impl Soup {
                 "object {i} is on layer {}; Unity has 32",
                 self.objects[i].layer
             ));
-        }
-        if let Some(i) = crate::first_bad(&self.positions, |_, p| !p.is_finite()) {
-            return Err(format!("vertex {i} is not finite"));
-        }
-        if indexed_geometry_hash(&self.positions, &self.triangles) != self.geometry_hash {
-            return Err("geometry hash does not match the triangles".into());
         }
         Ok(())
     }
@@ -578,6 +560,26 @@ impl Soup {
         Self::from_bytes(&envelope::read_file(path)?, path)
     }
 
+    /// The [`SoupGeometry`] of the soup at `path`: the whole payload's checksum verified,
+    /// positions and triangles decoded and checked as [`Soup::read`] checks them, the rest
+    /// (normals, materials, textures …) neither decoded nor checked.
+    pub fn read_geometry(path: &Path) -> Result<SoupGeometry, FormatError> {
+        let bytes = envelope::read_file(path)?;
+        envelope::decode_part::<Soup, _>(&bytes, path, |r| {
+            let positions = r.array("positions")?;
+            r.skip_array::<Vec3>("normals")?;
+            r.skip_array::<Vec2>("uvs")?;
+            let triangles = r.array("triangles")?;
+            let geometry_hash = r.last::<32>("the geometry hash")?;
+            check_geometry(&positions, &triangles, &geometry_hash)?;
+            Ok(SoupGeometry {
+                positions,
+                triangles,
+                geometry_hash,
+            })
+        })
+    }
+
     /// The [`SoupKey`] of the soup at `path`: the whole payload's checksum verified, then
     /// the triangles' count and the last field, without decoding or checking the rest
     /// ([`Soup::read`] does; a renderer reading the soup refuses one whose geometry hash
@@ -595,6 +597,51 @@ impl Soup {
                 geometry_hash,
             })
         })
+    }
+}
+
+/// Three corners per triangle, gathered on all cores.
+fn corners(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<[Vec3; 3]> {
+    use rayon::prelude::*;
+    triangles
+        .par_iter()
+        .with_min_len(1 << 14)
+        .map(|t| t.map(|v| positions[v as usize]))
+        .collect()
+}
+
+/// Every triangle names existing vertices, every vertex is finite, and the geometry hash is
+/// theirs.
+fn check_geometry(positions: &[Vec3], triangles: &[[u32; 3]], hash: &Digest) -> Result<(), String> {
+    let v = positions.len();
+    if let Some(i) = crate::first_bad(triangles, |_, t| t.iter().any(|&i| i as usize >= v)) {
+        return Err(format!(
+            "triangle {i} names vertices {:?} of {v}",
+            triangles[i]
+        ));
+    }
+    if let Some(i) = crate::first_bad(positions, |_, p| !p.is_finite()) {
+        return Err(format!("vertex {i} is not finite"));
+    }
+    if indexed_geometry_hash(positions, triangles) != *hash {
+        return Err("geometry hash does not match the triangles".into());
+    }
+    Ok(())
+}
+
+/// What a tree is built from: a soup's positions and triangles and their hash
+/// ([`Soup::read_geometry`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SoupGeometry {
+    pub positions: Vec<Vec3>,
+    pub triangles: Vec<[u32; 3]>,
+    pub geometry_hash: Digest,
+}
+
+impl SoupGeometry {
+    /// The corners of each triangle.
+    pub fn triangle_positions(&self) -> Vec<[Vec3; 3]> {
+        corners(&self.positions, &self.triangles)
     }
 }
 

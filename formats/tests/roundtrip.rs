@@ -376,6 +376,53 @@ fn keys_and_headers_match_the_full_reads() {
     );
 }
 
+/// `soup2kd` builds from a soup's geometry alone: the positions and triangles as the full
+/// read gives them, checked as it checks them; what the build does not read is not checked.
+#[test]
+fn geometry_reads_match_the_full_reads_and_check_the_geometry() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, soup) in [("small.soup", sample_soup()), ("large.soup", large_soup())] {
+        let path = dir.path().join(name);
+        soup.write(&path).unwrap();
+        let g = Soup::read_geometry(&path).unwrap();
+        assert_eq!(g.positions, soup.positions);
+        assert_eq!(g.triangles, soup.triangles);
+        assert_eq!(g.geometry_hash, soup.geometry_hash);
+        assert_eq!(g.triangle_positions(), soup.triangle_positions());
+    }
+    let path = dir.path().join("edited.soup");
+    let refused = |edit: &dyn Fn(&mut Soup), want: &str| {
+        let mut s = sample_soup();
+        edit(&mut s);
+        s.seal();
+        s.write(&path).unwrap();
+        for msg in [
+            Soup::read_geometry(&path).unwrap_err().to_string(),
+            Soup::read(&path).unwrap_err().to_string(),
+        ] {
+            assert!(msg.contains(want), "{want}: {msg}");
+        }
+    };
+    refused(
+        &|s| s.triangles[1][2] = 5,
+        "triangle 1 names vertices [3, 1, 5] of 5",
+    );
+    refused(&|s| s.positions[3].y = f32::NAN, "vertex 3 is not finite");
+    // A geometry hash that is not the triangles' (written without sealing).
+    let mut s = sample_soup();
+    s.geometry_hash[0] ^= 1;
+    s.write(&path).unwrap();
+    let msg = Soup::read_geometry(&path).unwrap_err().to_string();
+    assert!(msg.contains("geometry hash does not match"), "{msg}");
+    // A material index past the end: the renderer's problem, not the build's.
+    let mut s = sample_soup();
+    s.tri_material[0] = 7;
+    s.write(&path).unwrap();
+    assert!(Soup::read_geometry(&path).is_ok());
+    let msg = Soup::read(&path).unwrap_err().to_string();
+    assert!(msg.contains("triangle 0 names material 7 of 1"), "{msg}");
+}
+
 /// A large tree's checks name the first bad node and leaf entry too.
 #[test]
 fn large_trees_name_their_first_bad_node_and_entry() {

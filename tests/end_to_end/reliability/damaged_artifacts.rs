@@ -2,37 +2,22 @@
 
 use super::cases::*;
 use super::project::*;
-use formats::{soup::geometry_hash, KdFile, Soup};
-use glam::Vec3;
+use formats::{KdFile, Soup};
 use std::path::PathBuf;
 
-/// The artifact frame around `payload` with a correct checksum. The test package has no
-/// BLAKE3 of its own; `geometry_hash` is BLAKE3 over f32 little-endian bytes, so the
-/// payload (zero-padded to whole triangles, which the decoder never reaches) is handed
-/// to it as triangles whose bits are the payload bytes.
-fn frame(magic: &[u8; 8], version: u32, payload: &[u8]) -> Vec<u8> {
-    let mut payload = payload.to_vec();
-    payload.resize(payload.len().div_ceil(36) * 36, 0);
-    let f = |b: &[u8]| f32::from_bits(u32::from_le_bytes(b.try_into().expect("4")));
-    let tris: Vec<[Vec3; 3]> = payload
-        .chunks_exact(36)
-        .map(|t| {
-            let v =
-                |k: usize| Vec3::new(f(&t[k..k + 4]), f(&t[k + 4..k + 8]), f(&t[k + 8..k + 12]));
-            [v(0), v(12), v(24)]
-        })
-        .collect();
-    let mut out = magic.to_vec();
-    out.extend_from_slice(&version.to_le_bytes());
+/// The artifact frame around `payload` with a correct checksum and `good`'s magic and
+/// version: only the decoder stands between a damaged payload and the reader.
+fn frame(good: &[u8], payload: &[u8]) -> Vec<u8> {
+    let mut out = good[..12].to_vec();
     out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
-    out.extend_from_slice(&geometry_hash(&tris));
-    out.extend_from_slice(&payload);
+    out.extend_from_slice(blake3::hash(payload).as_bytes());
+    out.extend_from_slice(payload);
     out
 }
 
 /// Bad variants of one artifact file: (label, bytes). `len_at` is the payload offset of a
 /// u64 element count to replace by 10¹².
-fn bad_variants(good: &[u8], magic: &[u8; 8], len_at: usize) -> Vec<(&'static str, Vec<u8>)> {
+fn bad_variants(good: &[u8], len_at: usize) -> Vec<(&'static str, Vec<u8>)> {
     let mut old = good.to_vec();
     old[8..12].copy_from_slice(&0u32.to_le_bytes());
     let mut newer = good.to_vec();
@@ -60,10 +45,7 @@ fn bad_variants(good: &[u8], magic: &[u8; 8], len_at: usize) -> Vec<(&'static st
         ("4 bytes flipped mid-file", flipped),
         ("stray bytes after payload", [good, b"xx"].concat()),
         ("header length 10^12", lying_header),
-        (
-            "element count 10^12 (valid checksum)",
-            frame(magic, 1, &huge),
-        ),
+        ("element count 10^12 (valid checksum)", frame(good, &huge)),
     ]
 }
 
@@ -95,40 +77,60 @@ fn damaged_soup_and_kd_files_are_refused_by_every_reader() {
         ("missing".into(), dir.join("nope.soup")),
         ("a directory (unreadable)".into(), dir.join("Assets")),
     ];
-    for (label, bytes) in bad_variants(&good_soup, formats::soup::MAGIC, 0) {
+    for (label, bytes) in bad_variants(&good_soup, 0) {
         n += 1;
         let p = dir.join(format!("bad{n}.soup"));
         std::fs::write(&p, bytes).unwrap();
         soup_inputs.push((label.to_string(), p));
     }
     // A string length of 2·10¹⁸ behind a valid checksum (the object name "Box"): bincode
-    // used to allocate it before reading (found by cargo fuzz).
+    // used to allocate it before reading (found by cargo fuzz). The geometry is intact:
+    // soup2kd, which reads only the geometry, builds from it; the other readers refuse it.
     let mut payload = good_soup[52..].to_vec();
     let at = payload.windows(3).position(|w| w == b"Box").unwrap() - 8;
     payload[at..at + 8].copy_from_slice(&0x2074_6c75_6166_6544u64.to_le_bytes());
     let p = dir.join("huge-name.soup");
-    std::fs::write(&p, frame(formats::soup::MAGIC, 1, &payload)).unwrap();
+    std::fs::write(&p, frame(&good_soup, &payload)).unwrap();
     soup_inputs.push(("string length 2·10^18 (valid checksum)".into(), p));
     for (label, p) in &soup_inputs {
         let what = format!(".soup {label}");
         let ps = s(p);
+        // A damaged payload behind a valid checksum is named as one that does not decode.
+        let names: &[&str] = if label.ends_with("(valid checksum)") {
+            &[&ps, "does not decode"]
+        } else {
+            &[&ps]
+        };
+        let geometry_intact = label.starts_with("string length");
         let o = dir.join(format!("o{n}"));
         n += 1;
         std::fs::write(&o, &prev).unwrap();
-        cases.push(case(
-            &what,
-            "soup2kd",
-            &[&ps, "-o", &s(&o)],
-            1,
-            &[&ps],
-            Out::Intact(o.clone(), prev.clone()),
-        ));
+        if geometry_intact {
+            let kd_out = dir.join(format!("o{n}.kd"));
+            cases.push(case(
+                &what,
+                "soup2kd",
+                &[&ps, "-o", &s(&kd_out)],
+                0,
+                &["soup2kd:"],
+                Out::Written(kd_out),
+            ));
+        } else {
+            cases.push(case(
+                &what,
+                "soup2kd",
+                &[&ps, "-o", &s(&o)],
+                1,
+                names,
+                Out::Intact(o.clone(), prev.clone()),
+            ));
+        }
         cases.push(case(
             &what,
             "soup2obj",
             &[&ps, "-o", &s(&o)],
             1,
-            &[&ps],
+            names,
             Out::Intact(o.clone(), prev.clone()),
         ));
         cases.push(case(
@@ -136,7 +138,7 @@ fn damaged_soup_and_kd_files_are_refused_by_every_reader() {
             "raycast",
             &[&ps, &s(&a.kd), &s(&rays), "-o", &s(&o)],
             1,
-            &[&ps],
+            names,
             Out::Intact(o.clone(), prev.clone()),
         ));
         cases.push(case(
@@ -153,7 +155,7 @@ fn damaged_soup_and_kd_files_are_refused_by_every_reader() {
                 "8",
             ],
             1,
-            &[&ps],
+            names,
             Out::Intact(o.clone(), prev.clone()),
         ));
         let cache = dir.join(format!("cache{n}"));
@@ -161,8 +163,12 @@ fn damaged_soup_and_kd_files_are_refused_by_every_reader() {
             &what,
             "soup2kd",
             &[&ps, "--cache", &s(&cache)],
-            1,
-            &[&ps],
+            if geometry_intact { 0 } else { 1 },
+            if geometry_intact {
+                &["cache miss"]
+            } else {
+                names
+            },
             Out::None,
         ));
     }
@@ -170,7 +176,7 @@ fn damaged_soup_and_kd_files_are_refused_by_every_reader() {
         ("missing".into(), dir.join("nope.kd")),
         ("a directory (unreadable)".into(), dir.join("Assets")),
     ];
-    for (label, bytes) in bad_variants(&good_kd, formats::kd::MAGIC, nodes_at) {
+    for (label, bytes) in bad_variants(&good_kd, nodes_at) {
         n += 1;
         let p = dir.join(format!("bad{n}.kd"));
         std::fs::write(&p, bytes).unwrap();
@@ -180,6 +186,11 @@ fn damaged_soup_and_kd_files_are_refused_by_every_reader() {
     for (label, p) in &kd_inputs {
         let what = format!(".kd {label}");
         let ps = s(p);
+        let names: &[&str] = if label.ends_with("(valid checksum)") {
+            &[&ps, "does not decode"]
+        } else {
+            &[&ps]
+        };
         let o = dir.join(format!("o{n}"));
         n += 1;
         std::fs::write(&o, &prev).unwrap();
@@ -188,7 +199,7 @@ fn damaged_soup_and_kd_files_are_refused_by_every_reader() {
             "raycast",
             &[&s(&a.soup), &ps, &s(&rays), "-o", &s(&o)],
             1,
-            &[&ps],
+            names,
             Out::Intact(o.clone(), prev.clone()),
         ));
         cases.push(case(
@@ -205,7 +216,7 @@ fn damaged_soup_and_kd_files_are_refused_by_every_reader() {
                 "8",
             ],
             1,
-            &[&ps],
+            names,
             Out::Intact(o.clone(), prev.clone()),
         ));
         cases.push(case(
@@ -213,7 +224,7 @@ fn damaged_soup_and_kd_files_are_refused_by_every_reader() {
             "soup2kd",
             &["--stats", &ps],
             1,
-            &[&ps],
+            names,
             Out::None,
         ));
     }

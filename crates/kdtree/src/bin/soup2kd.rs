@@ -189,19 +189,24 @@ fn run(cli: Cli) -> Result<()> {
         }
         (None, None) => unreachable!("checked above"),
     };
-    let soup = Soup::read(soup_path)?;
-    if soup.triangles.len() >= kdtree::MAX_TRIANGLES {
+    // The build reads only the soup's geometry (its checksum verified over the whole
+    // file), and only the corners once they are gathered.
+    let soup = Soup::read_geometry(soup_path)?;
+    let (count, geometry_hash) = (soup.triangles.len(), soup.geometry_hash);
+    if count >= kdtree::MAX_TRIANGLES {
         bail!(
-            "{}: {} triangles; a tree holds fewer than {} (30-bit indices in nodes and build events)",
+            "{}: {count} triangles; a tree holds fewer than {} (30-bit indices in nodes and build events)",
             soup_path.display(),
-            soup.triangles.len(),
             kdtree::MAX_TRIANGLES
         );
     }
-    let kd = kdtree::build(&soup.triangle_positions(), &params, soup.geometry_hash);
+    let corners = soup.triangle_positions();
+    drop(soup);
+    let kd = kdtree::build(&corners, &params, geometry_hash);
+    drop(corners);
     // Atomic (temp file + rename): concurrent builders of one cache entry both succeed.
     kd.write(&path)?;
-    report(&cli, soup.triangles.len(), &kd.stats, &path, cache, start)
+    report(&cli, count, &kd.stats, &path, cache, start)
 }
 
 fn report(
