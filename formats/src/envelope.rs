@@ -93,7 +93,8 @@ pub fn decode<A: Artifact>(bytes: &[u8], path: &Path) -> Result<A, FormatError> 
 
 /// The leading fields of an artifact (and any fixed-size last one), read by `read` once
 /// the frame and the checksum of the whole payload are verified, without decoding the rest
-/// or checking its cross-references (what `soup2kd --cache` needs to find a cached tree).
+/// or checking its cross-references (what `soup2kd` needs to find a cached tree or to build
+/// one).
 pub fn decode_part<A: Artifact, T>(
     bytes: &[u8],
     path: &Path,
