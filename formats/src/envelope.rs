@@ -91,24 +91,41 @@ pub fn decode<A: Artifact>(bytes: &[u8], path: &Path) -> Result<A, FormatError> 
     Ok(value)
 }
 
-/// The leading fields of an artifact (and any fixed-size last one), read by `read` once
-/// the frame and the checksum of the whole payload are verified, without decoding the rest
-/// or checking its cross-references (what `soup2kd` needs to find a cached tree or to build
-/// one).
-pub fn decode_part<A: Artifact, T>(
-    bytes: &[u8],
-    path: &Path,
-    read: impl FnOnce(&mut PayloadReader) -> Result<T, String>,
-) -> Result<T, FormatError> {
-    let payload = checked_payload(bytes, A::MAGIC, A::KIND, A::VERSION, path)?;
-    read(&mut PayloadReader {
-        bytes: payload,
-        pos: 0,
-    })
-    .map_err(|detail| FormatError::Corrupt {
-        path: path.to_path_buf(),
-        detail,
-    })
+/// An artifact file whose frame and payload checksum are verified, its fields read on
+/// demand without decoding the rest or checking its cross-references: `soup2kd` reads a
+/// soup's key and then, on a cache miss, its geometry, with one pass of the checksum.
+pub struct Checked<A> {
+    bytes: FileBytes,
+    path: std::path::PathBuf,
+    kind: std::marker::PhantomData<A>,
+}
+
+impl<A: Artifact> Checked<A> {
+    pub fn open(path: &Path) -> Result<Checked<A>, FormatError> {
+        let bytes = read_file(path)?;
+        checked_payload(&bytes, A::MAGIC, A::KIND, A::VERSION, path)?;
+        Ok(Checked {
+            bytes,
+            path: path.to_path_buf(),
+            kind: std::marker::PhantomData,
+        })
+    }
+
+    /// What `read` takes from the payload (its leading fields, any fixed-size last one),
+    /// its errors named as corruption of this file.
+    pub fn read<T>(
+        &self,
+        read: impl FnOnce(&mut PayloadReader) -> Result<T, String>,
+    ) -> Result<T, FormatError> {
+        read(&mut PayloadReader {
+            bytes: &self.bytes[HEADER_LEN..],
+            pos: 0,
+        })
+        .map_err(|detail| FormatError::Corrupt {
+            path: self.path.clone(),
+            detail,
+        })
+    }
 }
 
 /// The payload of `bytes` once magic, version, length and checksum are right.

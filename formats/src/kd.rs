@@ -237,8 +237,7 @@ impl KdFile {
     /// The leading fields of the tree at `path`, the whole payload's checksum verified,
     /// without decoding or checking its nodes and lists ([`KdFile::read`] does).
     pub fn read_header(path: &Path) -> Result<KdHeader, FormatError> {
-        let bytes = envelope::read_file(path)?;
-        envelope::decode_part::<KdFile, _>(&bytes, path, KdHeader::read)
+        envelope::Checked::<KdFile>::open(path)?.read(KdHeader::read)
     }
 
     pub fn from_bytes(bytes: &[u8], path: &Path) -> Result<Self, FormatError> {

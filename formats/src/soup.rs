@@ -559,13 +559,31 @@ impl Soup {
     pub fn read(path: &Path) -> Result<Self, FormatError> {
         Self::from_bytes(&envelope::read_file(path)?, path)
     }
+}
 
-    /// The [`SoupGeometry`] of the soup at `path`: the whole payload's checksum verified,
-    /// positions and triangles decoded and checked as [`Soup::read`] checks them, the rest
-    /// (normals, materials, textures …) neither decoded nor checked.
-    pub fn read_geometry(path: &Path) -> Result<SoupGeometry, FormatError> {
-        let bytes = envelope::read_file(path)?;
-        envelope::decode_part::<Soup, _>(&bytes, path, |r| {
+impl envelope::Checked<Soup> {
+    /// The soup's [`SoupKey`]: the triangles' count and the last field, without decoding
+    /// or checking the rest ([`Soup::read`] does; a renderer reading the soup refuses one
+    /// whose geometry hash does not match its triangles).
+    pub fn key(&self) -> Result<SoupKey, FormatError> {
+        self.read(|r| {
+            r.skip_array::<Vec3>("positions")?;
+            r.skip_array::<Vec3>("normals")?;
+            r.skip_array::<Vec2>("uvs")?;
+            let triangles = r.skip_array::<[u32; 3]>("triangles")?;
+            let geometry_hash = r.last::<32>("the geometry hash")?;
+            Ok(SoupKey {
+                triangles,
+                geometry_hash,
+            })
+        })
+    }
+
+    /// The soup's [`SoupGeometry`]: positions and triangles decoded and checked as
+    /// [`Soup::read`] checks them, the rest (normals, materials, textures …) neither
+    /// decoded nor checked.
+    pub fn geometry(&self) -> Result<SoupGeometry, FormatError> {
+        self.read(|r| {
             let positions = r.array("positions")?;
             r.skip_array::<Vec3>("normals")?;
             r.skip_array::<Vec2>("uvs")?;
@@ -574,25 +592,6 @@ impl Soup {
             check_geometry(&positions, &triangles, &geometry_hash)?;
             Ok(SoupGeometry {
                 positions,
-                triangles,
-                geometry_hash,
-            })
-        })
-    }
-
-    /// The [`SoupKey`] of the soup at `path`: the whole payload's checksum verified, then
-    /// the triangles' count and the last field, without decoding or checking the rest
-    /// ([`Soup::read`] does; a renderer reading the soup refuses one whose geometry hash
-    /// does not match its triangles).
-    pub fn read_key(path: &Path) -> Result<SoupKey, FormatError> {
-        let bytes = envelope::read_file(path)?;
-        envelope::decode_part::<Soup, _>(&bytes, path, |r| {
-            r.skip_array::<Vec3>("positions")?;
-            r.skip_array::<Vec3>("normals")?;
-            r.skip_array::<Vec2>("uvs")?;
-            let triangles = r.skip_array::<[u32; 3]>("triangles")?;
-            let geometry_hash = r.last::<32>("the geometry hash")?;
-            Ok(SoupKey {
                 triangles,
                 geometry_hash,
             })
@@ -630,7 +629,7 @@ fn check_geometry(positions: &[Vec3], triangles: &[[u32; 3]], hash: &Digest) -> 
 }
 
 /// What a tree is built from: a soup's positions and triangles and their hash
-/// ([`Soup::read_geometry`]).
+/// (`Checked::<Soup>::geometry`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct SoupGeometry {
     pub positions: Vec<Vec3>,

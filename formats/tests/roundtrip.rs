@@ -296,7 +296,6 @@ fn large_arrays_round_trip_and_name_their_first_bad_entry() {
     assert!(s.triangles.len() * 12 > 3 << 20);
     s.write(&path).unwrap();
     assert_eq!(Soup::read(&path).unwrap(), s);
-    let p = Path::new("large.soup");
     type Edit<'a> = (&'a dyn Fn(&mut Soup), &'a str);
     let cases: [Edit; 4] = [
         (
@@ -326,14 +325,18 @@ fn large_arrays_round_trip_and_name_their_first_bad_entry() {
         ),
     ];
     for (edit, want) in cases {
-        let mut bad = s.clone();
-        edit(&mut bad);
-        bad.seal();
-        let msg = Soup::from_bytes(&bad.to_bytes(p).unwrap(), p)
-            .unwrap_err()
-            .to_string();
-        assert!(msg.contains(want), "{want}: {msg}");
+        refused_edit_of(s.clone(), edit, want);
     }
+}
+
+/// A soup's key, its checksum verified first.
+fn read_key(path: &Path) -> Result<SoupKey, FormatError> {
+    envelope::Checked::<Soup>::open(path)?.key()
+}
+
+/// A soup's geometry, its checksum verified first.
+fn read_geometry(path: &Path) -> Result<SoupGeometry, FormatError> {
+    envelope::Checked::<Soup>::open(path)?.geometry()
 }
 
 /// `soup2kd --cache` finds a tree from a soup's key and a tree's header: both read as the
@@ -344,14 +347,14 @@ fn keys_and_headers_match_the_full_reads() {
     for (name, soup) in [("small.soup", sample_soup()), ("large.soup", large_soup())] {
         let path = dir.path().join(name);
         soup.write(&path).unwrap();
-        let key = Soup::read_key(&path).unwrap();
+        let key = read_key(&path).unwrap();
         assert_eq!(key.triangles, soup.triangles.len());
         assert_eq!(key.geometry_hash, soup.geometry_hash);
         let mut bytes = std::fs::read(&path).unwrap();
         let at = bytes.len() - 40;
         bytes[at] ^= 1;
         std::fs::write(&path, &bytes).unwrap();
-        let msg = Soup::read_key(&path).unwrap_err().to_string();
+        let msg = read_key(&path).unwrap_err().to_string();
         assert!(msg.contains("checksum"), "{msg}");
     }
     // A well-framed payload that ends inside the arrays.
@@ -363,7 +366,7 @@ fn keys_and_headers_match_the_full_reads() {
     bytes.extend_from_slice(blake3::hash(&payload).as_bytes());
     bytes.extend_from_slice(&payload);
     std::fs::write(&path, &bytes).unwrap();
-    let msg = Soup::read_key(&path).unwrap_err().to_string();
+    let msg = read_key(&path).unwrap_err().to_string();
     assert!(msg.contains("inside the count of normals"), "{msg}");
 
     let path = dir.path().join("t.kd");
@@ -384,7 +387,7 @@ fn geometry_reads_match_the_full_reads_and_check_the_geometry() {
     for (name, soup) in [("small.soup", sample_soup()), ("large.soup", large_soup())] {
         let path = dir.path().join(name);
         soup.write(&path).unwrap();
-        let g = Soup::read_geometry(&path).unwrap();
+        let g = read_geometry(&path).unwrap();
         assert_eq!(g.positions, soup.positions);
         assert_eq!(g.triangles, soup.triangles);
         assert_eq!(g.geometry_hash, soup.geometry_hash);
@@ -397,7 +400,7 @@ fn geometry_reads_match_the_full_reads_and_check_the_geometry() {
         s.seal();
         s.write(&path).unwrap();
         for msg in [
-            Soup::read_geometry(&path).unwrap_err().to_string(),
+            read_geometry(&path).unwrap_err().to_string(),
             Soup::read(&path).unwrap_err().to_string(),
         ] {
             assert!(msg.contains(want), "{want}: {msg}");
@@ -412,13 +415,13 @@ fn geometry_reads_match_the_full_reads_and_check_the_geometry() {
     let mut s = sample_soup();
     s.geometry_hash[0] ^= 1;
     s.write(&path).unwrap();
-    let msg = Soup::read_geometry(&path).unwrap_err().to_string();
+    let msg = read_geometry(&path).unwrap_err().to_string();
     assert!(msg.contains("geometry hash does not match"), "{msg}");
     // A material index past the end: the renderer's problem, not the build's.
     let mut s = sample_soup();
     s.tri_material[0] = 7;
     s.write(&path).unwrap();
-    assert!(Soup::read_geometry(&path).is_ok());
+    assert!(read_geometry(&path).is_ok());
     let msg = Soup::read(&path).unwrap_err().to_string();
     assert!(msg.contains("triangle 0 names material 7 of 1"), "{msg}");
 }
@@ -576,8 +579,13 @@ fn geometry_hash_depends_on_positions_only() {
 /// `sample_soup` edited by `edit` (its geometry hash recomputed) is refused on read with a
 /// message containing `want`.
 fn refused(edit: &dyn Fn(&mut Soup), want: &str) {
+    refused_edit_of(sample_soup(), edit, want);
+}
+
+/// `soup` edited by `edit` (its geometry hash recomputed) is refused on read with a
+/// message containing `want`.
+fn refused_edit_of(mut s: Soup, edit: &dyn Fn(&mut Soup), want: &str) {
     let p = Path::new("edited.soup");
-    let mut s = sample_soup();
     edit(&mut s);
     s.seal();
     let msg = Soup::from_bytes(&s.to_bytes(p).unwrap(), p)

@@ -2,7 +2,7 @@
 
 use anyhow::{bail, Context, Result};
 use clap::{CommandFactory, Parser};
-use formats::{BuildParams, KdFile, Soup, TreeStats};
+use formats::{envelope::Checked, BuildParams, KdFile, Soup, TreeStats};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -167,6 +167,9 @@ fn run(cli: Cli) -> Result<()> {
     }
     let params = params(&cli)?;
     let start = Instant::now();
+    // The soup's checksum is verified once, over the whole file; only what is used is
+    // decoded from it.
+    let file = Checked::<Soup>::open(soup_path)?;
     let (path, cache) = match (&cli.output, &cli.cache) {
         (Some(out), _) => (out.clone(), "none"),
         (None, Some(dir)) => {
@@ -174,7 +177,7 @@ fn run(cli: Cli) -> Result<()> {
                 .with_context(|| format!("cannot create cache folder {}", dir.display()))?;
             // A hit reads only what names and matches the tree; both files' checksums are
             // verified, and the renderer checks the rest when it loads them.
-            let key = Soup::read_key(soup_path)?;
+            let key = file.key()?;
             let path = dir.join(params.cache_name(&key.geometry_hash));
             let cached = path
                 .exists()
@@ -189,9 +192,10 @@ fn run(cli: Cli) -> Result<()> {
         }
         (None, None) => unreachable!("checked above"),
     };
-    // The build reads only the soup's geometry (its checksum verified over the whole
-    // file), and only the corners once they are gathered.
-    let soup = Soup::read_geometry(soup_path)?;
+    // The build reads only the soup's geometry, and only the corners once they are
+    // gathered.
+    let soup = file.geometry()?;
+    drop(file);
     let (count, geometry_hash) = (soup.triangles.len(), soup.geometry_hash);
     if count >= kdtree::MAX_TRIANGLES {
         bail!(
