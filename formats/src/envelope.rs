@@ -102,7 +102,15 @@ pub struct Checked<A> {
 
 impl<A: Artifact> Checked<A> {
     pub fn open(path: &Path) -> Result<Checked<A>, FormatError> {
-        let bytes = read_file(path)?;
+        Self::verify(read_file(path)?, path)
+    }
+
+    /// A file's bytes already in memory, `path` naming it in errors.
+    pub fn from_bytes(bytes: Vec<u8>, path: &Path) -> Result<Checked<A>, FormatError> {
+        Self::verify(FileBytes::Read(bytes), path)
+    }
+
+    fn verify(bytes: FileBytes, path: &Path) -> Result<Checked<A>, FormatError> {
         checked_payload(&bytes, A::MAGIC, A::KIND, A::VERSION, path)?;
         Ok(Checked {
             bytes,

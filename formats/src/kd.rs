@@ -173,6 +173,14 @@ impl KdHeader {
     }
 }
 
+impl envelope::Checked<KdFile> {
+    /// The tree's [`KdHeader`], without decoding or checking its nodes and lists
+    /// ([`KdFile::read`] does).
+    pub fn header(&self) -> Result<KdHeader, FormatError> {
+        self.read(KdHeader::read)
+    }
+}
+
 /// Where [`KdFile::height`] stops counting.
 pub const HEIGHT_CAP: u32 = u8::MAX as u32;
 
@@ -237,7 +245,7 @@ impl KdFile {
     /// The leading fields of the tree at `path`, the whole payload's checksum verified,
     /// without decoding or checking its nodes and lists ([`KdFile::read`] does).
     pub fn read_header(path: &Path) -> Result<KdHeader, FormatError> {
-        envelope::Checked::<KdFile>::open(path)?.read(KdHeader::read)
+        envelope::Checked::<KdFile>::open(path)?.header()
     }
 
     pub fn from_bytes(bytes: &[u8], path: &Path) -> Result<Self, FormatError> {
