@@ -360,12 +360,7 @@ fn keys_and_headers_match_the_full_reads() {
     // A well-framed payload that ends inside the arrays.
     let path = dir.path().join("short.soup");
     let good = sample_soup().to_bytes(&path).unwrap();
-    let payload = good[52..60 + 5 * 12].to_vec();
-    let mut bytes = good[..12].to_vec();
-    bytes.extend_from_slice(&(payload.len() as u64).to_le_bytes());
-    bytes.extend_from_slice(blake3::hash(&payload).as_bytes());
-    bytes.extend_from_slice(&payload);
-    std::fs::write(&path, &bytes).unwrap();
+    std::fs::write(&path, framed(&good, &good[52..60 + 5 * 12])).unwrap();
     let msg = read_key(&path).unwrap_err().to_string();
     assert!(msg.contains("inside the count of normals"), "{msg}");
 
@@ -426,6 +421,24 @@ fn geometry_reads_match_the_full_reads_and_check_the_geometry() {
     assert!(msg.contains("triangle 0 names material 7 of 1"), "{msg}");
 }
 
+/// `good`'s magic and version framing `payload`, with its length and a correct checksum:
+/// only the decoder stands between a damaged payload and the reader.
+fn framed(good: &[u8], payload: &[u8]) -> Vec<u8> {
+    let mut bytes = good[..12].to_vec();
+    bytes.extend_from_slice(&(payload.len() as u64).to_le_bytes());
+    bytes.extend_from_slice(blake3::hash(payload).as_bytes());
+    bytes.extend_from_slice(payload);
+    bytes
+}
+
+/// Why the reader refuses `k` once written (it panics if the reader accepts it).
+fn kd_refusal(k: &KdFile) -> String {
+    let p = Path::new("bad.kd");
+    KdFile::from_bytes(&k.to_bytes(p).unwrap(), p)
+        .unwrap_err()
+        .to_string()
+}
+
 /// A large tree's checks name the first bad node and leaf entry too.
 #[test]
 fn large_trees_name_their_first_bad_node_and_entry() {
@@ -446,9 +459,7 @@ fn large_trees_name_their_first_bad_node_and_entry() {
     let mut bad = k.clone();
     bad.nodes[190_000] = KdNode::interior(0, 0.5, 7);
     bad.nodes[150_000] = KdNode::interior(1, 0.5, 150_000);
-    let msg = KdFile::from_bytes(&bad.to_bytes(p).unwrap(), p)
-        .unwrap_err()
-        .to_string();
+    let msg = kd_refusal(&bad);
     assert!(
         msg.contains("node 150000 points at child 150000 of 200001"),
         "{msg}"
@@ -456,9 +467,7 @@ fn large_trees_name_their_first_bad_node_and_entry() {
     let mut bad = k.clone();
     bad.nodes[199_999] = KdNode::leaf(2, 299_999);
     bad.nodes[70_001] = KdNode::leaf(9, 299_999);
-    let msg = KdFile::from_bytes(&bad.to_bytes(p).unwrap(), p)
-        .unwrap_err()
-        .to_string();
+    let msg = kd_refusal(&bad);
     assert!(
         msg.contains("leaf 70001 reaches past the triangle list"),
         "{msg}"
@@ -466,9 +475,7 @@ fn large_trees_name_their_first_bad_node_and_entry() {
     let mut bad = k;
     bad.leaf_tris[250_000] = 9;
     bad.leaf_tris[66_000] = 2;
-    let msg = KdFile::from_bytes(&bad.to_bytes(p).unwrap(), p)
-        .unwrap_err()
-        .to_string();
+    let msg = kd_refusal(&bad);
     assert!(
         msg.contains("leaf triangle 2 is out of range (2 triangles)"),
         "{msg}"
@@ -483,10 +490,9 @@ fn a_length_field_claiming_a_trillion_elements_fails_fast() {
     let good = sample_soup().to_bytes(p).unwrap();
     let mut payload = good[52..].to_vec();
     payload[..8].copy_from_slice(&1_000_000_000_000u64.to_le_bytes());
-    let mut bytes = good[..20].to_vec();
-    bytes.extend_from_slice(blake3::hash(&payload).as_bytes());
-    bytes.extend_from_slice(&payload);
-    let msg = Soup::from_bytes(&bytes, p).unwrap_err().to_string();
+    let msg = Soup::from_bytes(&framed(&good, &payload), p)
+        .unwrap_err()
+        .to_string();
     assert!(msg.contains("does not decode"), "{msg}");
 }
 
@@ -503,10 +509,9 @@ fn a_string_length_claiming_exabytes_fails_fast() {
         let at = payload.windows(4).position(|w| w == b"Cube").unwrap() - 8;
         assert_eq!(&payload[at..at + 8], &4u64.to_le_bytes());
         payload[at..at + 8].copy_from_slice(&claim.to_le_bytes());
-        let mut bytes = good[..20].to_vec();
-        bytes.extend_from_slice(blake3::hash(&payload).as_bytes());
-        bytes.extend_from_slice(&payload);
-        let msg = Soup::from_bytes(&bytes, p).unwrap_err().to_string();
+        let msg = Soup::from_bytes(&framed(&good, &payload), p)
+            .unwrap_err()
+            .to_string();
         assert!(
             msg.starts_with("huge-name.soup: corrupted: payload does not decode"),
             "{msg}"
@@ -516,12 +521,9 @@ fn a_string_length_claiming_exabytes_fails_fast() {
 
 #[test]
 fn kd_with_a_dangling_child_is_refused() {
-    let p = Path::new("bad.kd");
     let mut k = sample_kd();
     k.nodes[0] = KdNode::interior(0, 0.5, 7);
-    let msg = KdFile::from_bytes(&k.to_bytes(p).unwrap(), p)
-        .unwrap_err()
-        .to_string();
+    let msg = kd_refusal(&k);
     assert!(msg.contains("node 0 points at child 7"), "{msg}");
 }
 
