@@ -626,11 +626,16 @@ pub fn merge_labelled(parts: &[(String, &ExrImage)]) -> std::result::Result<ExrI
         for key in SAME_RENDER {
             let k = format!("{ATTR_PREFIX}{key}");
             if p.attributes.get(&k) != first.attributes.get(&k) {
+                let value = |img: &ExrImage| {
+                    img.attributes
+                        .get(&k)
+                        .map_or("unset".to_string(), |v| format!("\"{v}\""))
+                };
                 return Err(bad(format!(
-                    "{label} was rendered with {key} {:?}, {first_label} with {:?}: \
+                    "{label} was rendered with {key} {}, {first_label} with {}: \
                      they are not crops of one render",
-                    p.attributes.get(&k),
-                    first.attributes.get(&k)
+                    value(p),
+                    value(first)
                 )));
             }
         }
@@ -1066,7 +1071,9 @@ mod tests {
                 .unwrap_err()
                 .to_string();
             assert!(
-                err.contains("b.exr was rendered with") && err.contains(key),
+                err.contains(&format!(
+                    "b.exr was rendered with {key} \"2\", a.exr with \"1\""
+                )),
                 "{err}"
             );
         }

@@ -31,11 +31,10 @@ use std::sync::Arc;
 
 #[derive(Debug, thiserror::Error)]
 pub enum FbxError {
-    #[error("{path}: {source}")]
+    #[error("{path}: {error}")]
     Io {
         path: PathBuf,
-        #[source]
-        source: std::io::Error,
+        error: std::io::Error,
     },
     #[error("{0}: is a Git LFS pointer, not the model (run `git lfs pull` in the project)")]
     LfsPointer(PathBuf),
@@ -125,9 +124,9 @@ const NODE_DEPTH_LIMIT: u32 = 1024;
 
 /// Load an FBX model with the import settings of its `.meta`.
 pub fn load(path: &Path, meta: &ModelMeta) -> Result<Model, FbxError> {
-    let bytes = std::fs::read(path).map_err(|source| FbxError::Io {
+    let bytes = std::fs::read(path).map_err(|error| FbxError::Io {
         path: path.to_path_buf(),
-        source,
+        error,
     })?;
     load_bytes(&bytes, path, meta)
 }

@@ -55,16 +55,23 @@ impl FileCtx {
 
 #[derive(Debug, thiserror::Error)]
 pub enum LoadError {
-    #[error("{path}: {source}")]
+    // The I/O error is part of the message, not a `source`: printed with its causes, the
+    // reason would appear twice.
+    #[error("{path}: {error}")]
     Io {
         path: PathBuf,
-        #[source]
-        source: std::io::Error,
+        error: std::io::Error,
     },
+    #[error("{0}: is a folder, not a scene file")]
+    Folder(PathBuf),
     #[error("{0}: the file is empty (0 bytes)")]
     Empty(PathBuf),
     #[error("{0}: is a binary Unity file, not text YAML; in Unity set Edit > Project Settings > Editor > Asset Serialization > Mode to \"Force Text\" and save the scene again")]
     Binary(PathBuf),
+    #[error("{0}: is not a Unity scene or prefab (text ones begin with `%YAML` or `--- !u!`)")]
+    NotUnity(PathBuf),
+    #[error("{0}: holds no Unity objects (no `--- !u!` document header); not a Unity scene")]
+    NoDocuments(PathBuf),
 }
 
 /// The text of a scene or prefab, refusing empty and binary files.
@@ -75,7 +82,7 @@ pub fn read_text(project: &Project, path: &Path) -> Result<String, LoadError> {
         Err(e) => {
             return Err(LoadError::Io {
                 path: path.to_path_buf(),
-                source: std::io::Error::new(e.kind(), e.to_string()),
+                error: std::io::Error::new(e.kind(), e.to_string()),
             })
         }
     };
@@ -83,9 +90,22 @@ pub fn read_text(project: &Project, path: &Path) -> Result<String, LoadError> {
         return Err(LoadError::Empty(path.to_path_buf()));
     }
     if !docs::is_text_yaml(bytes) {
-        return Err(LoadError::Binary(path.to_path_buf()));
+        // Unity's binary serialized files open with big-endian header words whose high
+        // bytes are zero; a text file of another kind (UTF-16 too, by its byte order
+        // mark) is not a binary scene to re-save as text.
+        let head = &bytes[..bytes.len().min(64)];
+        let utf16 = head.starts_with(&[0xFF, 0xFE]) || head.starts_with(&[0xFE, 0xFF]);
+        return Err(if head.contains(&0) && !utf16 {
+            LoadError::Binary(path.to_path_buf())
+        } else {
+            LoadError::NotUnity(path.to_path_buf())
+        });
     }
-    Ok(String::from_utf8_lossy(bytes).into_owned())
+    let text = String::from_utf8_lossy(bytes).into_owned();
+    if docs::split(&text).is_empty() {
+        return Err(LoadError::NoDocuments(path.to_path_buf()));
+    }
+    Ok(text)
 }
 
 /// Classes whose bodies the converter reads.

@@ -80,6 +80,15 @@ pub fn convert(scene: &Path, opts: &Options) -> Result<Soup, ConvertError> {
 
 /// [`convert`], also returning counts for diagnostics and tests.
 pub fn convert_report(scene: &Path, opts: &Options) -> Result<Report, ConvertError> {
+    // A scene that cannot be read is named as such, before the project is looked for.
+    match std::fs::metadata(scene) {
+        Err(error) => {
+            let path = scene.to_path_buf();
+            return Err(graph::LoadError::Io { path, error }.into());
+        }
+        Ok(m) if m.is_dir() => return Err(graph::LoadError::Folder(scene.to_path_buf()).into()),
+        Ok(_) => {}
+    }
     let root = match &opts.project {
         Some(p) => p.clone(),
         None => {

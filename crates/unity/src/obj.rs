@@ -16,11 +16,10 @@ use std::path::{Path, PathBuf};
 
 #[derive(Debug, thiserror::Error)]
 pub enum ObjError {
-    #[error("{path}: {source}")]
+    #[error("{path}: {error}")]
     Io {
         path: PathBuf,
-        #[source]
-        source: std::io::Error,
+        error: std::io::Error,
     },
     #[error("{0}: is a Git LFS pointer, not the model (run `git lfs pull` in the project)")]
     LfsPointer(PathBuf),
@@ -152,9 +151,9 @@ pub fn load(path: &Path) -> Result<ObjModel, ObjError> {
 /// Load an OBJ whose `mtllib` files may be anywhere under `root` (the project), and
 /// nowhere else: a `../../x.mtl` or absolute path that leaves it is not read.
 pub fn load_in(path: &Path, root: &Path) -> Result<ObjModel, ObjError> {
-    let bytes = std::fs::read(path).map_err(|source| ObjError::Io {
+    let bytes = std::fs::read(path).map_err(|error| ObjError::Io {
         path: path.to_path_buf(),
-        source,
+        error,
     })?;
     if bytes.starts_with(b"version https://git-lfs.github.com/spec") {
         return Err(ObjError::LfsPointer(path.to_path_buf()));

@@ -7,7 +7,10 @@ use clap::Parser;
 use std::path::PathBuf;
 
 #[derive(Parser)]
-#[command(about = "Write the bundled Unity projects (baseline and effect scenes)")]
+#[command(
+    version,
+    about = "Write the bundled Unity projects (baseline and effect scenes)"
+)]
 struct Args {
     /// Folder that holds the projects (one sub-folder each).
     #[arg(default_value = "scenes")]

@@ -241,7 +241,7 @@ fn bad_unity_input_is_named_and_the_rest_converts() {
         &utf16,
         &[],
         1,
-        &[&s(&utf16)],
+        &[&format!("{}: is not a Unity scene or prefab", s(&utf16))],
     );
     let garbage = p.out("Assets/Garbage.unity");
     std::fs::write(&garbage, noise(4096, 7)).unwrap();
@@ -260,7 +260,11 @@ fn bad_unity_input_is_named_and_the_rest_converts() {
         &missing,
         &[],
         1,
-        &[&s(&missing)],
+        // Once: the OS error is not repeated as the message's cause.
+        &[&format!(
+            "{}: No such file or directory (os error 2)\n",
+            s(&missing)
+        )],
     );
     let dir_scene = p.root.join("Assets");
     add(
@@ -269,7 +273,7 @@ fn bad_unity_input_is_named_and_the_rest_converts() {
         &dir_scene,
         &[],
         1,
-        &[&s(&dir_scene)],
+        &[&format!("{}: is a folder, not a scene file", s(&dir_scene))],
     );
 
     check(cases);

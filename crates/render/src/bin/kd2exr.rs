@@ -173,8 +173,13 @@ fn finite_exposure(exposure: f32) -> Result<()> {
     Ok(())
 }
 
-/// Fail early, naming the path, when an output's folder does not exist.
+/// Fail early, naming the path, when an output's folder does not exist or the output is
+/// itself a folder: a render writes the EXR before its preview, and a preview refused only
+/// then would leave the EXR of a failed run behind.
 fn writable_folder(path: &std::path::Path) -> Result<()> {
+    if path.is_dir() {
+        anyhow::bail!("cannot write {}: it is a folder", path.display());
+    }
     match path.parent() {
         Some(dir) if !dir.as_os_str().is_empty() && !dir.is_dir() => anyhow::bail!(
             "cannot write {}: the folder {} does not exist",

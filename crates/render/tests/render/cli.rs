@@ -194,6 +194,7 @@ fn bad_input_is_one_clear_line_and_exit_1() {
     let (s, k) = (sp.to_str().unwrap(), kp.to_str().unwrap());
     let o = dir.path().join("x.exr");
     let o = o.to_str().unwrap();
+    let folder = dir.path().to_str().unwrap();
     let cases: Vec<(Vec<&str>, &str)> = vec![
         (vec![s, k, "-o", o, "--width", "0"], "--width 0"),
         (vec![s, k, "-o", o, "--spp", "0"], "--spp 0"),
@@ -223,6 +224,8 @@ fn bad_input_is_one_clear_line_and_exit_1() {
             vec![s, k, "-o", "/nonexistent/dir/x.exr"],
             "the folder /nonexistent/dir does not exist",
         ),
+        // Refused before rendering: the EXR of a run whose preview fails is never written.
+        (vec![s, k, "-o", o, "--preview", folder], "it is a folder"),
     ];
     for (args, needle) in cases {
         let out = kd2exr(&args);

@@ -5,7 +5,11 @@ use clap::Parser;
 use std::path::PathBuf;
 
 #[derive(Parser)]
-#[command(about = "Export a unitrace soup as a world-space Wavefront OBJ")]
+#[command(
+    name = "soup2obj",
+    version,
+    about = "Export a unitrace soup as a world-space Wavefront OBJ"
+)]
 struct Args {
     soup: PathBuf,
     #[arg(short, long)]

@@ -5,7 +5,11 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 #[derive(Parser)]
-#[command(about = "Convert a text-serialized Unity scene into a unitrace triangle soup")]
+#[command(
+    name = "unity2soup",
+    version,
+    about = "Convert a text-serialized Unity scene into a unitrace triangle soup"
+)]
 struct Args {
     /// The scene (.unity, text serialization).
     scene: PathBuf,

@@ -511,6 +511,28 @@ fn binary_scene_is_refused() {
 }
 
 #[test]
+fn files_that_are_not_unity_scenes_are_refused_by_what_they_are() {
+    let (_d, root) = project(&[
+        ("Assets/compose.unity", "services:\n  web:\n    image: x\n"),
+        ("Assets/plain.unity", "%YAML 1.1\nfoo: bar\n"),
+    ]);
+    let assets = root.join("Assets");
+    for (file, want) in [
+        (
+            "compose.unity",
+            "compose.unity: is not a Unity scene or prefab",
+        ),
+        ("plain.unity", "plain.unity: holds no Unity objects"),
+        ("missing.unity", "missing.unity: No such file or directory"),
+        ("", "Assets/: is a folder, not a scene file"),
+    ] {
+        let msg = convert_error(&assets.join(file));
+        assert!(msg.contains(want), "{file}: {msg}");
+        assert!(!msg.contains("Force Text"), "{file}: {msg}");
+    }
+}
+
+#[test]
 fn non_finite_transform_is_an_error_naming_the_object() {
     let mut sc = Scene::default();
     sc.primitive("Broken", &Tf::at(f32::NAN, 0.0, 0.0), 0, CUBE);
