@@ -555,8 +555,9 @@ fn temp_beside(path: &Path) -> Result<tempfile::NamedTempFile, FormatError> {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
+    remove_stale_temporaries(dir);
     let mut builder = tempfile::Builder::new();
-    builder.prefix(".unitrace-").suffix(".tmp");
+    builder.prefix(TEMP_PREFIX).suffix(TEMP_SUFFIX);
     // A temporary file is private (0600) by default; the output should be what creating it
     // directly gives (0666 less the umask), so that, say, a cluster's merge step running as
     // another user can read the tiles.
@@ -568,6 +569,41 @@ fn temp_beside(path: &Path) -> Result<tempfile::NamedTempFile, FormatError> {
     builder
         .tempfile_in(dir)
         .map_err(|e| FormatError::io(path, e))
+}
+
+const TEMP_PREFIX: &str = ".unitrace-";
+const TEMP_SUFFIX: &str = ".tmp";
+
+/// A temporary file untouched for this long belongs to a writer that was killed: a live one
+/// writes its file from start to end without pausing, and takes seconds even at 10 million
+/// triangles.
+pub const STALE_TEMP_SECONDS: u64 = 3600;
+
+/// Delete the hidden temporaries that killed writers left in `dir` (nothing survives a
+/// SIGKILL to delete its own). Best effort: a folder that cannot be listed, or a file that
+/// cannot be removed, is left as it is, and the write goes on.
+fn remove_stale_temporaries(dir: &Path) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    let stale = std::time::Duration::from_secs(STALE_TEMP_SECONDS);
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(name) = name.to_str() else { continue };
+        if !(name.starts_with(TEMP_PREFIX) && name.ends_with(TEMP_SUFFIX)) {
+            continue;
+        }
+        let old = entry
+            .metadata()
+            .ok()
+            .filter(|m| m.is_file())
+            .and_then(|m| m.modified().ok())
+            .and_then(|t| t.elapsed().ok())
+            .is_some_and(|age| age > stale);
+        if old {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
 }
 
 /// Sync the complete temporary file and rename it over `path`.

@@ -101,6 +101,42 @@ fn soup_round_trips_through_a_file() {
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
 }
 
+/// A killed writer's temporary is removed by the next write into its folder once it is
+/// stale; a fresh one (a writer still at work) and other files are left alone.
+#[test]
+fn writes_remove_the_stale_temporaries_of_killed_writers() {
+    let dir = tempfile::tempdir().unwrap();
+    let put = |name: &str, age: u64| {
+        let p = dir.path().join(name);
+        let f = std::fs::File::create(&p).unwrap();
+        let t = std::time::SystemTime::now() - std::time::Duration::from_secs(age);
+        f.set_modified(t).unwrap();
+        p
+    };
+    let stale = envelope::STALE_TEMP_SECONDS;
+    let killed = put(".unitrace-killed.tmp", stale + 60);
+    let working = put(".unitrace-working.tmp", stale - 60);
+    let other = put(".other-old.tmp", stale + 60);
+    let user = put("notes.unitrace-.tmp", stale + 60);
+    sample_soup().write(&dir.path().join("a.soup")).unwrap();
+    assert!(!killed.exists());
+    assert!(working.exists() && other.exists() && user.exists());
+    envelope::write_atomic(&dir.path().join("b.png"), b"x").unwrap();
+    let mut names: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    names.sort();
+    let want = [
+        ".other-old.tmp",
+        ".unitrace-working.tmp",
+        "a.soup",
+        "b.png",
+        "notes.unitrace-.tmp",
+    ];
+    assert_eq!(names, want);
+}
+
 /// `Soup::write` streams the payload into the file, its arrays as blocks, and patches the
 /// header afterwards; the file must be the very bytes `to_bytes` frames in memory, and those
 /// the bytes of the struct's own serde encoding that SOUP.md documents.

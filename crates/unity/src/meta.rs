@@ -23,6 +23,9 @@ impl GuidIndex {
         let Ok(inside) = assets.canonicalize() else {
             return idx;
         };
+        // Warnings name files from the project root, as every other warning does.
+        let root = assets.parent().unwrap_or(Path::new(""));
+        let rel = |p: &Path| p.strip_prefix(root).unwrap_or(p).display().to_string();
         let mut seen: HashSet<PathBuf> = [inside.clone()].into_iter().collect();
         let mut stack = vec![assets.to_path_buf()];
         while let Some(dir) = stack.pop() {
@@ -51,7 +54,7 @@ impl GuidIndex {
                         Ok(real) => {
                             idx.warnings.push(format!(
                                 "{}: symbolic link to {}, outside the project; not read",
-                                p.display(),
+                                rel(&p),
                                 real.display()
                             ));
                             continue;
@@ -79,7 +82,7 @@ impl GuidIndex {
                         {
                             idx.warnings.push(format!(
                                 "{}: symbolic link to {}, outside the project; not read",
-                                asset.display(),
+                                rel(&asset),
                                 real.display()
                             ));
                             continue;
@@ -87,8 +90,8 @@ impl GuidIndex {
                         if let Some(prev) = idx.map.get(&guid) {
                             idx.warnings.push(format!(
                                 "duplicate GUID {guid} in {} and {}; using the first",
-                                prev.display(),
-                                asset.display()
+                                rel(prev),
+                                rel(&asset)
                             ));
                         } else {
                             idx.map.insert(guid, asset);

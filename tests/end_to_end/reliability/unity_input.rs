@@ -298,10 +298,10 @@ fn bad_unity_input_is_named_and_the_rest_converts() {
         &[&s(&collide), "-o", &s(&o)],
         0,
         &[
-            "duplicate GUID",
-            g,
-            "B/two.obj and",
-            "A/one.obj; using the first",
+            // Named from the project root, as every other warning names files.
+            &format!(
+                "duplicate GUID {g} in Assets/B/two.obj and Assets/A/one.obj; using the first"
+            ),
             "14 triangles",
         ],
         Out::Written(o),
@@ -356,7 +356,8 @@ fn asset_paths_never_escape_the_project() {
         "a colour was read from outside the project: {:?}",
         soup.materials
     );
-    for want in ["secret.mtl", "outside the project", g_out] {
+    let link = format!("warning: Assets/linked: symbolic link to {}", s(&outside));
+    for want in ["secret.mtl", "outside the project", g_out, &link] {
         assert!(
             r.stderr.contains(want),
             "stderr lacks `{want}`:\n{}",
