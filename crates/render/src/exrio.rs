@@ -334,11 +334,30 @@ impl ExrImage {
                 "data window starts at {pos:?}, outside the image"
             )));
         }
+        let (width, height) = (display.size.0 as u64, display.size.1 as u64);
+        let max = crate::options::MAX_EDGE as u64;
+        if width > max || height > max {
+            return Err(err(format!(
+                "display window {width}×{height}: edges above {max} pixels are not supported"
+            )));
+        }
+        let (x1, y1) = (
+            pos.0 as u64 + layer.size.0 as u64,
+            pos.1 as u64 + layer.size.1 as u64,
+        );
+        // Merging places each crop's pixels by its data window: one reaching past the
+        // image would write outside it.
+        if x1 > width || y1 > height {
+            return Err(err(format!(
+                "the {}×{} data window at ({}, {}) reaches past the {width}×{height} image",
+                layer.size.0, layer.size.1, pos.0, pos.1
+            )));
+        }
         let window = Window {
             x0: pos.0 as u32,
             y0: pos.1 as u32,
-            x1: pos.0 as u32 + layer.size.0 as u32,
-            y1: pos.1 as u32 + layer.size.1 as u32,
+            x1: x1 as u32,
+            y1: y1 as u32,
         };
         let mut attributes = BTreeMap::new();
         let others = image
@@ -641,6 +660,26 @@ pub fn merge_labelled(parts: &[(String, &ExrImage)]) -> std::result::Result<ExrI
         }
     }
     let (w, h) = (first.width as usize, first.height as usize);
+    // The full image is assembled in memory: refuse, as a render does, what cannot fit.
+    let per_pixel: u64 = 1 + first
+        .channels
+        .iter()
+        .map(|(_, s)| match s {
+            FlatSamples::F16(_) => 2,
+            FlatSamples::F32(_) | FlatSamples::U32(_) => 4,
+        })
+        .sum::<u64>();
+    let need = w as u64 * h as u64 * per_pixel;
+    if let Some(avail) = crate::memory::available_bytes().filter(|&a| need > a) {
+        let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
+        return Err(bad(format!(
+            "a {w}×{h} image with {} channels needs about {:.1} GiB to merge, only {:.1} GiB \
+             of memory is available",
+            first.channels.len(),
+            gib(need),
+            gib(avail)
+        )));
+    }
     let mut covered = vec![false; w * h];
     let mut channels: Vec<(String, FlatSamples)> = first
         .channels
@@ -755,6 +794,45 @@ fn copy_row<T: Copy>(
 mod tests {
     use super::*;
     use crate::AovSet;
+
+    /// An EXR file of RGB whose display window is `display` and data window `data` at the
+    /// origin, as another program might write it.
+    fn foreign_exr(path: &Path, display: (usize, usize), data: (usize, usize)) {
+        let n = data.0 * data.1;
+        let ch = |name: &str| AnyChannel::new(name, FlatSamples::F32(vec![0.5; n]));
+        let channels = AnyChannels::sort(vec![ch("R"), ch("G"), ch("B")].into());
+        let layer = Layer::new(
+            data,
+            LayerAttributes::default(),
+            Encoding::UNCOMPRESSED,
+            channels,
+        );
+        let mut image = Image::from_layer(layer);
+        image.attributes.display_window = IntegerBounds::new((0, 0), display);
+        image.write().to_file(path).unwrap();
+    }
+
+    #[test]
+    fn crops_past_their_image_or_too_large_to_merge_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let past = dir.path().join("past.exr");
+        foreign_exr(&past, (1, 1), (10, 10));
+        let err = ExrImage::read(&past).unwrap_err().to_string();
+        assert!(
+            err.contains("past.exr") && err.contains("reaches past the 1×1 image"),
+            "{err}"
+        );
+
+        // A 400-byte file describing a 200,000² image: merging it would need about 480 GiB.
+        let huge = dir.path().join("huge.exr");
+        foreign_exr(&huge, (200_000, 200_000), (1, 1));
+        let img = ExrImage::read(&huge).unwrap();
+        let err = merge(&[img]).unwrap_err().to_string();
+        assert!(
+            err.contains("a 200000×200000 image with 3 channels needs about"),
+            "{err}"
+        );
+    }
 
     fn crop(window: Window, attrs: &[(&str, &str)]) -> ExrImage {
         let n = window.pixels() as usize;

@@ -151,6 +151,17 @@ impl Default for RenderOptions {
 /// Largest image edge: EXR windows are i32 and a pixel index must fit comfortably.
 pub const MAX_EDGE: u32 = 1 << 20;
 
+/// Deepest mirror recursion: each bounce is a stack frame, and a room of perfect mirrors
+/// (whose path weight never falls below the cut-off) overflowed the stack at about 5,000.
+pub const MAX_DEPTH: u32 = 256;
+
+/// Most samples per pixel: a pixel's sample positions are held at once, and its error has
+/// long stopped falling (as 1/√spp) at this count.
+pub const MAX_SPP: u32 = 1 << 16;
+
+/// Most threads: each has its own stack; a hundred thousand ran out of memory after minutes.
+pub const MAX_THREADS: usize = 1024;
+
 impl RenderOptions {
     /// Refuse options that cannot make an image, naming the option.
     pub fn validate(&self) -> Result<(), RenderError> {
@@ -170,6 +181,12 @@ impl RenderOptions {
         if self.spp == 0 {
             return bad("--spp 0: at least one sample per pixel is needed".into());
         }
+        if self.spp > MAX_SPP {
+            return bad(format!("--spp {}: at most {MAX_SPP}", self.spp));
+        }
+        if self.depth > MAX_DEPTH {
+            return bad(format!("--depth {}: at most {MAX_DEPTH}", self.depth));
+        }
         if self.soft_samples == 0 {
             return bad("--soft-samples 0: at least one shadow sample is needed".into());
         }
@@ -181,6 +198,9 @@ impl RenderOptions {
         }
         if self.threads == Some(0) {
             return bad("--threads 0: at least one thread is needed".into());
+        }
+        if let Some(n) = self.threads.filter(|&n| n > MAX_THREADS) {
+            return bad(format!("--threads {n}: at most {MAX_THREADS}"));
         }
         if self.tile == 0 {
             return bad("tile size 0".into());

@@ -52,6 +52,22 @@ fn absurd_render_options_are_refused_before_work() {
         ),
         mk("unknown AOV", &["--aov", "depth,colour"], &["colour"]),
         mk("NaN exposure", &["--exposure", "NaN"], &["--exposure"]),
+        // Bounds that keep the stack, the samples and the threads finite.
+        mk(
+            "--depth 5000",
+            &["--depth", "5000"],
+            &["--depth 5000: at most 256"],
+        ),
+        mk(
+            "--spp 10^9",
+            &["--spp", "1000000000"],
+            &["--spp 1000000000: at most 65536"],
+        ),
+        mk(
+            "--threads 100000",
+            &["--threads", "100000"],
+            &["--threads 100000: at most 1024"],
+        ),
     ]);
     // 16k × 16k with every AOV: either refused before any work (naming the memory it
     // needs and has), or it fits and starts; never killed by the OOM killer or a failed
