@@ -272,17 +272,39 @@ pub fn ext(p: &Path) -> String {
 
 /// Lower-case file name → first path in the walk order of [`Project::find_by_name`]. A
 /// folder that cannot be listed ends the walk: a search by name never looked past it.
+/// Symbolic links are followed as the GUID index follows them: only to what lies inside
+/// `dir`, and each real folder once, so a link loop cannot multiply the walk.
 fn index_by_name(dir: &Path) -> HashMap<String, PathBuf> {
     let mut index = HashMap::new();
+    let Ok(inside) = dir.canonicalize() else {
+        return index;
+    };
+    let mut seen: HashSet<PathBuf> = [inside.clone()].into_iter().collect();
     let mut stack = vec![dir.to_path_buf()];
     while let Some(d) = stack.pop() {
         let Ok(rd) = std::fs::read_dir(&d) else {
             break;
         };
-        let mut entries: Vec<_> = rd.filter_map(Result::ok).map(|e| e.path()).collect();
-        entries.sort();
-        for p in entries {
-            if p.is_dir() {
+        let mut entries: Vec<_> = rd
+            .filter_map(Result::ok)
+            .filter_map(|e| Some((e.path(), e.file_type().ok()?)))
+            .collect();
+        entries.sort_by(|a, b| a.0.cmp(&b.0));
+        for (p, ty) in entries {
+            let is_dir = if ty.is_symlink() || ty.is_dir() {
+                match p.canonicalize() {
+                    Ok(real) if real.starts_with(&inside) => {
+                        if real.is_dir() && !seen.insert(real) {
+                            continue; // a folder already walked (a link loop)
+                        }
+                        p.is_dir()
+                    }
+                    _ => continue, // dangling, or out of the project
+                }
+            } else {
+                false
+            };
+            if is_dir {
                 stack.push(p);
             } else if let Some(f) = p.file_name() {
                 let key = f.to_string_lossy().to_ascii_lowercase();

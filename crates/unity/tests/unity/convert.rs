@@ -481,6 +481,25 @@ fn model_materials_take_the_mtl_colour() {
 }
 
 #[test]
+fn the_search_by_name_walks_a_link_loop_once() {
+    let sc = mesh_scene(
+        "m",
+        4300000,
+        "99999999999999999999999999999999",
+        &[DEFAULT_MAT],
+    );
+    let (_d, root) = project(&[("Assets/Models/m.obj", OBJ), ("Assets/s.unity", &sc.text)]);
+    // Forty links back to Assets/ would make a walk that follows them blindly visit 40^depth
+    // folders; followed once each, the model is found as without them.
+    for i in 0..40 {
+        std::os::unix::fs::symlink(".", root.join(format!("Assets/loop{i}"))).unwrap();
+    }
+    let soup = convert(&root.join("Assets/s.unity"));
+    assert_eq!(soup.triangles.len(), 3);
+    assert_eq!(soup.objects[0].source, "Assets/Models/m.obj");
+}
+
+#[test]
 fn unresolved_mesh_falls_back_to_the_object_name() {
     let sc = mesh_scene(
         "m",
