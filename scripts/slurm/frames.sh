@@ -34,6 +34,11 @@ fi
 KD2EXR=$(realpath "$KD2EXR")
 export KD2EXR
 
+# Every line is checked before any output is cleared: `cut` passes a line without tabs
+# through whole, and the outputs are deleted before the frames render.
+bad=$(awk -F'\t' 'NF != 4 || $1 == "" || $2 == "" || $3 !~ /\.exr$/ || $4 !~ /\.png$/ {
+    print NR; exit }' "$frames")
+[ -z "$bad" ] || die "$frames:$bad: a frame is four tab-separated fields: SOUP KD OUT.exr OUT.png"
 mapfile -t exrs < <(cut -f3 "$frames")
 KIND=frame
 LOGDIR=$(dirname "$frames")/logs
