@@ -29,14 +29,9 @@ impl GuidIndex {
         let mut seen: HashSet<PathBuf> = [inside.clone()].into_iter().collect();
         let mut stack = vec![assets.to_path_buf()];
         while let Some(dir) = stack.pop() {
-            let Ok(rd) = std::fs::read_dir(&dir) else {
+            let Some(entries) = sorted_entries(&dir) else {
                 continue;
             };
-            let mut entries: Vec<_> = rd
-                .filter_map(Result::ok)
-                .filter_map(|e| Some((e.path(), e.file_type().ok()?)))
-                .collect();
-            entries.sort_by(|a, b| a.0.cmp(&b.0));
             for (p, ty) in entries {
                 let is_dir = if ty.is_symlink() {
                     match p.canonicalize() {
@@ -106,6 +101,18 @@ impl GuidIndex {
     pub fn get(&self, guid: &str) -> Option<&PathBuf> {
         self.map.get(guid)
     }
+}
+
+/// A folder's entries with their types (a link's own, not its target's), sorted by path so
+/// that walks are the same on every file system; None when it cannot be listed.
+pub(crate) fn sorted_entries(dir: &Path) -> Option<Vec<(PathBuf, std::fs::FileType)>> {
+    let mut entries: Vec<_> = std::fs::read_dir(dir)
+        .ok()?
+        .filter_map(Result::ok)
+        .filter_map(|e| Some((e.path(), e.file_type().ok()?)))
+        .collect();
+    entries.sort_by(|a, b| a.0.cmp(&b.0));
+    Some(entries)
 }
 
 /// The `guid:` line of a `.meta` file (read as a string, never as a number).

@@ -282,14 +282,9 @@ fn index_by_name(dir: &Path) -> HashMap<String, PathBuf> {
     let mut seen: HashSet<PathBuf> = [inside.clone()].into_iter().collect();
     let mut stack = vec![dir.to_path_buf()];
     while let Some(d) = stack.pop() {
-        let Ok(rd) = std::fs::read_dir(&d) else {
+        let Some(entries) = crate::meta::sorted_entries(&d) else {
             break;
         };
-        let mut entries: Vec<_> = rd
-            .filter_map(Result::ok)
-            .filter_map(|e| Some((e.path(), e.file_type().ok()?)))
-            .collect();
-        entries.sort_by(|a, b| a.0.cmp(&b.0));
         for (p, ty) in entries {
             let is_dir = if ty.is_symlink() || ty.is_dir() {
                 match p.canonicalize() {

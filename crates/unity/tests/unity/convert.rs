@@ -480,15 +480,21 @@ fn model_materials_take_the_mtl_colour() {
     assert_eq!(soup.materials[0].source, "Assets/two.obj#red");
 }
 
-#[test]
-fn the_search_by_name_walks_a_link_loop_once() {
+/// A MeshFilter whose mesh GUID is not in the project, on an object named after the only
+/// model, `Assets/Models/m.obj`.
+fn unresolved_mesh_project() -> (tempfile::TempDir, PathBuf) {
     let sc = mesh_scene(
         "m",
         4300000,
         "99999999999999999999999999999999",
         &[DEFAULT_MAT],
     );
-    let (_d, root) = project(&[("Assets/Models/m.obj", OBJ), ("Assets/s.unity", &sc.text)]);
+    project(&[("Assets/Models/m.obj", OBJ), ("Assets/s.unity", &sc.text)])
+}
+
+#[test]
+fn the_search_by_name_walks_a_link_loop_once() {
+    let (_d, root) = unresolved_mesh_project();
     // Forty links back to Assets/ would make a walk that follows them blindly visit 40^depth
     // folders; followed once each, the model is found as without them.
     for i in 0..40 {
@@ -501,13 +507,7 @@ fn the_search_by_name_walks_a_link_loop_once() {
 
 #[test]
 fn unresolved_mesh_falls_back_to_the_object_name() {
-    let sc = mesh_scene(
-        "m",
-        4300000,
-        "99999999999999999999999999999999",
-        &[DEFAULT_MAT],
-    );
-    let (_d, root) = project(&[("Assets/Models/m.obj", OBJ), ("Assets/s.unity", &sc.text)]);
+    let (_d, root) = unresolved_mesh_project();
     let soup = convert(&root.join("Assets/s.unity"));
     assert_eq!(soup.triangles.len(), 3);
     assert!(
