@@ -60,6 +60,12 @@ pub fn is_text_yaml(bytes: &[u8]) -> bool {
     head.starts_with(b"%YAML") || head.starts_with(b"--- !u!")
 }
 
+/// Whether the text holds a document, as [`split`] finds them, without splitting it all.
+pub fn has_document(text: &str) -> bool {
+    text.lines()
+        .any(|l| l.starts_with("--- !u!") && header(l.trim_end()).is_some())
+}
+
 /// All documents of a text file, in file order.
 pub fn split(text: &str) -> Vec<Doc<'_>> {
     let mut docs = Vec::new();

@@ -102,7 +102,7 @@ pub fn read_text(project: &Project, path: &Path) -> Result<String, LoadError> {
         });
     }
     let text = String::from_utf8_lossy(bytes).into_owned();
-    if docs::split(&text).is_empty() {
+    if !docs::has_document(&text) {
         return Err(LoadError::NoDocuments(path.to_path_buf()));
     }
     Ok(text)
