@@ -61,6 +61,8 @@ while [ $# -gt 0 ]; do
     shift
 done
 [[ $width =~ ^[0-9]+$ && $height =~ ^[0-9]+$ ]] || die "cannot tell the frame size ($width×$height)"
+# Shell arithmetic reads a leading zero as octal: 0768 would be an error, 0100 would be 64.
+width=$((10#$width)) height=$((10#$height))
 [ "$tiles" -le "$height" ] || die "$tiles tiles of a $height-row frame would leave some empty"
 
 base=${out%.exr}

@@ -200,8 +200,9 @@ fn just_slurm_renders_the_baseline_bit_identical_to_one_machine() {
     let out = cluster
         .command("just")
         .current_dir(repo())
-        // The default 1024×768: the tiles are bands of 96 rows.
-        .args(["slurm", BASELINE, &name, "8"])
+        // The default 1024×768, its height written with a leading zero that shell
+        // arithmetic would read as octal: the tiles are bands of 96 rows.
+        .args(["slurm", BASELINE, &name, "8", "--height", "0768"])
         .output()
         .expect("run just slurm");
     let err = text(&out.stderr);
