@@ -326,10 +326,8 @@ pub fn decode(
         if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
             return Err(too_large(w, h));
         }
-        let Some(end) = psd_end(bytes, w, h) else {
-            return Err(decode_err("PSD", "truncated".into()));
-        };
-        let rgba = decode_psd(&bytes[..end]).map_err(|m| decode_err("PSD", m))?;
+        let composite = psd_composite(bytes, w, h).map_err(|m| decode_err("PSD", m))?;
+        let rgba = decode_psd(&composite).map_err(|m| decode_err("PSD", m))?;
         let img = image::RgbaImage::from_raw(w, h, rgba)
             .ok_or_else(|| decode_err("PSD", "composite size does not match header".into()))?;
         (DynamicImage::ImageRgba8(img), false)
@@ -427,39 +425,77 @@ fn be32(b: &[u8], i: usize) -> Option<u32> {
     Some(u32::from_be_bytes(b.get(i..i + 4)?.try_into().ok()?))
 }
 
-/// How much of a PSD to hand the `psd` crate, or `None` when it holds fewer image-data
-/// bytes than its header promises (the crate reads a truncated composite as black instead
-/// of failing). Raw image data is cut where the header says it ends: the crate writes
-/// bytes past that end out of bounds.
-fn psd_end(bytes: &[u8], w: u32, h: u32) -> Option<usize> {
+/// The bytes to hand the `psd` crate: the header and the image data (the flattened
+/// composite), with the colour mode, image resource and layer sections emptied between
+/// them. The crate parses those sections in full although only the composite is read: a
+/// count in an image resource sizes a table before anything is read (an 88-byte file
+/// asked for 554 GB, an abort no `catch_unwind` survives), and layers it cannot parse
+/// (ZIP-compressed channels, which Photoshop writes) failed files whose composite is fine.
+///
+/// Refused, with the reason, when the image data holds fewer bytes than the header
+/// promises (the crate reads a truncated composite as black instead of failing) or its RLE
+/// runs decode to more than the header's size (the crate decodes every run, 129 bytes
+/// from two packed ones, whatever the size). The image data is cut where it ends, for raw
+/// data where the header says: the crate writes raw bytes past that end out of bounds.
+fn psd_composite(bytes: &[u8], w: u32, h: u32) -> Result<Vec<u8>, String> {
+    let truncated = || "truncated".to_string();
     let be16 = |i: usize| {
         bytes
             .get(i..i + 2)
             .map(|s| u16::from_be_bytes([s[0], s[1]]))
+            .ok_or_else(truncated)
     };
-    let (channels, depth) = (be16(12)?, be16(22)?);
+    let (channels, depth) = (be16(12)? as u64, be16(22)? as u64);
     let mut at = 26usize;
     for _ in 0..3 {
-        at = at
-            .saturating_add(4)
-            .saturating_add(be32(bytes, at)? as usize);
+        let len = be32(bytes, at).ok_or_else(truncated)?;
+        at = at.saturating_add(4).saturating_add(len as usize);
     }
-    let rows = channels as u64 * h as u64;
-    let (need, raw) = match be16(at)? {
-        0 => (rows * w as u64 * (depth as u64).div_ceil(8), true),
-        // RLE: at least the table of packed row lengths.
-        1 => (rows * 2, false),
-        _ => return None,
+    let data = bytes.get(at.saturating_add(2)..).unwrap_or_default();
+    let plane = h as u64 * (w as u64 * depth).div_ceil(8);
+    let len = match be16(at)? {
+        0 => channels * plane,
+        1 => psd_rle_len(data, channels, h, plane)?,
+        2 | 3 => return Err("ZIP-compressed image data is not supported".into()),
+        c => return Err(format!("unknown image data compression {c}")),
     };
-    let data = at as u64 + 2;
-    if (bytes.len() as u64).saturating_sub(data) < need {
-        return None;
+    if (data.len() as u64) < len {
+        return Err(truncated());
     }
-    Some(if raw {
-        (data + need) as usize
-    } else {
-        bytes.len()
-    })
+    let mut out = bytes[..26].to_vec();
+    out.extend([0; 12]);
+    out.extend(&bytes[at..at + 2 + len as usize]);
+    Ok(out)
+}
+
+/// The length of RLE image data (the packed length of every row, then the rows), or why it
+/// is refused: a channel whose runs decode to more than its `plane` bytes.
+fn psd_rle_len(data: &[u8], channels: u64, h: u32, plane: u64) -> Result<u64, String> {
+    let rows = (channels * h as u64) as usize;
+    let table = data.get(..rows * 2).ok_or("truncated")?;
+    let mut at = table.len();
+    // The crate decodes each channel's rows as one stream, so the bound is per channel.
+    for channel in table.chunks(h as usize * 2) {
+        let packed: usize = channel
+            .chunks_exact(2)
+            .map(|n| u16::from_be_bytes([n[0], n[1]]) as usize)
+            .sum();
+        let runs = data.get(at..at + packed).ok_or("truncated")?;
+        at += packed;
+        let (mut i, mut decoded) = (0, 0u64);
+        while i < runs.len() {
+            let n = runs[i] as i8;
+            (i, decoded) = match n {
+                -128 => (i + 1, decoded),
+                0.. => (i + 2 + n as usize, decoded + 1 + n as u64),
+                _ => (i + 2, decoded + 1 + n.unsigned_abs() as u64),
+            };
+        }
+        if decoded > plane {
+            return Err("RLE image data decodes past the size in the header".into());
+        }
+    }
+    Ok(at as u64)
 }
 
 /// The flattened composite of a PSD as RGBA, top row first. The `psd` crate indexes
@@ -678,6 +714,18 @@ m_SavedProperties:
 
     /// A minimal flattened PSD: RGB, 8 bits, no layers, raw image data (planar).
     fn psd_2x2() -> Vec<u8> {
+        psd_2x2_with(&[], &[], &psd_2x2_raw())
+    }
+
+    /// Image data: raw, the R plane (top row first), then G, then B.
+    fn psd_2x2_raw() -> Vec<u8> {
+        let mut b = 0u16.to_be_bytes().to_vec();
+        b.extend([255, 0, 0, 128, 0, 255, 0, 128, 0, 0, 255, 128]);
+        b
+    }
+
+    /// A 2×2 RGB PSD with the given image resources, layer and mask section and image data.
+    fn psd_2x2_with(resources: &[u8], layers: &[u8], image_data: &[u8]) -> Vec<u8> {
         let mut b = b"8BPS".to_vec();
         b.extend(1u16.to_be_bytes());
         b.extend([0; 6]);
@@ -687,13 +735,58 @@ m_SavedProperties:
         b.extend(8u16.to_be_bytes()); // depth
         b.extend(3u16.to_be_bytes()); // RGB
         b.extend(0u32.to_be_bytes()); // colour mode data
-        b.extend(0u32.to_be_bytes()); // image resources
-        b.extend(0u32.to_be_bytes()); // layers and masks
-        b.extend(0u16.to_be_bytes()); // raw
-        b.extend([255, 0, 0, 128]); // R plane, top row first
-        b.extend([0, 255, 0, 128]); // G
-        b.extend([0, 0, 255, 128]); // B
+        b.extend((resources.len() as u32).to_be_bytes());
+        b.extend(resources);
+        b.extend((layers.len() as u32).to_be_bytes());
+        b.extend(layers);
+        b.extend(image_data);
         b
+    }
+
+    /// A layer and mask section with one RGB layer over `rect` (top, left, bottom, right),
+    /// each channel `compression` then `channel`.
+    fn psd_layer(rect: [i32; 4], compression: u16, channel: &[u8]) -> Vec<u8> {
+        let mut info = 1i16.to_be_bytes().to_vec(); // layer count
+        for v in rect {
+            info.extend(v.to_be_bytes());
+        }
+        info.extend(3u16.to_be_bytes());
+        for id in 0..3i16 {
+            info.extend(id.to_be_bytes());
+            info.extend((2 + channel.len() as u32).to_be_bytes());
+        }
+        info.extend(b"8BIMnorm");
+        info.extend([255, 0, 2, 0]); // opacity, clipping, visible, filler
+        info.extend(12u32.to_be_bytes()); // no mask, no blending ranges, the name "L"
+        info.extend([0; 8]);
+        info.extend([1, b'L', 0, 0]);
+        for _ in 0..3 {
+            info.extend(compression.to_be_bytes());
+            info.extend(channel);
+        }
+        if info.len() % 2 == 1 {
+            info.push(0);
+        }
+        let mut section = (info.len() as u32).to_be_bytes().to_vec();
+        section.extend(info);
+        section.extend([0; 4]); // no global layer mask
+        section
+    }
+
+    /// An image resource section holding a slices resource whose descriptor claims `count`
+    /// fields and holds none.
+    fn psd_slices(count: u32) -> Vec<u8> {
+        let mut body = 7i32.to_be_bytes().to_vec(); // slices as a descriptor
+        body.extend(16i32.to_be_bytes());
+        body.extend([0; 8]); // no name, a four-byte class ID
+        body.extend(b"null");
+        body.extend(count.to_be_bytes());
+        let mut block = b"8BIM".to_vec();
+        block.extend(1050u16.to_be_bytes());
+        block.extend([0, 0]); // no name
+        block.extend((body.len() as u32).to_be_bytes());
+        block.extend(body);
+        block
     }
 
     #[test]
@@ -707,6 +800,54 @@ m_SavedProperties:
         padded.extend([0; 20]);
         let p = decode(&padded, "psd", "t.psd", &Import::default()).unwrap();
         assert_eq!(p, t);
+    }
+
+    #[test]
+    fn psd_sections_before_the_composite_are_not_parsed() {
+        let im = Import::default();
+        let plain = decode(&psd_2x2(), "psd", "t.psd", &im).unwrap();
+        let raw = psd_2x2_raw();
+        // Before the crate was handed the composite alone: a layer a million texels on a
+        // side (its RLE row table runs past the file) and ZIP-compressed layer channels
+        // were refused as malformed, and the resource's 2³¹ fields aborted the process.
+        let huge = psd_layer([0, 0, 1_000_000, 1_000_000], 1, &[0, 1, 255, 0]);
+        let zip = psd_layer([0, 0, 2, 2], 2, &[0x78, 0x9c, 3, 0, 0, 0, 0, 1]);
+        for (resources, layers) in [
+            (vec![], huge),
+            (vec![], zip),
+            (psd_slices(0x7fff_ffff), vec![]),
+        ] {
+            let psd = psd_2x2_with(&resources, &layers, &raw);
+            let t = decode(&psd, "psd", "t.psd", &im).unwrap();
+            assert_eq!(t, plain);
+        }
+    }
+
+    #[test]
+    fn psd_rle_composite() {
+        let im = Import::default();
+        let plain = decode(&psd_2x2(), "psd", "t.psd", &im).unwrap();
+        let rle = |first_row: &[u8]| {
+            let mut rows = vec![first_row.to_vec()];
+            for row in [[0, 128], [0, 255], [0, 128], [0, 0], [255, 128]] {
+                rows.push(vec![1, row[0], row[1]]); // a literal run of two
+            }
+            let mut b = 1u16.to_be_bytes().to_vec();
+            for row in &rows {
+                b.extend((row.len() as u16).to_be_bytes());
+            }
+            b.extend(rows.concat());
+            psd_2x2_with(&[], &[], &b)
+        };
+        let t = decode(&rle(&[1, 255, 0]), "psd", "t.psd", &im).unwrap();
+        assert_eq!(t, plain);
+        // A run of 128 in a 2-texel row: the crate would decode it all.
+        let long = decode(&rle(&[0x81, 7]), "psd", "t.psd", &im).unwrap_err();
+        assert!(long.to_string().contains("RLE"), "{long}");
+        let mut zip = psd_2x2();
+        zip[39] = 2;
+        let zip = decode(&zip, "psd", "t.psd", &im).unwrap_err();
+        assert!(zip.to_string().contains("ZIP"), "{zip}");
     }
 
     #[test]
