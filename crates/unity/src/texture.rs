@@ -357,6 +357,11 @@ pub fn decode(
         let mut limits = Limits::default();
         limits.max_image_width = Some(MAX_SIDE);
         limits.max_image_height = Some(MAX_SIDE);
+        // The crate's default cap (512 MiB) refused images Unity imports, a 16384² RGBA
+        // PNG or an 8192² float EXR among them: allow what the checked size decodes to in
+        // the widest pixel format (RGBA, 32-bit float), never less than that default.
+        let default = limits.max_alloc.unwrap_or(u64::MAX);
+        limits.max_alloc = Some(default.max(w as u64 * h as u64 * 16));
         reader.limits(limits);
         let img = reader
             .decode()
@@ -371,7 +376,7 @@ pub fn decode(
     let filter = image::imageops::FilterType::Triangle;
     // Float images hold linear light: stored sRGB-encoded, 8 bits lose least there.
     let (rows, srgb) = if float {
-        let mut img = image.to_rgba32f();
+        let mut img = image.into_rgba32f();
         if (w, h) != img.dimensions() {
             img = image::imageops::resize(&img, w, h, filter);
         }
@@ -389,7 +394,7 @@ pub fn decode(
             .collect();
         (bytes, true)
     } else {
-        let mut img = image.to_rgba8();
+        let mut img = image.into_rgba8();
         if (w, h) != img.dimensions() {
             img = image::imageops::resize(&img, w, h, filter);
         }
@@ -848,6 +853,27 @@ m_SavedProperties:
         zip[39] = 2;
         let zip = decode(&zip, "psd", "t.psd", &im).unwrap_err();
         assert!(zip.to_string().contains("ZIP"), "{zip}");
+    }
+
+    #[test]
+    fn images_decoding_past_512_mib_are_read() {
+        // 16384 × 8200 RGBA: 537 MB decoded, past the image crate's default cap, and
+        // imported as Unity does at the default size limit, 2048 × 1024. The zeroed pixel
+        // buffer stays mostly unbacked pages: only the red corner is written.
+        let (w, h) = (16384u32, 8200u32);
+        let mut img = RgbaImage::from_raw(w, h, vec![0; w as usize * h as usize * 4]).unwrap();
+        for y in 0..256 {
+            for x in 0..256 {
+                img.put_pixel(x, y, Rgba([255, 0, 0, 255]));
+            }
+        }
+        let png = encode(&img, ImageFormat::Png);
+        let t = decode(&png, "png", "big.png", &Import::default()).unwrap();
+        assert_eq!((t.width, t.height), (2048, 1024));
+        // The top-left corner, where rows bottom first put it last; the far corner.
+        let texel = |x: usize, y: usize| &t.texels[(y * 2048 + x) * 4..][..4];
+        assert_eq!(texel(0, 1023), [255, 0, 0, 255]);
+        assert_eq!(texel(2047, 0), [0, 0, 0, 0]);
     }
 
     #[test]
