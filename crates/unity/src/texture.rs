@@ -361,7 +361,11 @@ pub fn decode(
         // PNG or an 8192² float EXR among them: allow what the checked size decodes to in
         // the widest pixel format (RGBA, 32-bit float), never less than that default.
         let default = limits.max_alloc.unwrap_or(u64::MAX);
-        limits.max_alloc = Some(default.max(w as u64 * h as u64 * 16));
+        let cap = default.max(w as u64 * h as u64 * 16);
+        limits.max_alloc = Some(cap);
+        if format == ImageFormat::OpenExr {
+            exr_within(bytes, cap).map_err(|m| decode_err(&name, m))?;
+        }
         reader.limits(limits);
         let img = reader
             .decode()
@@ -416,6 +420,32 @@ pub fn decode(
     };
     t.validate().map_err(|m| decode_err("image", m))?;
     Ok(t)
+}
+
+/// Whether every part of an EXR fits in `cap` bytes across all its channels. The size
+/// checked above is the display window's, but the `exr` crate decompresses blocks of every
+/// channel of the data window, sized from the header alone before the allocation cap
+/// applies: 40,003 channels over a 16384×16 data window asked for 42 GB and aborted.
+fn exr_within(bytes: &[u8], cap: u64) -> Result<(), String> {
+    use exr::math::Vec2;
+    let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false)
+        .map_err(|e| e.to_string())?;
+    for header in meta.headers.iter() {
+        let Vec2(w, h) = header.layer_size;
+        let need = (w as u64 * h as u64).saturating_mul(header.channels.bytes_per_pixel as u64);
+        if need > cap {
+            let mib = |b: u64| b as f64 / (1u64 << 20) as f64;
+            let Vec2(dw, dh) = header.shared_attributes.display_window.size;
+            return Err(format!(
+                "its {w}×{h} data window of {} channels takes {:.0} MiB, more than the {:.0} \
+                 MiB a {dw}×{dh} texture may",
+                header.channels.list.len(),
+                mib(need),
+                mib(cap),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Width and height from a PSD header (`8BPS`, big-endian height then width).
@@ -874,6 +904,56 @@ m_SavedProperties:
         let texel = |x: usize, y: usize| &t.texels[(y * 2048 + x) * 4..][..4];
         assert_eq!(texel(0, 1023), [255, 0, 0, 255]);
         assert_eq!(texel(2047, 0), [0, 0, 0, 0]);
+    }
+
+    #[test]
+    fn exr_data_windows_past_their_image_are_refused_before_decoding() {
+        // A 4×4 RGB image whose 4096×16 data window holds 3,000 more float channels
+        // (787 MB): the `exr` crate sized its block buffers by them before reading a byte
+        // of pixels.
+        let attr = |name: &str, kind: &str, data: &[u8]| {
+            let mut b = format!("{name}\0{kind}\0").into_bytes();
+            b.extend((data.len() as i32).to_le_bytes());
+            b.extend(data);
+            b
+        };
+        let ints = |v: [i32; 4]| v.iter().flat_map(|i| i.to_le_bytes()).collect::<Vec<u8>>();
+        let mut channels = Vec::new();
+        let names = ["B", "G", "R"].map(String::from);
+        for name in names
+            .into_iter()
+            .chain((0..3000).map(|i| format!("c{i:04}")))
+        {
+            channels.extend(name.bytes().chain([0]));
+            channels.extend([2, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0]); // float, 1×1
+        }
+        channels.push(0);
+        let mut exr = vec![0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0];
+        exr.extend(attr("channels", "chlist", &channels));
+        exr.extend(attr("compression", "compression", &[0]));
+        exr.extend(attr("dataWindow", "box2i", &ints([0, 0, 4095, 15])));
+        exr.extend(attr("displayWindow", "box2i", &ints([0, 0, 3, 3])));
+        exr.extend(attr("lineOrder", "lineOrder", &[0]));
+        exr.extend(attr("pixelAspectRatio", "float", &1f32.to_le_bytes()));
+        exr.extend(attr("screenWindowCenter", "v2f", &[0; 8]));
+        exr.extend(attr("screenWindowWidth", "float", &1f32.to_le_bytes()));
+        exr.push(0);
+        let first_block = exr.len() as u64 + 16 * 8;
+        for line in 0..16 {
+            exr.extend((first_block + line * 8).to_le_bytes());
+        }
+        for line in 0..16i32 {
+            exr.extend(line.to_le_bytes());
+            exr.extend(0i32.to_le_bytes());
+        }
+        let err = decode(&exr, "exr", "many.exr", &Import::default()).unwrap_err();
+        assert!(
+            err.to_string().contains(
+                "its 4096×16 data window of 3003 channels takes 751 MiB, more than the 512 \
+                 MiB a 4×4 texture may"
+            ),
+            "{err}"
+        );
     }
 
     #[test]
