@@ -418,3 +418,97 @@ fn merge_refuses_a_missing_tile_and_tiles_of_another_render() {
     );
     assert_same_pixels(&merged, &single);
 }
+
+/// `kd2exr merge` refuses, in one line naming the file, EXR files it did not write and
+/// damaged ones: never a panic or an output. (Forged headers and offset tables are the
+/// decoder's unit tests, `exrread::tests`.)
+#[test]
+fn merge_refuses_foreign_and_damaged_exr_files() {
+    use exr::prelude::*;
+    let dir = tempfile::tempdir().unwrap();
+    let (soup, kd) = baseline_in(dir.path());
+    // A whole 48×32 render as its one crop: two blocks of 16 lines.
+    let tile = dir.path().join("tile.exr");
+    run_ok(
+        "kd2exr",
+        [
+            soup.as_os_str(),
+            kd.as_os_str(),
+            "-o".as_ref(),
+            tile.as_os_str(),
+            "--width".as_ref(),
+            "48".as_ref(),
+            "--height".as_ref(),
+            "32".as_ref(),
+            "--crop".as_ref(),
+            "0,0,48,32".as_ref(),
+        ],
+    );
+    let good = std::fs::read(&tile).unwrap();
+    let merged = dir.path().join("merged.exr");
+    let refused = |input: &Path, needles: &[&str]| {
+        let r = run(
+            "kd2exr",
+            [
+                "merge".as_ref(),
+                input.as_os_str(),
+                "-o".as_ref(),
+                merged.as_os_str(),
+            ],
+        );
+        assert_eq!(r.code, 1, "{}: {}", input.display(), r.stderr);
+        assert_eq!(r.stderr.trim().lines().count(), 1, "one line: {}", r.stderr);
+        assert!(
+            r.stderr.contains(input.to_str().unwrap()),
+            "the file is not named: {}",
+            r.stderr
+        );
+        for n in needles {
+            assert!(r.stderr.contains(n), "{n:?} not in: {}", r.stderr);
+        }
+        assert!(!merged.exists(), "no output after a refusal");
+    };
+    let file = |name: &str, bytes: &[u8]| {
+        let p = dir.path().join(name);
+        std::fs::write(&p, bytes).unwrap();
+        p
+    };
+
+    // An ordinary EXR of the image's size that another program wrote.
+    let foreign = dir.path().join("foreign.exr");
+    write_rgba_file(&foreign, 48, 32, |_, _| (0.5f32, 0.5f32, 0.5f32, 1.0f32)).unwrap();
+    refused(&foreign, &["was not written by kd2exr"]);
+
+    // The crop re-encoded with a lossy compression, its attributes kept.
+    let mut image = read_first_flat_layer_from_file(&tile).unwrap();
+    image.layer_data.encoding.compression = Compression::PXR24;
+    let lossy = dir.path().join("lossy.exr");
+    image.write().to_file(&lossy).unwrap();
+    refused(&lossy, &["pxr24 compression, which is lossy"]);
+
+    // The crop as one part of a two-part file.
+    let named = |name: &str| {
+        let mut layer = image.layer_data.clone();
+        layer.attributes.layer_name = Some(Text::from(name));
+        layer
+    };
+    let two = Image::from_layers(
+        image.attributes.clone(),
+        SmallVec::from_vec(vec![named("a"), named("b")]),
+    );
+    let parts = dir.path().join("parts.exr");
+    two.write().to_file(&parts).unwrap();
+    refused(&parts, &["holds 2 parts"]);
+
+    // Truncated, empty, not EXR at all, a folder, a device.
+    refused(&file("half.exr", &good[..good.len() / 2]), &["truncated"]);
+    refused(&file("empty.exr", &[]), &["the file is empty"]);
+    refused(
+        &file("text.exr", b"P3 1 1 255 0 0 0\n"),
+        &["not an OpenEXR file"],
+    );
+    refused(dir.path(), &["is a folder"]);
+    if cfg!(unix) {
+        refused(Path::new("/dev/null"), &["not a regular file"]);
+    }
+}

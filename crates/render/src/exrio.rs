@@ -1,6 +1,6 @@
 //! OpenEXR output: RGBA (f32, or f16 with `--half`) plus AOV channels in one single-part
 //! scan-line file, the data window set to the rendered crop and the display window to the
-//! full image; reading back; and merging crops into the full image.
+//! full image; and merging crops into the full image. Reading back is [`crate::exrread`].
 
 use crate::frame::ChannelView;
 use crate::{Frame, RenderError, Window};
@@ -304,85 +304,6 @@ impl ExrImage {
         path: &Path,
     ) -> std::result::Result<(), RenderError> {
         write_encoded(path, Self::encode_frame(frame, half, attributes))
-    }
-
-    pub fn read(path: &Path) -> std::result::Result<Self, RenderError> {
-        let err = |detail: String| RenderError::ExrRead {
-            path: path.to_path_buf(),
-            detail,
-        };
-        let bytes = std::fs::read(path).map_err(|e| err(e.to_string()))?;
-        let image = read()
-            .no_deep_data()
-            .largest_resolution_level()
-            .all_channels()
-            .first_valid_layer()
-            .all_attributes()
-            .from_buffered(Cursor::new(bytes))
-            .map_err(|e| err(e.to_string()))?;
-        let display = image.attributes.display_window;
-        if display.position != Vec2(0, 0) {
-            return Err(err(format!(
-                "display window starts at {:?}; unitrace images start at (0, 0)",
-                display.position
-            )));
-        }
-        let layer = image.layer_data;
-        let pos = layer.attributes.layer_position;
-        if pos.0 < 0 || pos.1 < 0 {
-            return Err(err(format!(
-                "data window starts at {pos:?}, outside the image"
-            )));
-        }
-        let (width, height) = (display.size.0 as u64, display.size.1 as u64);
-        let max = crate::options::MAX_EDGE as u64;
-        if width > max || height > max {
-            return Err(err(format!(
-                "display window {width}×{height}: edges above {max} pixels are not supported"
-            )));
-        }
-        let (x1, y1) = (
-            pos.0 as u64 + layer.size.0 as u64,
-            pos.1 as u64 + layer.size.1 as u64,
-        );
-        // Merging places each crop's pixels by its data window: one reaching past the
-        // image would write outside it.
-        if x1 > width || y1 > height {
-            return Err(err(format!(
-                "the {}×{} data window at ({}, {}) reaches past the {width}×{height} image",
-                layer.size.0, layer.size.1, pos.0, pos.1
-            )));
-        }
-        let window = Window {
-            x0: pos.0 as u32,
-            y0: pos.1 as u32,
-            x1: x1 as u32,
-            y1: y1 as u32,
-        };
-        let mut attributes = BTreeMap::new();
-        let others = image
-            .attributes
-            .other
-            .iter()
-            .chain(layer.attributes.other.iter());
-        for (k, v) in others {
-            if let AttributeValue::Text(t) = v {
-                attributes.insert(k.to_string(), t.to_string());
-            }
-        }
-        let channels = layer
-            .channel_data
-            .list
-            .into_iter()
-            .map(|c| (c.name.to_string(), c.sample_data))
-            .collect();
-        Ok(ExrImage {
-            width: display.size.0 as u32,
-            height: display.size.1 as u32,
-            window,
-            channels,
-            attributes,
-        })
     }
 }
 
@@ -791,13 +712,13 @@ fn copy_row<T: Copy>(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::AovSet;
 
     /// An EXR file of RGB whose display window is `display` and data window `data` at the
     /// origin, as another program might write it.
-    fn foreign_exr(path: &Path, display: (usize, usize), data: (usize, usize)) {
+    pub(crate) fn foreign_exr(path: &Path, display: (usize, usize), data: (usize, usize)) {
         let n = data.0 * data.1;
         let ch = |name: &str| AnyChannel::new(name, FlatSamples::F32(vec![0.5; n]));
         let channels = AnyChannels::sort(vec![ch("R"), ch("G"), ch("B")].into());
@@ -871,7 +792,7 @@ mod tests {
 
     /// A 50×40 crop at (3, 37) of a 60×90 image: three blocks of 16 lines, the last one
     /// short. `noise` fills every channel with random bits, which deflate cannot shrink.
-    fn encodable(noise: bool) -> ExrImage {
+    pub(crate) fn encodable(noise: bool) -> ExrImage {
         let window = Window {
             x0: 3,
             y0: 37,

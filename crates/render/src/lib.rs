@@ -23,6 +23,7 @@ pub mod counters;
 pub mod environment;
 pub mod error;
 pub mod exrio;
+pub mod exrread;
 pub mod frame;
 pub mod integrator;
 pub mod lights;

@@ -141,7 +141,7 @@ fn merge(
     }
     let parts = inputs
         .iter()
-        .map(|p| Ok((p.display().to_string(), ExrImage::read(p)?)))
+        .map(|p| Ok((p.display().to_string(), ExrImage::read_crop(p)?)))
         .collect::<Result<Vec<_>, render::RenderError>>()?;
     let labelled: Vec<(String, &ExrImage)> = parts.iter().map(|(l, p)| (l.clone(), p)).collect();
     let full = render::exrio::merge_labelled(&labelled)?;
