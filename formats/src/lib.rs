@@ -11,6 +11,7 @@ pub mod rays;
 pub mod soup;
 pub mod srgb;
 pub mod texture;
+pub mod threads;
 
 pub use envelope::write_atomic;
 pub use error::FormatError;

@@ -159,8 +159,7 @@ pub const MAX_DEPTH: u32 = 256;
 /// long stopped falling (as 1/√spp) at this count.
 pub const MAX_SPP: u32 = 1 << 16;
 
-/// Most threads: each has its own stack; a hundred thousand ran out of memory after minutes.
-pub const MAX_THREADS: usize = 1024;
+pub use formats::threads::MAX_THREADS;
 
 impl RenderOptions {
     /// Refuse options that cannot make an image, naming the option.

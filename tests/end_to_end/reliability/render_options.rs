@@ -122,3 +122,39 @@ fn absurd_render_options_are_refused_before_work() {
     );
     assert_eq!(crop.code, 0, "{}", crop.stderr);
 }
+
+/// rayon's own variable is held to `--threads`'s bounds in every program (it started any
+/// count it was given: 100,000 stalled `soup2kd` for minutes creating threads).
+#[test]
+fn rayon_num_threads_beyond_the_bound_is_refused() {
+    let a = artifacts();
+    let (so, k) = (s(&a.soup), s(&a.kd));
+    let (kd, exr) = (a.p.out("t.kd"), a.p.out("t.exr"));
+    for (program, args) in [
+        ("soup2kd", vec![so.clone(), "-o".into(), s(&kd)]),
+        ("kd2exr", vec![so.clone(), k.clone(), "-o".into(), s(&exr)]),
+        (
+            "raycast",
+            vec![
+                so.clone(),
+                k.clone(),
+                "rays".into(),
+                "-o".into(),
+                "hits".into(),
+            ],
+        ),
+    ] {
+        let out = Command::new(bin(program))
+            .args(&args)
+            .env("RAYON_NUM_THREADS", "100000")
+            .output()
+            .expect("run");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{program}: {err}");
+        assert!(
+            err.contains("RAYON_NUM_THREADS=100000: at most 1024 threads"),
+            "{program}: {err}"
+        );
+    }
+    assert!(!kd.exists() && !exr.exists());
+}

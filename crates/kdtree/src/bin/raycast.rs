@@ -1,6 +1,6 @@
 //! raycast: answer a file of rays against a soup and its k-d tree (formats/RAYS.md).
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use clap::Parser;
 use formats::{rays, Hit, KdFile, Soup};
 use kdtree::{Accel, Ray};
@@ -32,15 +32,7 @@ struct Cli {
 }
 
 fn run(cli: Cli) -> Result<()> {
-    if let Some(n) = cli.threads {
-        if n == 0 {
-            bail!("--threads must be at least 1");
-        }
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build_global()
-            .context("cannot start the thread pool")?;
-    }
+    formats::threads::start(cli.threads).map_err(anyhow::Error::msg)?;
     let soup = Soup::read(&cli.soup)?;
     let kd = KdFile::read(&cli.kd)?;
     let accel = Accel::new(&soup, kd)

@@ -147,15 +147,7 @@ fn print_stats(path: &Path, json: bool) -> Result<()> {
 }
 
 fn run(cli: Cli) -> Result<()> {
-    if let Some(n) = cli.threads {
-        if n == 0 {
-            bail!("--threads must be at least 1");
-        }
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build_global()
-            .context("cannot start the thread pool")?;
-    }
+    formats::threads::start(cli.threads).map_err(anyhow::Error::msg)?;
     if let Some(path) = &cli.stats {
         return print_stats(path, cli.json);
     }

@@ -217,12 +217,7 @@ fn run(a: RenderArgs) -> Result<()> {
     // Everything that can be refused is refused before loading or tracing anything.
     opts.validate()?;
     // Loading and writing run on the same number of threads as the tracing.
-    if let Some(n) = opts.threads {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build_global()
-            .context("cannot start the thread pool")?;
-    }
+    formats::threads::start(opts.threads).map_err(anyhow::Error::msg)?;
     memory::check(&opts, memory::available_bytes())?;
     for p in std::iter::once(&out_path).chain(a.preview.as_ref()) {
         writable_folder(p)?;

@@ -25,6 +25,7 @@ fn main() {
 }
 
 fn run(args: &Args) -> anyhow::Result<()> {
+    formats::threads::start(None).map_err(anyhow::Error::msg)?;
     let soup = formats::Soup::read(&args.soup)?;
     let text = unity::objexport::to_obj(&soup);
     formats::write_atomic(&args.output, text.as_bytes())

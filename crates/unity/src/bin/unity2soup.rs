@@ -49,6 +49,7 @@ fn main() {
 
 fn run(args: &Args) -> anyhow::Result<()> {
     let t0 = Instant::now();
+    formats::threads::start(None).map_err(anyhow::Error::msg)?;
     let opts = unity::Options {
         project: args.assets.clone(),
         strict: args.strict,
