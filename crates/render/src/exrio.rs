@@ -591,14 +591,11 @@ pub fn merge_labelled(parts: &[(String, &ExrImage)]) -> std::result::Result<ExrI
         })
         .sum::<u64>();
     let need = w as u64 * h as u64 * per_pixel;
-    if let Some(avail) = crate::memory::available_bytes().filter(|&a| need > a) {
-        let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
+    if let Some((need, avail)) = crate::memory::short_of(need, crate::memory::available_bytes()) {
         return Err(bad(format!(
-            "a {w}×{h} image with {} channels needs about {:.1} GiB to merge, only {:.1} GiB \
-             of memory is available",
+            "a {w}×{h} image with {} channels needs about {need:.1} GiB to merge, only \
+             {avail:.1} GiB of memory is available",
             first.channels.len(),
-            gib(need),
-            gib(avail)
         )));
     }
     let mut covered = vec![false; w * h];

@@ -3,7 +3,7 @@
 //! file anybody may hand in, and the `exr` crate sizes its buffers by what a header says.
 
 use crate::exrio::{ExrImage, ATTR_PREFIX};
-use crate::{RenderError, Window};
+use crate::{memory, RenderError, Window};
 use exr::block::reader::ChunksReader;
 use exr::block::UncompressedBlock;
 use exr::meta::header::Header;
@@ -173,16 +173,13 @@ impl ExrImage {
             .saturating_mul(per_pixel)
             .saturating_add(block_bytes.saturating_mul(in_flight))
             .saturating_add(bytes.len() as u64);
-        if let Some(avail) = crate::memory::available_bytes().filter(|&a| need > a) {
-            let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
+        if let Some((need, avail)) = memory::short_of(need, memory::available_bytes()) {
             return Err(err(format!(
-                "its {}×{} data window with {} channels needs about {:.1} GiB to read, only \
-                 {:.1} GiB of memory is available",
+                "its {}×{} data window with {} channels needs about {need:.1} GiB to read, \
+                 only {avail:.1} GiB of memory is available",
                 size.0,
                 size.1,
                 header.channels.list.len(),
-                gib(need),
-                gib(avail)
             )));
         }
 
@@ -262,12 +259,9 @@ fn file_bytes(path: &Path) -> std::result::Result<Vec<u8>, RenderError> {
             "is not a regular file (a pipe, socket or device); only EXR files are read".into(),
         ));
     }
-    if let Some(avail) = crate::memory::available_bytes().filter(|&a| meta.len() > a) {
-        let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
+    if let Some((size, avail)) = memory::short_of(meta.len(), memory::available_bytes()) {
         return Err(err(format!(
-            "the file holds {:.1} GiB, more than the {:.1} GiB of memory available",
-            gib(meta.len()),
-            gib(avail)
+            "the file holds {size:.1} GiB, more than the {avail:.1} GiB of memory available"
         )));
     }
     std::fs::read(path).map_err(|e| err(e.to_string()))

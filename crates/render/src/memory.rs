@@ -38,18 +38,26 @@ pub fn available_bytes() -> Option<u64> {
     Some(avail)
 }
 
+/// `need` and `available` bytes in GiB when `need` exceeds `available` (never when the
+/// available memory is unknown): what every refusal for memory reports.
+pub fn short_of(need: u64, available: Option<u64>) -> Option<(f64, f64)> {
+    let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
+    available
+        .filter(|&avail| need > avail)
+        .map(|avail| (gib(need), gib(avail)))
+}
+
 /// Err when the render's estimate exceeds `available` bytes (no check when None).
 pub fn check(opts: &RenderOptions, available: Option<u64>) -> Result<(), RenderError> {
-    let need = estimate_bytes(opts);
-    match available {
-        Some(avail) if need > avail => Err(RenderError::OutOfMemory {
+    match short_of(estimate_bytes(opts), available) {
+        Some((need_gib, available_gib)) => Err(RenderError::OutOfMemory {
             width: opts.window().width(),
             height: opts.window().height(),
             channels: 4 + opts.aovs.channel_count(),
-            need_gib: need as f64 / (1u64 << 30) as f64,
-            available_gib: avail as f64 / (1u64 << 30) as f64,
+            need_gib,
+            available_gib,
         }),
-        _ => Ok(()),
+        None => Ok(()),
     }
 }
 

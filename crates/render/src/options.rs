@@ -159,8 +159,6 @@ pub const MAX_DEPTH: u32 = 256;
 /// long stopped falling (as 1/√spp) at this count.
 pub const MAX_SPP: u32 = 1 << 16;
 
-pub use formats::threads::MAX_THREADS;
-
 impl RenderOptions {
     /// Refuse options that cannot make an image, naming the option.
     pub fn validate(&self) -> Result<(), RenderError> {
@@ -195,12 +193,7 @@ impl RenderOptions {
                 self.cutoff
             ));
         }
-        if self.threads == Some(0) {
-            return bad("--threads 0: at least one thread is needed".into());
-        }
-        if let Some(n) = self.threads.filter(|&n| n > MAX_THREADS) {
-            return bad(format!("--threads {n}: at most {MAX_THREADS}"));
-        }
+        formats::threads::requested(self.threads, None).map_err(RenderError::Option)?;
         if self.tile == 0 {
             return bad("tile size 0".into());
         }
