@@ -19,7 +19,7 @@ pub use kd::{BuildParams, KdFile, KdHeader, KdNode, TreeStats};
 pub use rays::{Hit, RayRecord};
 pub use soup::{
     Alpha, Ambient, AmbientMode, Camera, CastShadows, ClearFlags, Cull, Environment, Light,
-    LightKind, Material, Object, Projection, Shadows, Soup, SoupGeometry, SoupKey,
+    LightKind, Material, NormalMap, Object, Projection, Shadows, Soup, SoupGeometry, SoupKey,
 };
 pub use texture::{Texture, TextureRef, Tiling};
 

@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 pub const MAGIC: &[u8; 8] = b"UTSOUP\0\0";
-pub const VERSION: u32 = 4;
+pub const VERSION: u32 = 5;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Soup {
@@ -136,6 +136,21 @@ pub struct Material {
     pub opacity: f32,
     /// How the material's alpha is used.
     pub alpha: Alpha,
+    /// The tangent-space normal map (`_BumpMap`, HDRP `_NormalMap`) where the shader's
+    /// `_NORMALMAP` keyword turns it on.
+    pub normal_map: Option<NormalMap>,
+}
+
+/// A material's normal map: a linear texture whose red and green channels hold the
+/// normal's tangent-space x (along increasing u) and y (along increasing v) as
+/// `2·c − 1`; z follows from them, as Unity's shaders unpack it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct NormalMap {
+    /// The texture, tiled as the albedo map (Unity's shaders apply the main texture's
+    /// tiling to every map).
+    pub map: TextureRef,
+    /// `_BumpScale` (HDRP `_NormalScale`): x and y are multiplied by it.
+    pub scale: f32,
 }
 
 /// The shader's blend mode as far as rays care (Standard `_Mode`, URP `_Surface` and
@@ -156,6 +171,11 @@ impl Material {
     pub fn uses_alpha(&self) -> bool {
         self.alpha != Alpha::Opaque
     }
+
+    /// Whether the material looks anything up by UV (an albedo or a normal map).
+    pub fn reads_uvs(&self) -> bool {
+        self.albedo_map.is_some() || self.normal_map.is_some()
+    }
 }
 
 impl Material {
@@ -173,6 +193,7 @@ impl Material {
             albedo_map: None,
             opacity: 1.0,
             alpha: Alpha::Opaque,
+            normal_map: None,
         }
     }
 
@@ -501,7 +522,7 @@ impl Soup {
             t.validate()?;
         }
         let n = self.positions.len();
-        let textured = self.materials.iter().any(|m| m.albedo_map.is_some());
+        let textured = self.materials.iter().any(Material::reads_uvs);
         if !(self.uvs.is_empty() || self.uvs.len() == n) || (textured && self.uvs.len() != n) {
             return Err(format!(
                 "{n} vertices but {} UVs{}",
@@ -514,7 +535,16 @@ impl Soup {
             ));
         }
         for (i, m) in self.materials.iter().enumerate() {
-            if let Some(r) = &m.albedo_map {
+            if let Some(n) = &m.normal_map {
+                if !n.scale.is_finite() {
+                    return Err(format!("material {i} has normal map scale {}", n.scale));
+                }
+            }
+            for r in m
+                .albedo_map
+                .iter()
+                .chain(m.normal_map.as_ref().map(|n| &n.map))
+            {
                 if r.texture as usize >= self.textures.len() {
                     return Err(format!(
                         "material {i} names texture {} of {}",

@@ -25,6 +25,13 @@ fn sample_soup() -> Soup {
         Vec2::new(-1.0, 2.0),
     ];
     s.materials = vec![Material {
+        normal_map: Some(NormalMap {
+            map: TextureRef {
+                texture: 0,
+                tiling: Tiling::default(),
+            },
+            scale: 0.5,
+        }),
         albedo_map: Some(TextureRef {
             texture: 0,
             tiling: Tiling {
@@ -96,7 +103,7 @@ fn soup_round_trips_through_a_file() {
     assert_eq!(Soup::read(&path).unwrap(), s);
     let bytes = std::fs::read(&path).unwrap();
     assert_eq!(&bytes[..8], b"UTSOUP\0\0");
-    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 4);
+    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 5);
     // Nothing but the artifact is left in the folder (the temp file was renamed).
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
 }
@@ -726,13 +733,13 @@ fn atomic_outputs_get_the_umask_permissions_not_the_temporary_files() {
 }
 
 #[test]
-fn a_version_3_soup_is_refused_with_the_versions_named() {
+fn a_version_4_soup_is_refused_with_the_versions_named() {
     let p = Path::new("old.soup");
     let mut b = sample_soup().to_bytes(p).unwrap();
-    b[8..12].copy_from_slice(&3u32.to_le_bytes());
+    b[8..12].copy_from_slice(&4u32.to_le_bytes());
     let msg = Soup::from_bytes(&b, p).unwrap_err().to_string();
     assert!(
-        msg.contains("soup format version 3, this build reads version 4"),
+        msg.contains("soup format version 4, this build reads version 5"),
         "{msg}"
     );
     assert!(msg.contains("re-run the stage that made it"), "{msg}");
@@ -798,6 +805,25 @@ fn bad_texture_references_are_corrupt() {
         &|s| s.materials[0].albedo_map.as_mut().unwrap().tiling.offset[1] = f32::INFINITY,
         "non-finite texture tiling",
     );
+    fn normal(s: &mut Soup) -> &mut NormalMap {
+        s.materials[0].normal_map.as_mut().unwrap()
+    }
+    refused(
+        &|s| normal(s).map.texture = 1,
+        "material 0 names texture 1 of 1",
+    );
+    refused(
+        &|s| normal(s).map.tiling.scale[0] = f32::NAN,
+        "non-finite texture tiling",
+    );
+    refused(&|s| normal(s).scale = f32::INFINITY, "normal map scale inf");
+    refused(
+        &|s| {
+            s.materials[0].albedo_map = None;
+            s.uvs.clear();
+        },
+        "(a material has a texture)",
+    );
     refused(&|s| s.materials[0].opacity = 1.5, "opacity 1.5");
     refused(
         &|s| s.textures[0].texels.pop().map(drop).unwrap(),
@@ -807,6 +833,7 @@ fn bad_texture_references_are_corrupt() {
     // Without a textured material the UVs may be left out.
     let mut s = sample_soup();
     s.materials[0].albedo_map = None;
+    s.materials[0].normal_map = None;
     s.uvs.clear();
     let p = Path::new("tex.soup");
     assert_eq!(Soup::from_bytes(&s.to_bytes(p).unwrap(), p).unwrap(), s);

@@ -157,3 +157,23 @@ fn a_transparent_quad_blends_half_its_colour_and_half_a_shadow() {
     // Outside the quad the wall is fully lit.
     assert_close(f.rgb(4, 32), wall, "beside");
 }
+
+#[test]
+fn the_normal_map_bends_the_normal_towards_increasing_u_as_in_unity() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = render(dir.path(), "NormalMap");
+    // The map's texel (204, 128) is tangent-space x = 2·204/255 − 1 = 0.6 along increasing
+    // u (Unity +X, the image's right) and y = 1/255 along v; the Quad faces −Z and the sun
+    // arrives from 30° to its right: cos = 0.5·x + cos 30°·√(1 − x² − y²).
+    let (x, y) = (2.0 * 204.0 / 255.0 - 1.0, 2.0 * 128.0 / 255.0 - 1.0);
+    let z = (1.0f32 - x * x - y * y).sqrt();
+    let cos = 0.5 * x + 30f32.to_radians().cos() * z;
+    assert!((cos - 0.9928).abs() < 1e-4, "{cos}");
+    for (px, py) in [(0, 0), (8, 40), (32, 32), (63, 63)] {
+        assert_close(f.rgb(px, py), Vec3::splat(cos), "bent");
+    }
+    // Unmapped, the Quad would take cos 30° = 0.866; mirrored, 0.393.
+    assert_eq!(f.json["plan"]["normal_maps"]["enabled"], true, "{}", f.json);
+    assert_eq!(f.json["rays"]["normal_lookups"], (SIDE * SIDE) as u64);
+    assert_eq!(f.json["rays"]["texture_lookups"], 0);
+}

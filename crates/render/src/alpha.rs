@@ -57,6 +57,7 @@ mod tests {
         Material {
             alpha,
             opacity,
+            normal_map: None,
             albedo_map: map.then_some(TextureRef {
                 texture: 0,
                 tiling: Tiling::default(),

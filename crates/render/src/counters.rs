@@ -30,6 +30,8 @@ pub struct RayCounts {
     pub soft_decided: u64,
     /// Albedo lookups at shaded points.
     pub texture_lookups: u64,
+    /// Normal-map lookups at shaded points.
+    pub normal_lookups: u64,
     /// Alpha lookups: cut-out tests inside the traversals and blended surfaces' alpha where
     /// no albedo lookup gave it.
     pub alpha_lookups: u64,
@@ -51,6 +53,7 @@ impl RayCounts {
         self.shadow_reuse += o.shadow_reuse;
         self.soft_decided += o.soft_decided;
         self.texture_lookups += o.texture_lookups;
+        self.normal_lookups += o.normal_lookups;
         self.alpha_lookups += o.alpha_lookups;
         self.sanitized += o.sanitized;
     }
@@ -73,6 +76,7 @@ pub struct SharedCounts {
     shadow_reuse: AtomicU64,
     soft_decided: AtomicU64,
     texture_lookups: AtomicU64,
+    normal_lookups: AtomicU64,
     alpha_lookups: AtomicU64,
     sanitized: AtomicU64,
 }
@@ -92,6 +96,7 @@ impl SharedCounts {
         self.shadow_reuse.fetch_add(c.shadow_reuse, Relaxed);
         self.soft_decided.fetch_add(c.soft_decided, Relaxed);
         self.texture_lookups.fetch_add(c.texture_lookups, Relaxed);
+        self.normal_lookups.fetch_add(c.normal_lookups, Relaxed);
         self.alpha_lookups.fetch_add(c.alpha_lookups, Relaxed);
         self.sanitized.fetch_add(c.sanitized, Relaxed);
     }
@@ -108,6 +113,7 @@ impl SharedCounts {
             shadow_reuse: self.shadow_reuse.load(Relaxed),
             soft_decided: self.soft_decided.load(Relaxed),
             texture_lookups: self.texture_lookups.load(Relaxed),
+            normal_lookups: self.normal_lookups.load(Relaxed),
             alpha_lookups: self.alpha_lookups.load(Relaxed),
             sanitized: self.sanitized.load(Relaxed),
         }

@@ -27,6 +27,7 @@ use crate::cone::RayCone;
 use crate::counters::RayCounts;
 use crate::environment;
 use crate::lights::{incident, Incident};
+use crate::normal_map;
 use crate::offset::{
     hit_point, intersector_margin, offset_origin, SHADOW_TMAX_FRACTION, SPAWN_TMIN,
 };
@@ -124,6 +125,8 @@ struct Surfacing {
     map: Option<(usize, Tiling)>,
     /// The albedo is multiplied by the map's colour.
     colour: bool,
+    /// The normal map's sampler, tiling and scale, where the plan reads it.
+    normal: Option<(usize, Tiling, f32)>,
     alpha: AlphaUse,
     opacity: f32,
 }
@@ -285,7 +288,8 @@ impl<'a> Integrator<'a> {
             .collect();
         let textures = plan.textures.enabled;
         let alpha = plan.alpha.enabled;
-        let (samplers, surfacing) = if textures || alpha {
+        let normals = plan.normal_maps.enabled;
+        let (samplers, surfacing) = if textures || alpha || normals {
             let surfacing = soup
                 .materials
                 .iter()
@@ -295,6 +299,10 @@ impl<'a> Integrator<'a> {
                         .map(|r| (r.texture as usize, r.tiling))
                         .filter(|_| textures || alpha),
                     colour: textures && colour_mapped(m),
+                    normal: m
+                        .normal_map
+                        .filter(|n| normals && plan.textures.read[n.map.texture as usize])
+                        .map(|n| (n.map.texture as usize, n.map.tiling, n.scale)),
                     alpha: if alpha {
                         alpha_use(m, &plan.alpha.min_alpha)
                     } else {
@@ -774,7 +782,16 @@ impl<'a> Integrator<'a> {
         if ns == Vec3::ZERO || !ns.is_finite() {
             ns = ng;
         }
-        if ns.dot(ray.dir) > 0.0 {
+        // The side the ray sees is decided before the map bends the normal, which may
+        // turn it past the ray at grazing angles.
+        let back = ns.dot(ray.dir) > 0.0;
+        if let Some((i, tiling, scale)) = self.surfacing.get(mat_index).and_then(|s| s.normal) {
+            counts.normal_lookups += 1;
+            let texel = self.texel(&(i, tiling), prim, hit, ray.dir, cone.at(hit.t));
+            let uv = self.soup.corner_uvs(prim);
+            ns = normal_map::bend(ns, *tri, uv, texel, scale);
+        }
+        if back {
             ns = -ns;
         }
 
@@ -1412,6 +1429,7 @@ mod tests {
             reflectivity: None,
             emission: Vec3::ZERO,
             cull,
+            normal_map: None,
             albedo_map: None,
             opacity,
             alpha,

@@ -28,6 +28,7 @@ pub mod frame;
 pub mod integrator;
 pub mod lights;
 pub mod memory;
+pub mod normal_map;
 pub mod offset;
 pub mod options;
 pub mod plan;

@@ -86,7 +86,7 @@ pub struct TexturePlan {
     pub enabled: bool,
     /// Used materials whose albedo is looked up in a map.
     pub textured_materials: usize,
-    /// Distinct textures those materials (and the alpha lookups) read.
+    /// Distinct textures those materials, the alpha lookups and the normal maps read.
     pub textures: usize,
     /// Bytes of those textures' mip levels below the full-size images, which the soup
     /// holds (linear RGBA f32).
@@ -97,6 +97,18 @@ pub struct TexturePlan {
     /// alone.
     #[serde(skip)]
     pub read: Vec<bool>,
+}
+
+/// Normal maps: on when a used material has one and its shading normal can change the
+/// image: it takes direct light or an ambient that depends on the normal (trilight, sky)
+/// on a diffuse albedo, it mirrors, or the normal AOV is written. Off, no normal map is
+/// read and shading uses the interpolated vertex normal.
+#[derive(Clone, Debug, Serialize)]
+pub struct NormalMapPlan {
+    pub enabled: bool,
+    /// Used materials whose shading normal is looked up in a map.
+    pub materials: usize,
+    pub reason: String,
 }
 
 /// Alpha: on when a used material is cut out where its α can fall below the cut-off, or
@@ -121,6 +133,7 @@ pub struct Plan {
     pub culling: CullPlan,
     pub shadow_casting: ShadowCastPlan,
     pub textures: TexturePlan,
+    pub normal_maps: NormalMapPlan,
     pub alpha: AlphaPlan,
     pub reflections: ReflectionPlan,
     pub ambient: Effect,
@@ -266,8 +279,38 @@ impl Plan {
             ClearFlags::Skybox => "sky gradient".into(),
         };
 
+        // The shading normal shows through diffuse light (direct, or an ambient that
+        // depends on it), a mirror's direction, or the normal AOV.
+        let diffuse_normal = direct.enabled
+            || (ambient.enabled && soup.environment.ambient.mode != AmbientMode::Flat);
+        let normal_mapped: Vec<&Material> = mats
+            .iter()
+            .filter(|m| {
+                m.normal_map.is_some()
+                    && (opts.aovs.normal
+                        || (diffuse_normal && m.albedo().max_element() > 0.0)
+                        || (reflections.enabled
+                            && m.reflectance().max_element() >= opts.cutoff.max(f32::MIN_POSITIVE)))
+            })
+            .copied()
+            .collect();
+        let normal_maps = NormalMapPlan {
+            enabled: !normal_mapped.is_empty(),
+            materials: normal_mapped.len(),
+            reason: if !normal_mapped.is_empty() {
+                format!(
+                    "{} materials with normal maps, read with the albedo's filter",
+                    normal_mapped.len()
+                )
+            } else if mats.iter().any(|m| m.normal_map.is_some()) {
+                "no light, mirror or AOV shows the normal-mapped materials' normals".into()
+            } else {
+                "no material has a normal map".into()
+            },
+        };
+
         let (culling, shadow_casting) = draw_rules(soup, &used, &lights);
-        let (textures, alpha) = texturing(soup, &mats, opts.texture_filter);
+        let (textures, alpha) = texturing(soup, &mats, &normal_mapped, opts.texture_filter);
 
         Plan {
             direct,
@@ -275,6 +318,7 @@ impl Plan {
             culling,
             shadow_casting,
             textures,
+            normal_maps,
             alpha,
             reflections,
             ambient,
@@ -320,6 +364,11 @@ impl Plan {
             self.textures.reason
         );
         s += &format!(
+            "  normal maps    {}  {}\n",
+            on(self.normal_maps.enabled),
+            self.normal_maps.reason
+        );
+        s += &format!(
             "  alpha          {}  {}\n",
             on(self.alpha.enabled),
             self.alpha.reason
@@ -360,8 +409,14 @@ pub fn colour_mapped(m: &Material) -> bool {
     m.albedo_map.is_some() && m.albedo().max_element() > 0.0
 }
 
-/// The texture and alpha effects the used materials `mats` call for.
-fn texturing(soup: &Soup, mats: &[&Material], filter: TextureFilter) -> (TexturePlan, AlphaPlan) {
+/// The texture and alpha effects the used materials `mats` call for; the normal maps of
+/// `normal_mapped` are read too.
+fn texturing(
+    soup: &Soup,
+    mats: &[&Material],
+    normal_mapped: &[&Material],
+    filter: TextureFilter,
+) -> (TexturePlan, AlphaPlan) {
     let min_alpha = min_alphas(&soup.textures);
     let uses: Vec<AlphaUse> = mats.iter().map(|m| alpha_use(m, &min_alpha)).collect();
     let cutout_materials = uses
@@ -381,6 +436,11 @@ fn texturing(soup: &Soup, mats: &[&Material], filter: TextureFilter) -> (Texture
             if let Some(x) = read.get_mut(r.texture as usize) {
                 *x = true;
             }
+        }
+    }
+    for n in normal_mapped.iter().filter_map(|m| m.normal_map) {
+        if let Some(x) = read.get_mut(n.map.texture as usize) {
+            *x = true;
         }
     }
     let textures = read.iter().filter(|&&r| r).count();

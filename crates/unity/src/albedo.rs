@@ -1,13 +1,18 @@
-//! A material's albedo map in the soup: the texture a `.mat` names, or the file a model's
-//! own material names, found the way Unity's model importer finds it. Each image is
-//! decoded once per import settings and shared by every material that uses it; a texture
-//! that cannot be read leaves the material its tint alone, with one warning naming the
-//! material and the file.
+//! A material's albedo and normal maps in the soup: the textures a `.mat` names, or the
+//! file a model's own material names, found the way Unity's model importer finds it. Each
+//! image is decoded once per import settings and shared by every material that uses it; a
+//! texture that cannot be read leaves the material its tint alone (or without its normal
+//! map), with one warning naming the material and the file.
 
 use crate::emit::Emitter;
-use crate::texture::{albedo_slot, load, Import};
+use crate::texture::{albedo_slot, load, normal_slot, Import};
 use crate::yaml::Node;
 use formats::texture::{TextureRef, Tiling};
+use formats::{Material, NormalMap};
+
+/// What a material loses with its albedo map, and with its normal map, as warnings say.
+pub(crate) const TINT_ALONE: &str = "drawn with its tint alone";
+const NO_NORMAL_MAP: &str = "drawn without its normal map";
 use rayon::prelude::*;
 use std::path::{Component, Path, PathBuf};
 
@@ -16,8 +21,8 @@ pub(crate) struct PendingTexture {
     path: PathBuf,
     rel: String,
     import: Import,
-    /// The materials that use it, as warnings name them.
-    users: Vec<String>,
+    /// The materials that use it, as warnings name them, and what they lose without it.
+    users: Vec<(String, &'static str)>,
 }
 
 impl Emitter<'_, '_> {
@@ -31,7 +36,36 @@ impl Emitter<'_, '_> {
             ));
             return None;
         };
-        self.texture_ref(&path, slot.tiling, what)
+        self.texture_ref(&path, Import::read(&path), slot.tiling, what, TINT_ALONE)
+    }
+
+    /// The normal map of Material `body` where its shader samples one; `what` names the
+    /// material in warnings. Unity imports a normal map as linear data whatever the sRGB
+    /// box says.
+    pub(crate) fn mat_normal(&mut self, body: &Node, what: &str) -> Option<NormalMap> {
+        let (slot, scale) = normal_slot(body)?;
+        let Some(path) = self.g.project.resolve(&slot.guid).cloned() else {
+            self.soup.warnings.push(format!(
+                "{what}: {}: texture GUID {} is not in the project; {NO_NORMAL_MAP}",
+                slot.property, slot.guid
+            ));
+            return None;
+        };
+        let import = Import {
+            srgb: false,
+            ..Import::read(&path)
+        };
+        if import.from_grayscale {
+            self.soup.warnings.push(format!(
+                "{what}: {}: {} is a height map Unity turns into normals on import \
+                 (Create from Grayscale), which is not supported; {NO_NORMAL_MAP}",
+                slot.property,
+                self.g.project.rel(&path)
+            ));
+            return None;
+        }
+        let map = self.texture_ref(&path, import, slot.tiling, what, NO_NORMAL_MAP)?;
+        Some(NormalMap { map, scale })
     }
 
     /// The soup texture of the image at `path` with `tiling`. The image is only named
@@ -40,10 +74,11 @@ impl Emitter<'_, '_> {
     pub(crate) fn texture_ref(
         &mut self,
         path: &Path,
+        import: Import,
         tiling: Tiling,
         what: &str,
+        without: &'static str,
     ) -> Option<TextureRef> {
-        let import = Import::read(path);
         // The same image imported twice with different settings is two textures to Unity.
         let key = format!("{}\n{import:?}", path.display());
         let texture = match self.textures.get(&key) {
@@ -62,7 +97,7 @@ impl Emitter<'_, '_> {
         };
         self.pending_textures[texture as usize]
             .users
-            .push(what.to_string());
+            .push((what.to_string(), without));
         Some(TextureRef { texture, tiling })
     }
 
@@ -84,20 +119,21 @@ impl Emitter<'_, '_> {
                 }
                 Err(e) => {
                     index.push(None);
-                    for what in &p.users {
-                        self.soup
-                            .warnings
-                            .push(format!("{what}: {e}; drawn with its tint alone"));
+                    for (what, without) in &p.users {
+                        self.soup.warnings.push(format!("{what}: {e}; {without}"));
                     }
                 }
             }
         }
+        let decoded =
+            |r: TextureRef| index[r.texture as usize].map(|texture| TextureRef { texture, ..r });
         for m in &mut self.soup.materials {
-            m.albedo_map = m
-                .albedo_map
-                .and_then(|r| index[r.texture as usize].map(|texture| TextureRef { texture, ..r }));
+            m.albedo_map = m.albedo_map.and_then(decoded);
+            m.normal_map = m
+                .normal_map
+                .and_then(|n| decoded(n.map).map(|map| NormalMap { map, ..n }));
         }
-        if self.soup.materials.iter().all(|m| m.albedo_map.is_none()) {
+        if !self.soup.materials.iter().any(Material::reads_uvs) {
             self.soup.uvs = Vec::new();
         }
     }

@@ -60,6 +60,23 @@ pub(crate) fn props<'a>(saved: &'a Node, section: &str) -> Vec<(&'a str, &'a Nod
     out
 }
 
+/// Whether the material's shader keywords (`m_ShaderKeywords`, or 2021's
+/// `m_ValidKeywords`) include `keyword`; None when the file lists no keywords at all.
+pub(crate) fn keyword_on(body: &Node, keyword: &str) -> Option<bool> {
+    let lists: Vec<&Node> = ["m_ShaderKeywords", "m_ValidKeywords"]
+        .iter()
+        .filter_map(|k| body.get(k))
+        .collect();
+    if lists.is_empty() {
+        return None;
+    }
+    Some(lists.iter().any(|n| match n {
+        Node::Scalar(s) => s.split_whitespace().any(|k| k == keyword),
+        Node::Seq(v) => v.iter().any(|k| k.as_str() == Some(keyword)),
+        _ => false,
+    }))
+}
+
 /// Convert a parsed Material body. Returns the material and notes worth a warning.
 pub fn convert(body: &Node, source: &str) -> (Material, Vec<String>) {
     let mut notes = Vec::new();
@@ -112,23 +129,7 @@ pub fn convert(body: &Node, source: &str) -> (Material, Vec<String>) {
         let e = linear_rgb(e);
         // Unity's Standard and URP shaders glow only with the _EMISSION keyword; files
         // without any keyword list (custom shaders) glow when the colour is not black.
-        let keywords: Vec<&str> = ["m_ShaderKeywords", "m_ValidKeywords"]
-            .iter()
-            .filter_map(|k| body.get(k))
-            .flat_map(|n| match n {
-                Node::Scalar(s) => s.split_whitespace().collect::<Vec<_>>(),
-                Node::Seq(v) => v.iter().filter_map(Node::as_str).collect(),
-                _ => vec![],
-            })
-            .collect();
-        let has_keyword_info =
-            body.get("m_ShaderKeywords").is_some() || body.get("m_ValidKeywords").is_some();
-        let enabled = if has_keyword_info {
-            keywords.contains(&"_EMISSION")
-        } else {
-            e != Vec3::ZERO
-        };
-        if enabled {
+        if keyword_on(body, "_EMISSION").unwrap_or(e != Vec3::ZERO) {
             m.emission = e;
         }
     }
@@ -284,6 +285,7 @@ impl Emitter<'_, '_> {
                 let body = self.inherit(&body, &src);
                 let (mut m, _notes) = convert(&body, &src);
                 m.albedo_map = self.mat_albedo(&body, &src);
+                m.normal_map = self.mat_normal(&body, &src);
                 (self.add_material(key, || m), format!("override {src}"))
             }
             _ => {
@@ -309,6 +311,7 @@ impl Emitter<'_, '_> {
                     self.soup.warnings.push(format!("{rel}: {n}"));
                 }
                 m.albedo_map = self.mat_albedo(&b, &rel);
+                m.normal_map = self.mat_normal(&b, &rel);
                 self.add_material(key, || m)
             }
             Ok(None) => self.warn_default(what, format!("{rel} holds no Material")),
@@ -397,7 +400,13 @@ impl Emitter<'_, '_> {
                 m.color = own.color;
                 let src = m.source.clone();
                 m.albedo_map = match texture {
-                    Some((_, Some(found))) => self.texture_ref(&found, Default::default(), &src),
+                    Some((_, Some(found))) => self.texture_ref(
+                        &found,
+                        crate::texture::Import::read(&found),
+                        Default::default(),
+                        &src,
+                        crate::albedo::TINT_ALONE,
+                    ),
                     Some((t, None)) => {
                         self.soup.warnings.push(format!(
                             "{src}: texture {t} is not next to the model, in a Textures folder or anywhere in Assets; drawn with its tint alone"

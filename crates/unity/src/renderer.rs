@@ -135,7 +135,7 @@ impl Placements {
     /// split into each mesh's share, so meshes fill on all threads, and large meshes in
     /// parallel pieces; the output is the same as a sequential loop's.
     ///
-    /// UVs are stored only when some material is textured; then every vertex has its
+    /// UVs are stored only when some material has an albedo or normal map; then every vertex has its
     /// mesh's UVs, or (0, 0) when the mesh has none (or fewer than positions). Texture
     /// coordinates do not move with the mesh.
     ///
@@ -143,7 +143,7 @@ impl Placements {
     /// object left without triangles is dropped with them, so that object indices stay
     /// dense in what renders; `origins` is kept parallel to the objects.
     pub(crate) fn fill(self, soup: &mut Soup, origins: &mut Vec<Vec<(u32, String)>>) {
-        let textured = soup.materials.iter().any(|m| m.albedo_map.is_some());
+        let textured = soup.materials.iter().any(formats::Material::reads_uvs);
         let (nv, nt) = (self.vertices, self.triangles);
         let mut positions: Vec<Vec3> = bytemuck::zeroed_vec(nv);
         let mut normals: Vec<Vec3> = bytemuck::zeroed_vec(nv);

@@ -1,5 +1,5 @@
-//! Albedo textures: which texture a `.mat` draws with, how its `.meta` TextureImporter
-//! says to import it, and decoding the image file into a [`formats::texture::Texture`] the
+//! Albedo and normal maps: which textures a `.mat` draws with, how their `.meta`
+//! TextureImporter says to import them, and decoding the image file into a [`formats::texture::Texture`] the
 //! way Unity's importer would hand it to the shader (power-of-two rounding, size limit,
 //! bottom row first).
 
@@ -44,9 +44,9 @@ pub enum TextureError {
     },
 }
 
-/// The albedo slot of a material: which property, which texture, what tiling.
+/// A texture slot of a material: which property, which texture, what tiling.
 #[derive(Clone, Debug, PartialEq)]
-pub struct AlbedoSlot {
+pub struct TextureSlot {
     pub property: String,
     pub guid: String,
     pub tiling: Tiling,
@@ -54,7 +54,7 @@ pub struct AlbedoSlot {
 
 /// The albedo texture slot of a Material body, in either `m_TexEnvs` layout. `None` when
 /// the material's albedo property is empty (`{fileID: 0}`) or absent.
-pub fn albedo_slot(body: &Node) -> Option<AlbedoSlot> {
+pub fn albedo_slot(body: &Node) -> Option<TextureSlot> {
     let saved = body.get("m_SavedProperties")?;
     let envs = props(saved, "m_TexEnvs");
     let slot = |name: &str| envs.iter().find(|(k, _)| *k == name).map(|(_, v)| *v);
@@ -77,12 +77,59 @@ pub fn albedo_slot(body: &Node) -> Option<AlbedoSlot> {
         .find_map(|name| slot(name).and_then(|env| texture_of(name, env)))
 }
 
-fn texture_of(property: &str, env: &Node) -> Option<AlbedoSlot> {
+/// The normal map of a Material body and its scale, where the shader samples one: Standard
+/// and URP Lit `_BumpMap` (`_BumpScale`), HDRP Lit `_NormalMap` (`_NormalScale`), only
+/// with the `_NORMALMAP` keyword (or in a file that lists no keywords). Its UVs are tiled
+/// by the albedo property's scale and offset, as Unity's shaders transform every map's UVs
+/// by the main texture's, whether or not the albedo slot holds a texture.
+pub fn normal_slot(body: &Node) -> Option<(TextureSlot, f32)> {
+    if crate::material::keyword_on(body, "_NORMALMAP") == Some(false) {
+        return None;
+    }
+    let saved = body.get("m_SavedProperties")?;
+    let envs = props(saved, "m_TexEnvs");
+    let slot = |name: &str| envs.iter().find(|(k, _)| *k == name).map(|(_, v)| *v);
+    let shader = body.get("m_Shader").and_then(|s| s.str_at("guid"));
+    let (texture, scale) = match shader {
+        Some(HDRP_LIT) => ("_NormalMap", "_NormalScale"),
+        _ => ("_BumpMap", "_BumpScale"),
+    };
+    let mut found = texture_of(texture, slot(texture)?)?;
+    found.tiling = main_env(body, &envs).map_or_else(Tiling::default, tiling_of);
+    let scale = props(saved, "m_Floats")
+        .iter()
+        .find(|(k, _)| *k == scale)
+        .and_then(|(_, v)| v.as_f32())
+        .filter(|x| x.is_finite())
+        .unwrap_or(1.0);
+    Some((found, scale))
+}
+
+/// The albedo property's entry of `envs`: the shader's own, else the first present.
+fn main_env<'a>(body: &Node, envs: &[(&'a str, &'a Node)]) -> Option<&'a Node> {
+    let slot = |name: &str| envs.iter().find(|(k, _)| *k == name).map(|(_, v)| *v);
+    let own = match body.get("m_Shader").and_then(|s| s.str_at("guid")) {
+        Some(URP_LIT) => "_BaseMap",
+        Some(HDRP_LIT) => "_BaseColorMap",
+        _ => "_MainTex",
+    };
+    slot(own).or_else(|| ALBEDO_PROPERTIES.iter().find_map(|name| slot(name)))
+}
+
+fn texture_of(property: &str, env: &Node) -> Option<TextureSlot> {
     let tex = env.get("m_Texture")?;
     if tex.i64_at("fileID").unwrap_or(0) == 0 {
         return None;
     }
     let guid = tex.str_at("guid")?.trim().to_string();
+    Some(TextureSlot {
+        property: property.to_string(),
+        guid,
+        tiling: tiling_of(env),
+    })
+}
+
+fn tiling_of(env: &Node) -> Tiling {
     let pair = |key: &str, default: f32| {
         let n = env.get(key);
         [
@@ -90,14 +137,10 @@ fn texture_of(property: &str, env: &Node) -> Option<AlbedoSlot> {
             n.and_then(|n| n.f32_at("y")).unwrap_or(default),
         ]
     };
-    Some(AlbedoSlot {
-        property: property.to_string(),
-        guid,
-        tiling: Tiling {
-            scale: pair("m_Scale", 1.0),
-            offset: pair("m_Offset", 0.0),
-        },
-    })
+    Tiling {
+        scale: pair("m_Scale", 1.0),
+        offset: pair("m_Offset", 0.0),
+    }
 }
 
 /// TextureImporter `nPOTScale`.
@@ -121,6 +164,12 @@ pub struct Import {
     pub npot: Npot,
     /// The importer dilates colour into transparent texels; cut-out rendering will want it.
     pub alpha_is_transparency: bool,
+    /// `bumpmap.convertToNormalMap`: Unity makes the normal map from the image's grey
+    /// levels as heights, which this converter does not.
+    pub from_grayscale: bool,
+    /// `bumpmap.flipGreenChannel` on a normal map (`textureType: 1`): the image's green
+    /// channel points along decreasing v (DirectX's convention) and is inverted on import.
+    pub flip_green: bool,
 }
 
 impl Default for Import {
@@ -134,6 +183,8 @@ impl Default for Import {
             max_size: 2048,
             npot: Npot::ToNearest,
             alpha_is_transparency: false,
+            from_grayscale: false,
+            flip_green: false,
         }
     }
 }
@@ -218,6 +269,9 @@ impl Import {
             im.npot = Npot::None;
         }
         im.alpha_is_transparency = imp.i64_at("alphaIsTransparency") == Some(1);
+        let bumpmap = |key: &str| imp.get("bumpmap").and_then(|b| b.i64_at(key)) == Some(1);
+        im.from_grayscale = bumpmap("convertToNormalMap");
+        im.flip_green = bumpmap("flipGreenChannel") && imp.i64_at("textureType") == Some(1);
         im
     }
 
@@ -406,7 +460,14 @@ pub fn decode(
     };
     // Image files list the top row first; Unity's v = 0 is the bottom row.
     let row = w as usize * 4;
-    let texels: Vec<u8> = rows.chunks_exact(row).rev().flatten().copied().collect();
+    let mut texels: Vec<u8> = rows.chunks_exact(row).rev().flatten().copied().collect();
+    if import.flip_green {
+        texels
+            .iter_mut()
+            .skip(1)
+            .step_by(4)
+            .for_each(|g| *g = 255 - *g);
+    }
     let t = Texture {
         source: source.to_string(),
         width: w,
@@ -603,6 +664,79 @@ m_SavedProperties:
     }
 
     #[test]
+    fn normal_slot_needs_the_keyword_and_takes_the_main_tiling() {
+        let standard = |keywords: &str| {
+            mat(&format!(
+                "m_Shader: {{fileID: 46, guid: 0000000000000000f000000000000000, type: 0}}
+{keywords}m_SavedProperties:
+  m_TexEnvs:
+  - _BumpMap:
+      m_Texture: {{fileID: 2800000, guid: nnnn, type: 3}}
+      m_Scale: {{x: 1, y: 1}}
+      m_Offset: {{x: 0, y: 0}}
+  - _MainTex:
+      m_Texture: {{fileID: 0}}
+      m_Scale: {{x: 4, y: 2}}
+      m_Offset: {{x: 0.5, y: 0}}
+  m_Floats:
+  - _BumpScale: 0.25
+"
+            ))
+        };
+        let (s, scale) =
+            normal_slot(&standard("m_ShaderKeywords: _EMISSION _NORMALMAP\n")).unwrap();
+        assert_eq!(
+            (s.property.as_str(), s.guid.as_str(), scale),
+            ("_BumpMap", "nnnn", 0.25)
+        );
+        // Unity's shaders tile every map as the main texture, empty or not.
+        assert_eq!(s.tiling.scale, [4.0, 2.0]);
+        assert_eq!(s.tiling.offset, [0.5, 0.0]);
+        let valid = standard("m_ValidKeywords:\n- _NORMALMAP\n");
+        assert!(normal_slot(&valid).is_some());
+        // A keyword list without _NORMALMAP: the shader samples no normal map.
+        assert_eq!(
+            normal_slot(&standard("m_ShaderKeywords: _EMISSION\n")),
+            None
+        );
+        assert_eq!(normal_slot(&standard("m_ValidKeywords: []\n")), None);
+        // A file without any keyword list uses the map it names.
+        assert!(normal_slot(&standard("")).is_some());
+
+        let hdrp = mat(
+            "m_Shader: {fileID: 4800000, guid: 6e4ae4064600d784cac1e41a9e6f2e59, type: 3}
+m_ShaderKeywords: _NORMALMAP _NORMALMAP_TANGENT_SPACE
+m_SavedProperties:
+  m_TexEnvs:
+  - _BaseColorMap:
+      m_Texture: {fileID: 0}
+      m_Scale: {x: 3, y: 3}
+      m_Offset: {x: 0, y: 0}
+  - _BumpMap:
+      m_Texture: {fileID: 2800000, guid: stale, type: 3}
+  - _NormalMap:
+      m_Texture: {fileID: 2800000, guid: hhhh, type: 3}
+  m_Floats:
+  - _BumpScale: 1
+  - _NormalScale: 1.5
+",
+        );
+        let (s, scale) = normal_slot(&hdrp).unwrap();
+        assert_eq!(
+            (s.property.as_str(), s.guid.as_str(), scale),
+            ("_NormalMap", "hhhh", 1.5)
+        );
+        assert_eq!(s.tiling.scale, [3.0, 3.0]);
+        let empty = mat("m_ShaderKeywords: _NORMALMAP
+m_SavedProperties:
+  m_TexEnvs:
+  - _BumpMap:
+      m_Texture: {fileID: 0}
+");
+        assert_eq!(normal_slot(&empty), None);
+    }
+
+    #[test]
     fn albedo_slot_legacy_layout() {
         let old = mat(
             "m_Shader: {fileID: 46, guid: 0000000000000000f000000000000000, type: 0}
@@ -644,6 +778,10 @@ m_SavedProperties:
     wrapV: 2
   nPOTScale: 3
   alphaIsTransparency: 1
+  bumpmap:
+    convertToNormalMap: 1
+    flipGreenChannel: 1
+  textureType: 1
   platformSettings:
   - buildTarget: DefaultTexturePlatform
     maxTextureSize: 256
@@ -660,6 +798,8 @@ m_SavedProperties:
                 max_size: 256,
                 npot: Npot::ToSmaller,
                 alpha_is_transparency: true,
+                from_grayscale: true,
+                flip_green: true,
             }
         );
         let old = Import::parse(
@@ -732,6 +872,21 @@ m_SavedProperties:
         )
         .unwrap();
         assert_eq!(t.texel(1, 0)[0], 128.0 / 255.0);
+        // A normal map imported with Flip Green Channel: green inverted, nothing else.
+        let flipped = Import {
+            flip_green: true,
+            ..linear
+        };
+        let f = decode(
+            &encode(&four_colours(), ImageFormat::Png),
+            "png",
+            "t",
+            &flipped,
+        )
+        .unwrap();
+        for (a, b) in t.texels.chunks(4).zip(f.texels.chunks(4)) {
+            assert_eq!([b[0], 255 - b[1], b[2], b[3]], [a[0], a[1], a[2], a[3]]);
+        }
     }
 
     #[test]

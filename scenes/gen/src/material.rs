@@ -27,6 +27,9 @@ pub struct Surface {
     pub mode: Mode,
     /// `_Cutoff`, the alpha threshold in [`Mode::Cutout`].
     pub cutoff: f32,
+    /// `_BumpMap`, a normal map's GUID (turns on the `_NORMALMAP` keyword), with
+    /// `_BumpScale`.
+    pub bump_map: Option<(String, f32)>,
 }
 
 impl Default for Surface {
@@ -36,6 +39,7 @@ impl Default for Surface {
             alpha: 1.0,
             mode: Mode::Opaque,
             cutoff: 0.5,
+            bump_map: None,
         }
     }
 }
@@ -146,6 +150,9 @@ pub fn write_surface(m: &MatDesc, surface: &Surface) -> String {
     if m.emission.is_some() {
         keywords.push("_EMISSION");
     }
+    if surface.bump_map.is_some() {
+        keywords.push("_NORMALMAP");
+    }
     keywords.sort();
     let keywords = if keywords.is_empty() {
         " []".to_string()
@@ -192,6 +199,14 @@ pub fn write_surface(m: &MatDesc, surface: &Surface) -> String {
                 slot.scale,
                 slot.offset,
             ),
+            _ if t == "_BumpMap" && surface.bump_map.is_some() => (
+                format!(
+                    "{{fileID: 2800000, guid: {}, type: 3}}",
+                    surface.bump_map.as_ref().map_or("", |b| &b.0)
+                ),
+                [1.0, 1.0],
+                [0.0, 0.0],
+            ),
             _ => ("{fileID: 0}".to_string(), [1.0, 1.0], [0.0, 0.0]),
         };
         let _ = write!(
@@ -210,7 +225,7 @@ pub fn write_surface(m: &MatDesc, surface: &Surface) -> String {
     s += "    m_Ints: []\n    m_Floats:\n";
     // Unity keeps properties sorted by name; `_Reflectivity` slots in among them.
     let mut floats: Vec<(&str, f32)> = vec![
-        ("_BumpScale", 1.0),
+        ("_BumpScale", surface.bump_map.as_ref().map_or(1.0, |b| b.1)),
         ("_Cutoff", surface.cutoff),
         ("_DetailNormalMapScale", 1.0),
         ("_DstBlend", dst),

@@ -35,6 +35,8 @@ pub struct TextureImport {
     /// `wrapU`/`wrapV`: 0 repeat, 1 clamp.
     pub wrap: u8,
     pub alpha_is_transparency: bool,
+    /// Texture Type "Normal map" (`textureType: 1`).
+    pub normal_map: bool,
 }
 
 /// A texture's `.meta`: TextureImporter as Unity 2022.3 writes it for a Default texture.
@@ -97,7 +99,7 @@ TextureImporter:
   alphaUsage: 1
   alphaIsTransparency: {ait}
   spriteTessellationDetail: -1
-  textureType: 0
+  textureType: {kind}
   textureShape: 1
   singleChannelComponent: 0
   flipbookRows: 1
@@ -145,6 +147,7 @@ TextureImporter:
         filter = im.filter,
         wrap = im.wrap,
         ait = b(im.alpha_is_transparency),
+        kind = b(im.normal_map),
     )
 }
 

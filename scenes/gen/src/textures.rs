@@ -1,5 +1,5 @@
-//! The `textures` project: one scene per way a material uses its albedo texture and
-//! alpha, each a Quad seen square-on so every pixel's expected value follows from a texel.
+//! The `textures` project: one scene per way a material uses its albedo texture, alpha
+//! and normal map, each a Quad seen square-on so every pixel's expected value follows from a texel.
 //!
 //! All scenes are lit by one white directional light of intensity 1 shining straight at
 //! the Quads' fronts (Unity +Z) and have no ambient light, so a lit Quad's pixel is its
@@ -50,7 +50,12 @@ const CRISP: TextureImport = TextureImport {
     srgb: true,
     wrap: 0,
     alpha_is_transparency: false,
+    normal_map: false,
 };
+
+/// The normal map's texel: red 204 is a tilt of 0.6 towards increasing u (2·204/255 − 1),
+/// green 128 one of 1/255 towards increasing v; blue is not read.
+pub const BENT: [u8; 4] = [204, 128, 255, 255];
 
 fn white(name: &'static str) -> MatDesc {
     MatDesc {
@@ -114,6 +119,15 @@ pub fn project() -> Project {
             ..CRISP
         },
     );
+    let bent = b.texture(
+        "Assets/Textures/Bent.png",
+        png(2, 2, &[BENT; 4]),
+        &TextureImport {
+            srgb: false,
+            normal_map: true,
+            ..CRISP
+        },
+    );
     let textured = |guid: &str| Surface {
         main_tex: Some(TexSlot::new(guid)),
         ..Surface::default()
@@ -137,6 +151,13 @@ pub fn project() -> Project {
             mode: Mode::Cutout,
             cutoff: 0.5,
             ..textured(&cutout)
+        },
+    );
+    b.look(
+        &white("Bent"),
+        &Surface {
+            bump_map: Some((bent, 1.0)),
+            ..Surface::default()
         },
     );
     b.look(
@@ -174,6 +195,18 @@ pub fn project() -> Project {
         .mesh("Glass", unity::QUAD, "HalfRed", Xform::at(0.0, 0.0, 0.0))
         .light("Sun", Xform::at(0.0, 3.0, -3.0), sun())
         .scene("Transparent", NO_AMBIENT);
+    // (f) A white Quad whose normal map tilts every normal towards increasing u (Unity
+    // +X, the image's right), under a sun from the front right (30° off the Quad's
+    // normal): lit at cos = 0.5·0.6 + cos 30°·0.8 ≈ 0.993, where a flat Quad takes
+    // 0.866 and a mirrored map 0.393.
+    b.camera(Xform::at(0.0, 0.0, -2.0), ortho())
+        .mesh("Bent", unity::QUAD, "Bent", Xform::at(0.0, 0.0, 0.0))
+        .light(
+            "Sun",
+            Xform::at(3.0, 0.0, -3.0).euler(0.0, -30.0, 0.0),
+            sun(),
+        )
+        .scene("NormalMap", NO_AMBIENT);
     b.done()
 }
 
@@ -222,7 +255,15 @@ mod tests {
         let meta = text(&p, "Assets/Textures/Quadrants.png.meta");
         assert!(meta.contains("    enableMipMap: 0\n") && meta.contains("    filterMode: 0\n"));
         let scenes = p.files.keys().filter(|k| k.ends_with(".unity")).count();
-        assert_eq!(scenes, 5);
+        assert_eq!(scenes, 6);
+        let bent = text(&p, "Assets/Materials/Bent.mat");
+        assert!(bent.contains("  m_ValidKeywords:\n  - _NORMALMAP\n"));
+        let guid = p.guid("Assets/Textures/Bent.png");
+        assert!(bent.contains(&format!(
+            "    - _BumpMap:\n        m_Texture: {{fileID: 2800000, guid: {guid}, type: 3}}\n"
+        )));
+        let meta = text(&p, "Assets/Textures/Bent.png.meta");
+        assert!(meta.contains("    sRGBTexture: 0\n") && meta.contains("  textureType: 1\n"));
         // Top row first in the file: red at the top-left.
         let img = image::load_from_memory(&p.files["Assets/Textures/Quadrants.png"])
             .unwrap()

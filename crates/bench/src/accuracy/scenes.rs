@@ -66,6 +66,7 @@ fn material(name: &str, color: Vec3, metallic: f32, smoothness: f32) -> Material
         emission: Vec3::ZERO,
         // Two-sided: the analytic references draw both faces.
         cull: Cull::None,
+        normal_map: None,
         albedo_map: None,
         opacity: 1.0,
         alpha: Alpha::Opaque,
@@ -236,6 +237,7 @@ pub fn checkerboard() -> Scene {
     let mut soup = Soup::empty();
     soup.textures = vec![checker_texture(128, 2)];
     soup.materials = vec![Material {
+        normal_map: None,
         albedo_map: Some(TextureRef {
             texture: 0,
             tiling: Tiling::default(),

@@ -117,10 +117,10 @@ impl SceneBuilder {
         self.soup.camera = c;
     }
 
-    /// Seal and compile the scene; a scene without textures keeps no UVs, as unity2soup
+    /// Seal and compile the scene; a scene without albedo or normal maps keeps no UVs, as unity2soup
     /// writes it.
     pub fn build(mut self) -> (Soup, KdFile) {
-        if self.soup.materials.iter().all(|m| m.albedo_map.is_none()) {
+        if !self.soup.materials.iter().any(Material::reads_uvs) {
             self.soup.uvs.clear();
         }
         self.soup.seal();
@@ -146,6 +146,7 @@ pub fn diffuse(c: Vec3) -> Material {
         reflectivity: None,
         emission: Vec3::ZERO,
         cull: Cull::None,
+        normal_map: None,
         albedo_map: None,
         opacity: 1.0,
         alpha: Alpha::Opaque,
@@ -162,6 +163,7 @@ pub fn mirror(reflectivity: f32) -> Material {
         reflectivity: Some(reflectivity),
         emission: Vec3::ZERO,
         cull: Cull::None,
+        normal_map: None,
         albedo_map: None,
         opacity: 1.0,
         alpha: Alpha::Opaque,
@@ -178,6 +180,7 @@ pub fn emissive(e: Vec3) -> Material {
         reflectivity: None,
         emission: e,
         cull: Cull::None,
+        normal_map: None,
         albedo_map: None,
         opacity: 1.0,
         alpha: Alpha::Opaque,

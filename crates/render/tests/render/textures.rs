@@ -24,6 +24,7 @@ fn four_colours(wrap: Wrap) -> formats::Texture {
 /// A white material showing texture `t` through `tiling`.
 fn mapped(t: u32, tiling: Tiling) -> Material {
     Material {
+        normal_map: None,
         albedo_map: Some(TextureRef { texture: t, tiling }),
         ..diffuse(Vec3::ONE)
     }
@@ -212,6 +213,7 @@ fn quad_over_lit_floor(quad: Material, tex: Option<formats::Texture>) -> SceneBu
         Some(t) => {
             let t = s.texture(t);
             Material {
+                normal_map: None,
                 albedo_map: Some(TextureRef {
                     texture: t,
                     tiling: Tiling::default(),
@@ -434,4 +436,80 @@ fn a_mirror_shows_a_texture_where_its_reflection_lands() {
     }
     assert_eq!(out.counts.texture_lookups, 16);
     assert_eq!(out.counts.reflection, 16);
+}
+
+/// A quad whose normal map tilts every normal by 0.6 towards increasing u (the image's
+/// right) and 1/255 towards increasing v, lit by a sun 30° off its normal from the u side:
+/// each pixel is the cosine between the light and the bent normal. The plan reads the map
+/// only while something shows the normal: a light, an ambient that depends on it, or the
+/// normal AOV.
+#[test]
+fn normal_maps_bend_the_light_and_are_read_only_where_they_show() {
+    let (x, y) = (2.0 * 204.0 / 255.0 - 1.0f32, 2.0 * 128.0 / 255.0 - 1.0f32);
+    let z = (1.0 - x * x - y * y).sqrt();
+    let cos30 = 30f32.to_radians().cos();
+    let scene = |sun: bool, ambient: formats::AmbientMode, scale: f32| {
+        let mut s = SceneBuilder::new();
+        let t = s.texture(texture(1, 1, &[[204, 128, 255, 255]], Wrap::Repeat));
+        let m = s.material(Material {
+            normal_map: Some(formats::NormalMap {
+                map: TextureRef {
+                    texture: t,
+                    tiling: Tiling::default(),
+                },
+                scale,
+            }),
+            ..diffuse(Vec3::ONE)
+        });
+        unity_quad(&mut s, 1.0, m, [Vec2::ZERO, Vec2::ONE]);
+        if sun {
+            // Travelling towards +Z and soup +X: it arrives from soup −X, where u grows.
+            let d = Vec3::new(0.5, 0.0, cos30);
+            s.light(directional_light(d, 1.0, Shadows::None));
+        }
+        s.soup.environment.ambient.mode = ambient;
+        s.soup.environment.ambient.sky = Vec3::splat(if sun { 0.0 } else { 1.0 });
+        s.camera(front_camera(0.5));
+        s.build()
+    };
+    let flat = formats::AmbientMode::Flat;
+    let (soup, kd) = scene(true, flat, 1.0);
+    let mut o = opts(4, 4);
+    o.aovs.normal = true;
+    let (out, plan) = render(&soup, &kd, &o);
+    assert!(plan.normal_maps.enabled, "{}", plan.normal_maps.reason);
+    assert_eq!(out.counts.normal_lookups, 16);
+    let cos = 0.5 * x + cos30 * z;
+    for (px, py) in [(0, 0), (3, 0), (1, 2), (3, 3)] {
+        assert_close(out.frame.pixel(px, py), Vec3::splat(cos), 1e-5, "bent");
+    }
+    // The normal AOV holds the bent normal, facing the camera (soup −Z); u grows along −X.
+    let bent = Vec3::new(-x, y, -z);
+    assert_close(out.frame.normal[5], bent, 1e-5, "normal AOV");
+    // Half the scale halves the tilt.
+    let (soup, kd) = scene(true, flat, 0.5);
+    let (out, _) = render(&soup, &kd, &opts(4, 4));
+    let (hx, hy) = (x / 2.0, y / 2.0);
+    let half = 0.5 * hx + cos30 * (1.0 - hx * hx - hy * hy).sqrt();
+    assert_close(out.frame.pixel(1, 1), Vec3::splat(half), 1e-5, "scale 0.5");
+
+    // Flat ambient alone: the normal cannot show, the map is not read, the pixel is white.
+    let (soup, kd) = scene(false, flat, 1.0);
+    o.aovs.normal = false;
+    let (out, plan) = render(&soup, &kd, &o);
+    assert!(!plan.normal_maps.enabled, "{}", plan.normal_maps.reason);
+    assert_eq!(out.counts.normal_lookups, 0);
+    assert_eq!(out.frame.pixel(2, 2), Vec3::ONE);
+    // The same scene with the normal AOV written reads it.
+    o.aovs.normal = true;
+    let (out, plan) = render(&soup, &kd, &o);
+    assert!(plan.normal_maps.enabled);
+    assert_eq!(out.counts.normal_lookups, 16);
+    assert_eq!(out.frame.pixel(2, 2), Vec3::ONE);
+    // A trilight ambient depends on the normal.
+    let (soup, kd) = scene(false, formats::AmbientMode::Trilight, 1.0);
+    o.aovs.normal = false;
+    let (out, plan) = render(&soup, &kd, &o);
+    assert!(plan.normal_maps.enabled);
+    assert_eq!(out.counts.normal_lookups, 16);
 }

@@ -53,9 +53,19 @@ fn seeds() -> Vec<(PathBuf, Vec<u8>)> {
     assert!(!soup.uvs.is_empty() && soup.textures.len() == 1);
     let framed = soup.to_bytes(Path::new("seed-4tri.soup")).unwrap();
     let payload = framed[52..].to_vec();
+    let bent = unity::convert(
+        &textures.join("Scenes/NormalMap.unity"),
+        &unity::Options::default(),
+    )
+    .unwrap();
+    assert!(bent.materials[0].normal_map.is_some());
     let fuzz = repo().join("fuzz/corpus");
     vec![
         (fuzz.join("soup/seed-4tri.soup"), framed),
+        (
+            fuzz.join("soup/seed-normal-map.soup"),
+            bent.to_bytes(Path::new("seed-normal-map.soup")).unwrap(),
+        ),
         (fuzz.join("soup/seed-4tri-payload.bin"), payload),
         (
             fuzz.join("unity_texture/seed-png.bin"),

@@ -473,3 +473,67 @@ fn corpus_model_textures_are_found_and_shared() {
     assert_eq!(target.alpha, formats::Alpha::Cutout { cutoff: 0.579 });
     assert!(target.albedo_map.is_some());
 }
+
+/// The `NormalMap` scene: the Quad's material keeps its map as a linear texture of the
+/// file's texels, with the scale the material gives; the soup carries UVs for it alone.
+#[test]
+fn normal_maps_are_linear_textures_with_their_scale() {
+    let soup = convert(&textures_scene("NormalMap"));
+    assert!(soup.warnings.is_empty(), "{:?}", soup.warnings);
+    let bent = soup.materials.iter().find(|m| m.name == "Bent").unwrap();
+    assert_eq!(bent.albedo_map, None);
+    let n = bent.normal_map.expect("the Bent material's normal map");
+    assert_eq!(n.scale, 1.0);
+    assert_eq!(n.map.tiling, formats::Tiling::default());
+    let t = &soup.textures[n.map.texture as usize];
+    assert_eq!(t.source, "Assets/Textures/Bent.png");
+    assert!(!t.srgb);
+    assert_eq!((t.width, t.height), (2, 2));
+    assert_eq!(t.texels, [204, 128, 255, 255].repeat(4));
+    assert_eq!(soup.uvs.len(), soup.positions.len());
+    assert_quad_uvs(&soup, 0..2);
+}
+
+/// A normal map that is missing, unreadable, or made by Unity from a height map is one
+/// warning naming the material and what it loses; the material draws without it.
+#[test]
+fn normal_maps_that_cannot_be_used_warn_and_are_dropped() {
+    let src = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/textures");
+    type Damage = fn(&std::path::Path);
+    let cases: [(&str, Damage, &str); 3] = [
+        (
+            "missing",
+            |d| std::fs::remove_file(d.join("Assets/Textures/Bent.png.meta")).unwrap(),
+            "Assets/Materials/Bent.mat: _BumpMap: texture GUID ",
+        ),
+        (
+            "truncated",
+            |d| std::fs::write(d.join("Assets/Textures/Bent.png"), b"\x89PNG\r\n").unwrap(),
+            "Assets/Materials/Bent.mat: Assets/Textures/Bent.png: ",
+        ),
+        (
+            "from grayscale",
+            |d| {
+                let meta = d.join("Assets/Textures/Bent.png.meta");
+                let text = std::fs::read_to_string(&meta).unwrap();
+                let text = text.replace("convertToNormalMap: 0", "convertToNormalMap: 1");
+                std::fs::write(&meta, text).unwrap();
+            },
+            "Assets/Materials/Bent.mat: _BumpMap: Assets/Textures/Bent.png is a height map",
+        ),
+    ];
+    for (what, damage, start) in cases {
+        let dir = tempfile::tempdir().unwrap();
+        copy_dir(&src, dir.path());
+        damage(dir.path());
+        let soup = convert(&dir.path().join("Assets/Scenes/NormalMap.unity"));
+        assert_eq!(soup.warnings.len(), 1, "{what}: {:?}", soup.warnings);
+        let w = &soup.warnings[0];
+        assert!(
+            w.starts_with(start) && w.ends_with("drawn without its normal map"),
+            "{what}: {w}"
+        );
+        assert_eq!(soup.materials[0].normal_map, None, "{what}");
+        assert!(soup.textures.is_empty() && soup.uvs.is_empty(), "{what}");
+    }
+}
