@@ -160,8 +160,18 @@ fn list(report: &unity::Report) {
             }
             None => "no texture".to_string(),
         };
+        let normal = match &m.normal_map {
+            Some(n) => {
+                let t = &soup.textures[n.map.texture as usize];
+                format!(
+                    ", normal map {} {}x{} scale {}",
+                    t.source, t.width, t.height, n.scale
+                )
+            }
+            None => String::new(),
+        };
         eprintln!(
-            "material {:?} ({}): {texture}, opacity {}, alpha {:?}",
+            "material {:?} ({}): {texture}{normal}, opacity {}, alpha {:?}",
             m.name, m.source, m.opacity, m.alpha
         );
     }
