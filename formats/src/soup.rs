@@ -139,6 +139,9 @@ pub struct Material {
     /// The tangent-space normal map (`_BumpMap`, HDRP `_NormalMap`) where the shader's
     /// `_NORMALMAP` keyword turns it on.
     pub normal_map: Option<NormalMap>,
+    /// The emission map (`_EmissionMap`), multiplied with `emission`, tiled as the albedo
+    /// map.
+    pub emission_map: Option<TextureRef>,
 }
 
 /// A material's normal map: a linear texture whose red and green channels hold the
@@ -172,9 +175,9 @@ impl Material {
         self.alpha != Alpha::Opaque
     }
 
-    /// Whether the material looks anything up by UV (an albedo or a normal map).
+    /// Whether the material looks anything up by UV (an albedo, normal or emission map).
     pub fn reads_uvs(&self) -> bool {
-        self.albedo_map.is_some() || self.normal_map.is_some()
+        self.albedo_map.is_some() || self.normal_map.is_some() || self.emission_map.is_some()
     }
 }
 
@@ -194,6 +197,7 @@ impl Material {
             opacity: 1.0,
             alpha: Alpha::Opaque,
             normal_map: None,
+            emission_map: None,
         }
     }
 
@@ -540,11 +544,12 @@ impl Soup {
                     return Err(format!("material {i} has normal map scale {}", n.scale));
                 }
             }
-            for r in m
-                .albedo_map
-                .iter()
-                .chain(m.normal_map.as_ref().map(|n| &n.map))
-            {
+            let maps = [
+                m.albedo_map.as_ref(),
+                m.normal_map.as_ref().map(|n| &n.map),
+                m.emission_map.as_ref(),
+            ];
+            for r in maps.into_iter().flatten() {
                 if r.texture as usize >= self.textures.len() {
                     return Err(format!(
                         "material {i} names texture {} of {}",

@@ -32,6 +32,14 @@ fn sample_soup() -> Soup {
             },
             scale: 0.5,
         }),
+        emission: Vec3::new(0.5, 2.0, 0.0),
+        emission_map: Some(TextureRef {
+            texture: 0,
+            tiling: Tiling {
+                scale: [1.0, 3.0],
+                offset: [0.0, 0.25],
+            },
+        }),
         albedo_map: Some(TextureRef {
             texture: 0,
             tiling: Tiling {
@@ -818,6 +826,10 @@ fn bad_texture_references_are_corrupt() {
     );
     refused(&|s| normal(s).scale = f32::INFINITY, "normal map scale inf");
     refused(
+        &|s| s.materials[0].emission_map.as_mut().unwrap().texture = 2,
+        "material 0 names texture 2 of 1",
+    );
+    refused(
         &|s| {
             s.materials[0].albedo_map = None;
             s.uvs.clear();
@@ -834,6 +846,7 @@ fn bad_texture_references_are_corrupt() {
     let mut s = sample_soup();
     s.materials[0].albedo_map = None;
     s.materials[0].normal_map = None;
+    s.materials[0].emission_map = None;
     s.uvs.clear();
     let p = Path::new("tex.soup");
     assert_eq!(Soup::from_bytes(&s.to_bytes(p).unwrap(), p).unwrap(), s);

@@ -177,3 +177,17 @@ fn the_normal_map_bends_the_normal_towards_increasing_u_as_in_unity() {
     assert_eq!(f.json["rays"]["normal_lookups"], (SIDE * SIDE) as u64);
     assert_eq!(f.json["rays"]["texture_lookups"], 0);
 }
+
+#[test]
+fn the_emission_map_glows_upright_without_light() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = render(dir.path(), "EmissionMap");
+    // No light and no ambient: the white glow times the quadrant texture, in the corners
+    // the image file puts them.
+    assert_close(f.rgb(8, 8), Vec3::X, "top left");
+    assert_close(f.rgb(56, 8), Vec3::Y, "top right");
+    assert_close(f.rgb(8, 56), Vec3::Z, "bottom left");
+    assert_close(f.rgb(56, 56), Vec3::ONE, "bottom right");
+    assert_eq!(f.json["rays"]["emission_lookups"], (SIDE * SIDE) as u64);
+    assert_eq!(f.json["rays"]["shadow"], 0);
+}

@@ -58,6 +58,7 @@ mod tests {
             alpha,
             opacity,
             normal_map: None,
+            emission_map: None,
             albedo_map: map.then_some(TextureRef {
                 texture: 0,
                 tiling: Tiling::default(),

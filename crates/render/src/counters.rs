@@ -32,6 +32,8 @@ pub struct RayCounts {
     pub texture_lookups: u64,
     /// Normal-map lookups at shaded points.
     pub normal_lookups: u64,
+    /// Emission-map lookups at shaded points of glowing materials.
+    pub emission_lookups: u64,
     /// Alpha lookups: cut-out tests inside the traversals and blended surfaces' alpha where
     /// no albedo lookup gave it.
     pub alpha_lookups: u64,
@@ -54,6 +56,7 @@ impl RayCounts {
         self.soft_decided += o.soft_decided;
         self.texture_lookups += o.texture_lookups;
         self.normal_lookups += o.normal_lookups;
+        self.emission_lookups += o.emission_lookups;
         self.alpha_lookups += o.alpha_lookups;
         self.sanitized += o.sanitized;
     }
@@ -77,6 +80,7 @@ pub struct SharedCounts {
     soft_decided: AtomicU64,
     texture_lookups: AtomicU64,
     normal_lookups: AtomicU64,
+    emission_lookups: AtomicU64,
     alpha_lookups: AtomicU64,
     sanitized: AtomicU64,
 }
@@ -97,6 +101,7 @@ impl SharedCounts {
         self.soft_decided.fetch_add(c.soft_decided, Relaxed);
         self.texture_lookups.fetch_add(c.texture_lookups, Relaxed);
         self.normal_lookups.fetch_add(c.normal_lookups, Relaxed);
+        self.emission_lookups.fetch_add(c.emission_lookups, Relaxed);
         self.alpha_lookups.fetch_add(c.alpha_lookups, Relaxed);
         self.sanitized.fetch_add(c.sanitized, Relaxed);
     }
@@ -114,6 +119,7 @@ impl SharedCounts {
             soft_decided: self.soft_decided.load(Relaxed),
             texture_lookups: self.texture_lookups.load(Relaxed),
             normal_lookups: self.normal_lookups.load(Relaxed),
+            emission_lookups: self.emission_lookups.load(Relaxed),
             alpha_lookups: self.alpha_lookups.load(Relaxed),
             sanitized: self.sanitized.load(Relaxed),
         }

@@ -127,6 +127,8 @@ struct Surfacing {
     colour: bool,
     /// The normal map's sampler, tiling and scale, where the plan reads it.
     normal: Option<(usize, Tiling, f32)>,
+    /// The emission map's sampler and tiling, where the plan reads it.
+    emission: Option<(usize, Tiling)>,
     alpha: AlphaUse,
     opacity: f32,
 }
@@ -289,7 +291,12 @@ impl<'a> Integrator<'a> {
         let textures = plan.textures.enabled;
         let alpha = plan.alpha.enabled;
         let normals = plan.normal_maps.enabled;
-        let (samplers, surfacing) = if textures || alpha || normals {
+        let glow_maps = plan.emission.enabled
+            && soup
+                .materials
+                .iter()
+                .any(|m| m.emission_map.is_some() && m.emission.max_element() > 0.0);
+        let (samplers, surfacing) = if textures || alpha || normals || glow_maps {
             let surfacing = soup
                 .materials
                 .iter()
@@ -303,6 +310,10 @@ impl<'a> Integrator<'a> {
                         .normal_map
                         .filter(|n| normals && plan.textures.read[n.map.texture as usize])
                         .map(|n| (n.map.texture as usize, n.map.tiling, n.scale)),
+                    emission: m
+                        .emission_map
+                        .filter(|r| glow_maps && plan.textures.read[r.texture as usize])
+                        .map(|r| (r.texture as usize, r.tiling)),
                     alpha: if alpha {
                         alpha_use(m, &plan.alpha.min_alpha)
                     } else {
@@ -807,7 +818,14 @@ impl<'a> Integrator<'a> {
 
         let mut l = Vec3::ZERO;
         if self.emission {
-            l += mat.emission;
+            match self.surfacing.get(mat_index).and_then(|s| s.emission) {
+                Some(map) if mat.emission.max_element() > 0.0 => {
+                    counts.emission_lookups += 1;
+                    let texel = self.texel(&map, prim, hit, ray.dir, cone.at(hit.t));
+                    l += mat.emission * texel.truncate();
+                }
+                _ => l += mat.emission,
+            }
         }
         // A black albedo cannot show any light: no light is asked, no shadow ray traced.
         let lit = albedo.max_element() > 0.0;
@@ -1430,6 +1448,7 @@ mod tests {
             emission: Vec3::ZERO,
             cull,
             normal_map: None,
+            emission_map: None,
             albedo_map: None,
             opacity,
             alpha,

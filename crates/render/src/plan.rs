@@ -86,7 +86,8 @@ pub struct TexturePlan {
     pub enabled: bool,
     /// Used materials whose albedo is looked up in a map.
     pub textured_materials: usize,
-    /// Distinct textures those materials, the alpha lookups and the normal maps read.
+    /// Distinct textures those materials, the alpha lookups, and the normal and emission
+    /// maps read.
     pub textures: usize,
     /// Bytes of those textures' mip levels below the full-size images, which the soup
     /// holds (linear RGBA f32).
@@ -248,10 +249,14 @@ impl Plan {
             .iter()
             .filter(|m| m.emission.max_element() > 0.0)
             .count();
+        let emission_mapped = mats
+            .iter()
+            .filter(|m| m.emission.max_element() > 0.0 && m.emission_map.is_some())
+            .count();
         let emission = Effect {
             enabled: emissive > 0,
             reason: if emissive > 0 {
-                format!("{emissive} emissive materials")
+                format!("{emissive} emissive materials ({emission_mapped} with emission maps)")
             } else {
                 "no material emits".into()
             },
@@ -310,7 +315,18 @@ impl Plan {
         };
 
         let (culling, shadow_casting) = draw_rules(soup, &used, &lights);
-        let (textures, alpha) = texturing(soup, &mats, &normal_mapped, opts.texture_filter);
+        // Maps read besides the albedo maps: normal maps that show, and the emission maps of
+        // glowing materials.
+        let other_maps: Vec<u32> = normal_mapped
+            .iter()
+            .filter_map(|m| m.normal_map.map(|n| n.map.texture))
+            .chain(
+                mats.iter()
+                    .filter(|m| m.emission.max_element() > 0.0)
+                    .filter_map(|m| m.emission_map.map(|r| r.texture)),
+            )
+            .collect();
+        let (textures, alpha) = texturing(soup, &mats, &other_maps, opts.texture_filter);
 
         Plan {
             direct,
@@ -409,12 +425,12 @@ pub fn colour_mapped(m: &Material) -> bool {
     m.albedo_map.is_some() && m.albedo().max_element() > 0.0
 }
 
-/// The texture and alpha effects the used materials `mats` call for; the normal maps of
-/// `normal_mapped` are read too.
+/// The texture and alpha effects the used materials `mats` call for; the textures
+/// `other_maps` (normal and emission maps) are read too.
 fn texturing(
     soup: &Soup,
     mats: &[&Material],
-    normal_mapped: &[&Material],
+    other_maps: &[u32],
     filter: TextureFilter,
 ) -> (TexturePlan, AlphaPlan) {
     let min_alpha = min_alphas(&soup.textures);
@@ -438,8 +454,8 @@ fn texturing(
             }
         }
     }
-    for n in normal_mapped.iter().filter_map(|m| m.normal_map) {
-        if let Some(x) = read.get_mut(n.map.texture as usize) {
+    for &t in other_maps {
+        if let Some(x) = read.get_mut(t as usize) {
             *x = true;
         }
     }

@@ -1,11 +1,12 @@
-//! A material's albedo and normal maps in the soup: the textures a `.mat` names, or the
-//! file a model's own material names, found the way Unity's model importer finds it. Each
-//! image is decoded once per import settings and shared by every material that uses it; a
-//! texture that cannot be read leaves the material its tint alone (or without its normal
-//! map), with one warning naming the material and the file.
+//! A material's albedo, normal and emission maps in the soup: the textures a `.mat` names,
+//! or the file a model's own material names, found the way Unity's model importer finds
+//! it. Each image is decoded once per import settings and shared by every material that
+//! uses it; a texture that cannot be read leaves the material its tint alone (or without
+//! its normal map, or glowing with its emission colour alone), with one warning naming the
+//! material and the file.
 
 use crate::emit::Emitter;
-use crate::texture::{albedo_slot, load, normal_slot, Import};
+use crate::texture::{albedo_slot, emission_slot, load, normal_slot, Import};
 use crate::yaml::Node;
 use formats::texture::{TextureRef, Tiling};
 use formats::{Material, NormalMap};
@@ -13,6 +14,7 @@ use formats::{Material, NormalMap};
 /// What a material loses with its albedo map, and with its normal map, as warnings say.
 pub(crate) const TINT_ALONE: &str = "drawn with its tint alone";
 const NO_NORMAL_MAP: &str = "drawn without its normal map";
+const EMISSION_COLOUR_ALONE: &str = "glows with its emission colour alone";
 use rayon::prelude::*;
 use std::path::{Component, Path, PathBuf};
 
@@ -37,6 +39,29 @@ impl Emitter<'_, '_> {
             return None;
         };
         self.texture_ref(&path, Import::read(&path), slot.tiling, what, TINT_ALONE)
+    }
+
+    /// The emission map of Material `body` where it can show: the material glows
+    /// (`emission`, the converted emission colour, is not black).
+    pub(crate) fn mat_emission(
+        &mut self,
+        body: &Node,
+        emission: glam::Vec3,
+        what: &str,
+    ) -> Option<TextureRef> {
+        if emission.max_element() <= 0.0 {
+            return None;
+        }
+        let slot = emission_slot(body)?;
+        let Some(path) = self.g.project.resolve(&slot.guid).cloned() else {
+            self.soup.warnings.push(format!(
+                "{what}: {}: texture GUID {} is not in the project; {EMISSION_COLOUR_ALONE}",
+                slot.property, slot.guid
+            ));
+            return None;
+        };
+        let import = Import::read(&path);
+        self.texture_ref(&path, import, slot.tiling, what, EMISSION_COLOUR_ALONE)
     }
 
     /// The normal map of Material `body` where its shader samples one; `what` names the
@@ -132,6 +157,7 @@ impl Emitter<'_, '_> {
             m.normal_map = m
                 .normal_map
                 .and_then(|n| decoded(n.map).map(|map| NormalMap { map, ..n }));
+            m.emission_map = m.emission_map.and_then(decoded);
         }
         if !self.soup.materials.iter().any(Material::reads_uvs) {
             self.soup.uvs = Vec::new();

@@ -286,6 +286,7 @@ impl Emitter<'_, '_> {
                 let (mut m, _notes) = convert(&body, &src);
                 m.albedo_map = self.mat_albedo(&body, &src);
                 m.normal_map = self.mat_normal(&body, &src);
+                m.emission_map = self.mat_emission(&body, m.emission, &src);
                 (self.add_material(key, || m), format!("override {src}"))
             }
             _ => {
@@ -312,6 +313,7 @@ impl Emitter<'_, '_> {
                 }
                 m.albedo_map = self.mat_albedo(&b, &rel);
                 m.normal_map = self.mat_normal(&b, &rel);
+                m.emission_map = self.mat_emission(&b, m.emission, &rel);
                 self.add_material(key, || m)
             }
             Ok(None) => self.warn_default(what, format!("{rel} holds no Material")),

@@ -105,6 +105,19 @@ pub fn normal_slot(body: &Node) -> Option<(TextureSlot, f32)> {
     Some((found, scale))
 }
 
+/// The emission map of a Material body (`_EmissionMap` of the Standard and URP Lit
+/// shaders), tiled as the albedo map, as those shaders sample it with the main texture's
+/// UVs. Whether it shows is the emission colour's and keyword's business
+/// ([`crate::material::convert`]).
+pub fn emission_slot(body: &Node) -> Option<TextureSlot> {
+    let saved = body.get("m_SavedProperties")?;
+    let envs = props(saved, "m_TexEnvs");
+    let env = envs.iter().find(|(k, _)| *k == "_EmissionMap")?.1;
+    let mut found = texture_of("_EmissionMap", env)?;
+    found.tiling = main_env(body, &envs).map_or_else(Tiling::default, tiling_of);
+    Some(found)
+}
+
 /// The albedo property's entry of `envs`: the shader's own, else the first present.
 fn main_env<'a>(body: &Node, envs: &[(&'a str, &'a Node)]) -> Option<&'a Node> {
     let slot = |name: &str| envs.iter().find(|(k, _)| *k == name).map(|(_, v)| *v);
@@ -734,6 +747,31 @@ m_SavedProperties:
       m_Texture: {fileID: 0}
 ");
         assert_eq!(normal_slot(&empty), None);
+    }
+
+    #[test]
+    fn emission_slot_takes_the_main_tiling() {
+        let m = mat("m_SavedProperties:
+  m_TexEnvs:
+  - _EmissionMap:
+      m_Texture: {fileID: 2800000, guid: eeee, type: 3}
+      m_Scale: {x: 1, y: 1}
+      m_Offset: {x: 0, y: 0}
+  - _MainTex:
+      m_Texture: {fileID: 2800000, guid: aaaa, type: 3}
+      m_Scale: {x: 2, y: 2}
+      m_Offset: {x: 0, y: 0.5}
+");
+        let s = emission_slot(&m).unwrap();
+        assert_eq!(
+            (s.property.as_str(), s.guid.as_str()),
+            ("_EmissionMap", "eeee")
+        );
+        assert_eq!((s.tiling.scale, s.tiling.offset), ([2.0, 2.0], [0.0, 0.5]));
+        let none = mat(
+            "m_SavedProperties:\n  m_TexEnvs:\n  - _EmissionMap:\n      m_Texture: {fileID: 0}\n",
+        );
+        assert_eq!(emission_slot(&none), None);
     }
 
     #[test]

@@ -30,6 +30,8 @@ pub struct Surface {
     /// `_BumpMap`, a normal map's GUID (turns on the `_NORMALMAP` keyword), with
     /// `_BumpScale`.
     pub bump_map: Option<(String, f32)>,
+    /// `_EmissionMap`: a texture's GUID, multiplied with the emission colour.
+    pub emission_map: Option<String>,
 }
 
 impl Default for Surface {
@@ -40,6 +42,7 @@ impl Default for Surface {
             mode: Mode::Opaque,
             cutoff: 0.5,
             bump_map: None,
+            emission_map: None,
         }
     }
 }
@@ -198,6 +201,14 @@ pub fn write_surface(m: &MatDesc, surface: &Surface) -> String {
                 format!("{{fileID: 2800000, guid: {}, type: 3}}", slot.guid),
                 slot.scale,
                 slot.offset,
+            ),
+            _ if t == "_EmissionMap" && surface.emission_map.is_some() => (
+                format!(
+                    "{{fileID: 2800000, guid: {}, type: 3}}",
+                    surface.emission_map.as_deref().unwrap_or("")
+                ),
+                [1.0, 1.0],
+                [0.0, 0.0],
             ),
             _ if t == "_BumpMap" && surface.bump_map.is_some() => (
                 format!(

@@ -1,5 +1,5 @@
-//! The `textures` project: one scene per way a material uses its albedo texture, alpha
-//! and normal map, each a Quad seen square-on so every pixel's expected value follows from a texel.
+//! The `textures` project: one scene per way a material uses its albedo texture, alpha,
+//! normal map and emission map, each a Quad seen square-on so every pixel's expected value follows from a texel.
 //!
 //! All scenes are lit by one white directional light of intensity 1 shining straight at
 //! the Quads' fronts (Unity +Z) and have no ambient light, so a lit Quad's pixel is its
@@ -154,6 +154,16 @@ pub fn project() -> Project {
         },
     );
     b.look(
+        &MatDesc {
+            emission: Some([1.0, 1.0, 1.0]),
+            ..white("Glow")
+        },
+        &Surface {
+            emission_map: Some(quadrants.clone()),
+            ..Surface::default()
+        },
+    );
+    b.look(
         &white("Bent"),
         &Surface {
             bump_map: Some((bent, 1.0)),
@@ -207,6 +217,11 @@ pub fn project() -> Project {
             sun(),
         )
         .scene("NormalMap", NO_AMBIENT);
+    // (g) The quadrant texture as the emission map of a white glow, no light and no
+    // ambient: the Quad shows the texture's colours by emission alone, upright.
+    b.camera(Xform::at(0.0, 0.0, -2.0), ortho())
+        .mesh("Glow", unity::QUAD, "Glow", Xform::at(0.0, 0.0, 0.0))
+        .scene("EmissionMap", NO_AMBIENT);
     b.done()
 }
 
@@ -255,7 +270,13 @@ mod tests {
         let meta = text(&p, "Assets/Textures/Quadrants.png.meta");
         assert!(meta.contains("    enableMipMap: 0\n") && meta.contains("    filterMode: 0\n"));
         let scenes = p.files.keys().filter(|k| k.ends_with(".unity")).count();
-        assert_eq!(scenes, 6);
+        assert_eq!(scenes, 7);
+        let glow = text(&p, "Assets/Materials/Glow.mat");
+        let quadrants = p.guid("Assets/Textures/Quadrants.png");
+        assert!(glow.contains("  m_ValidKeywords:\n  - _EMISSION\n"));
+        assert!(glow.contains(&format!(
+            "    - _EmissionMap:\n        m_Texture: {{fileID: 2800000, guid: {quadrants}, type: 3}}\n"
+        )));
         let bent = text(&p, "Assets/Materials/Bent.mat");
         assert!(bent.contains("  m_ValidKeywords:\n  - _NORMALMAP\n"));
         let guid = p.guid("Assets/Textures/Bent.png");

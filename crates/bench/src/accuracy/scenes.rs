@@ -67,6 +67,7 @@ fn material(name: &str, color: Vec3, metallic: f32, smoothness: f32) -> Material
         // Two-sided: the analytic references draw both faces.
         cull: Cull::None,
         normal_map: None,
+        emission_map: None,
         albedo_map: None,
         opacity: 1.0,
         alpha: Alpha::Opaque,
@@ -238,6 +239,7 @@ pub fn checkerboard() -> Scene {
     soup.textures = vec![checker_texture(128, 2)];
     soup.materials = vec![Material {
         normal_map: None,
+        emission_map: None,
         albedo_map: Some(TextureRef {
             texture: 0,
             tiling: Tiling::default(),

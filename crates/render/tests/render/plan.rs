@@ -348,6 +348,7 @@ fn shadow_and_mirror_rays_traced_in_blocks_equal_rays_traced_alone() {
             let cut_out = s.material(formats::Material {
                 alpha: formats::Alpha::Cutout { cutoff: 0.5 },
                 normal_map: None,
+                emission_map: None,
                 albedo_map: map,
                 ..diffuse(Vec3::splat(0.6))
             });

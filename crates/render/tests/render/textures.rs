@@ -25,6 +25,7 @@ fn four_colours(wrap: Wrap) -> formats::Texture {
 fn mapped(t: u32, tiling: Tiling) -> Material {
     Material {
         normal_map: None,
+        emission_map: None,
         albedo_map: Some(TextureRef { texture: t, tiling }),
         ..diffuse(Vec3::ONE)
     }
@@ -214,6 +215,7 @@ fn quad_over_lit_floor(quad: Material, tex: Option<formats::Texture>) -> SceneBu
             let t = s.texture(t);
             Material {
                 normal_map: None,
+                emission_map: None,
                 albedo_map: Some(TextureRef {
                     texture: t,
                     tiling: Tiling::default(),
@@ -512,4 +514,39 @@ fn normal_maps_bend_the_light_and_are_read_only_where_they_show() {
     let (out, plan) = render(&soup, &kd, &o);
     assert!(plan.normal_maps.enabled);
     assert_eq!(out.counts.normal_lookups, 16);
+}
+
+/// An emission map multiplies the emission colour texel by texel; a material that does not
+/// glow never reads it.
+#[test]
+fn emission_maps_multiply_the_glow_and_are_read_only_when_it_shows() {
+    let scene = |emission: Vec3| {
+        let mut s = SceneBuilder::new();
+        let t = s.texture(four_colours(Wrap::Clamp));
+        let m = s.material(Material {
+            emission,
+            emission_map: Some(TextureRef {
+                texture: t,
+                tiling: Tiling::default(),
+            }),
+            ..diffuse(Vec3::ONE)
+        });
+        unity_quad(&mut s, 1.0, m, [Vec2::ZERO, Vec2::ONE]);
+        s.camera(front_camera(0.5));
+        s.build()
+    };
+    let (soup, kd) = scene(Vec3::new(2.0, 1.0, 0.5));
+    let (out, plan) = render(&soup, &kd, &opts(4, 4));
+    assert!(plan.emission.enabled);
+    assert_eq!(plan.textures.textures, 1);
+    assert_eq!(out.counts.emission_lookups, 16);
+    let glow = Vec3::new(2.0, 1.0, 0.5);
+    assert_eq!(out.frame.pixel(0, 3), glow * rgb(RED), "bottom-left");
+    assert_eq!(out.frame.pixel(3, 0), glow * rgb(WHITE), "top-right");
+    let (soup, kd) = scene(Vec3::ZERO);
+    let (out, plan) = render(&soup, &kd, &opts(4, 4));
+    assert!(!plan.emission.enabled);
+    assert_eq!(plan.textures.textures, 0);
+    assert_eq!(out.counts.emission_lookups, 0);
+    assert_eq!(out.frame.pixel(0, 3), Vec3::ZERO);
 }

@@ -170,8 +170,15 @@ fn list(report: &unity::Report) {
             }
             None => String::new(),
         };
+        let glow = match &m.emission_map {
+            Some(r) => {
+                let t = &soup.textures[r.texture as usize];
+                format!(", emission map {} {}x{}", t.source, t.width, t.height)
+            }
+            None => String::new(),
+        };
         eprintln!(
-            "material {:?} ({}): {texture}{normal}, opacity {}, alpha {:?}",
+            "material {:?} ({}): {texture}{normal}{glow}, opacity {}, alpha {:?}",
             m.name, m.source, m.opacity, m.alpha
         );
     }

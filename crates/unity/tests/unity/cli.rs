@@ -133,20 +133,28 @@ fn unity2soup_list_says_where_each_material_came_from() {
 
 #[test]
 fn unity2soup_list_names_each_materials_maps() {
-    let scene = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../scenes/textures/Assets/Scenes/NormalMap.unity");
-    let d = tempfile::tempdir().unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_unity2soup"))
-        .arg(&scene)
-        .arg("-o")
-        .arg(d.path().join("s.soup"))
-        .arg("--list")
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let stderr = String::from_utf8_lossy(&o.stderr);
+    let list = |name: &str| {
+        let scene = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join(format!("../../scenes/textures/Assets/Scenes/{name}.unity"));
+        let d = tempfile::tempdir().unwrap();
+        let o = Command::new(env!("CARGO_BIN_EXE_unity2soup"))
+            .arg(&scene)
+            .arg("-o")
+            .arg(d.path().join("s.soup"))
+            .arg("--list")
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stderr).into_owned()
+    };
+    let bent = list("NormalMap");
     assert!(
-        stderr.contains("material \"Bent\" (Assets/Materials/Bent.mat): no texture, normal map Assets/Textures/Bent.png 2x2 scale 1, opacity 1, alpha Opaque"),
-        "{stderr}"
+        bent.contains("material \"Bent\" (Assets/Materials/Bent.mat): no texture, normal map Assets/Textures/Bent.png 2x2 scale 1, opacity 1, alpha Opaque"),
+        "{bent}"
+    );
+    let glow = list("EmissionMap");
+    assert!(
+        glow.contains("material \"Glow\" (Assets/Materials/Glow.mat): no texture, emission map Assets/Textures/Quadrants.png 2x2, opacity 1, alpha Opaque"),
+        "{glow}"
     );
 }

@@ -537,3 +537,51 @@ fn normal_maps_that_cannot_be_used_warn_and_are_dropped() {
         assert!(soup.textures.is_empty() && soup.uvs.is_empty(), "{what}");
     }
 }
+
+/// The `EmissionMap` scene: the glowing material keeps the quadrant texture as its
+/// emission map; a map that cannot be found is one warning, and a material that does not
+/// glow reads no emission map at all.
+#[test]
+fn emission_maps_belong_to_glowing_materials() {
+    let soup = convert(&textures_scene("EmissionMap"));
+    assert!(soup.warnings.is_empty(), "{:?}", soup.warnings);
+    let glow = &soup.materials[0];
+    assert_eq!(
+        (glow.name.as_str(), glow.emission),
+        ("Glow", glam::Vec3::ONE)
+    );
+    let r = glow.emission_map.expect("the Glow material's emission map");
+    let t = &soup.textures[r.texture as usize];
+    assert_eq!(t.source, "Assets/Textures/Quadrants.png");
+    assert!(t.srgb);
+    assert_eq!(t.texels, QUADRANT_TEXELS);
+
+    let src = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/textures");
+    let dir = tempfile::tempdir().unwrap();
+    copy_dir(&src, dir.path());
+    let mat = dir.path().join("Assets/Materials/Glow.mat");
+    let text = std::fs::read_to_string(&mat).unwrap();
+    let guid = text
+        .split("_EmissionMap:\n        m_Texture: {fileID: 2800000, guid: ")
+        .nth(1)
+        .and_then(|t| t.get(..32))
+        .unwrap()
+        .to_string();
+    let missing = text.replace(&guid, "0123456789abcdef0123456789abcdef");
+    std::fs::write(&mat, &missing).unwrap();
+    let scene = dir.path().join("Assets/Scenes/EmissionMap.unity");
+    let soup = convert(&scene);
+    assert_eq!(soup.warnings.len(), 1, "{:?}", soup.warnings);
+    assert_eq!(
+        soup.warnings[0],
+        "Assets/Materials/Glow.mat: _EmissionMap: texture GUID 0123456789abcdef0123456789abcdef \
+         is not in the project; glows with its emission colour alone"
+    );
+    assert_eq!(soup.materials[0].emission_map, None);
+    // Without the _EMISSION keyword the material does not glow and its map is not loaded.
+    std::fs::write(&mat, text.replace("  - _EMISSION\n", "")).unwrap();
+    let soup = convert(&scene);
+    assert_eq!(soup.materials[0].emission, glam::Vec3::ZERO);
+    assert_eq!(soup.materials[0].emission_map, None);
+    assert!(soup.textures.is_empty() && soup.uvs.is_empty());
+}
