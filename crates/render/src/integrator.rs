@@ -127,7 +127,7 @@ struct Surfacing {
     colour: bool,
     /// The normal map's sampler, tiling and scale, where the plan reads it.
     normal: Option<(usize, Tiling, f32)>,
-    /// The emission map's sampler and tiling, where the plan reads it.
+    /// The emission map's sampler and tiling, where the plan reads it for a glowing material.
     emission: Option<(usize, Tiling)>,
     alpha: AlphaUse,
     opacity: f32,
@@ -290,13 +290,8 @@ impl<'a> Integrator<'a> {
             .collect();
         let textures = plan.textures.enabled;
         let alpha = plan.alpha.enabled;
-        let normals = plan.normal_maps.enabled;
-        let glow_maps = plan.emission.enabled
-            && soup
-                .materials
-                .iter()
-                .any(|m| m.emission_map.is_some() && m.emission.max_element() > 0.0);
-        let (samplers, surfacing) = if textures || alpha || normals || glow_maps {
+        let read = &plan.textures.read;
+        let (samplers, surfacing) = if alpha || read.contains(&true) {
             let surfacing = soup
                 .materials
                 .iter()
@@ -308,11 +303,15 @@ impl<'a> Integrator<'a> {
                     colour: textures && colour_mapped(m),
                     normal: m
                         .normal_map
-                        .filter(|n| normals && plan.textures.read[n.map.texture as usize])
+                        .filter(|n| plan.normal_maps.enabled && read[n.map.texture as usize])
                         .map(|n| (n.map.texture as usize, n.map.tiling, n.scale)),
                     emission: m
                         .emission_map
-                        .filter(|r| glow_maps && plan.textures.read[r.texture as usize])
+                        .filter(|r| {
+                            plan.emission.enabled
+                                && m.emission.max_element() > 0.0
+                                && read[r.texture as usize]
+                        })
                         .map(|r| (r.texture as usize, r.tiling)),
                     alpha: if alpha {
                         alpha_use(m, &plan.alpha.min_alpha)
@@ -379,6 +378,12 @@ impl<'a> Integrator<'a> {
     /// The map's RGBA at a hit of `prim` along `dir`, where the ray's cone is `width` wide
     /// (0: the full-size image, for shadow rays, which have no pixel footprint).
     fn texel(&self, map: &(usize, Tiling), prim: usize, hit: &Hit, dir: Vec3, width: f32) -> Vec4 {
+        self.sample(map, self.footprint(prim, hit, dir, width))
+    }
+
+    /// The hit's UV and the footprint of a ray cone `width` wide there, in UV units: what
+    /// every map of the surface is read at.
+    fn footprint(&self, prim: usize, hit: &Hit, dir: Vec3, width: f32) -> (Vec2, f32) {
         let uv = self.uv_at(prim, hit.u, hit.v);
         let w = if self.filter == TextureFilter::Cone && width > 0.0 {
             cone_footprint(
@@ -390,6 +395,11 @@ impl<'a> Integrator<'a> {
         } else {
             0.0
         };
+        (uv, w)
+    }
+
+    /// The map's RGBA at a [`Integrator::footprint`].
+    fn sample(&self, map: &(usize, Tiling), (uv, w): (Vec2, f32)) -> Vec4 {
         self.samplers[map.0]
             .as_ref()
             .expect("the plan reads every texture a lookup can reach")
@@ -750,11 +760,18 @@ impl<'a> Integrator<'a> {
         let mat = &self.soup.materials[mat_index];
         let mut albedo = mat.albedo();
         let mut a = 1.0f32;
-        if let Some(s) = self.surfacing.get(mat_index) {
+        let surfacing = self.surfacing.get(mat_index);
+        // Every map of the surface is read at one UV and footprint, found at the first.
+        let mut at = None;
+        let mut lookup = |map: &(usize, Tiling)| {
+            let fp = *at.get_or_insert_with(|| self.footprint(prim, hit, ray.dir, cone.at(hit.t)));
+            self.sample(map, fp)
+        };
+        if let Some(s) = surfacing {
             let blend = s.alpha == AlphaUse::Blend;
             match &s.map {
                 Some(map) if s.colour || blend => {
-                    let texel = self.texel(map, prim, hit, ray.dir, cone.at(hit.t));
+                    let texel = lookup(map);
                     if s.colour {
                         counts.texture_lookups += 1;
                         albedo *= texel.truncate();
@@ -796,9 +813,9 @@ impl<'a> Integrator<'a> {
         // The side the ray sees is decided before the map bends the normal, which may
         // turn it past the ray at grazing angles.
         let back = ns.dot(ray.dir) > 0.0;
-        if let Some((i, tiling, scale)) = self.surfacing.get(mat_index).and_then(|s| s.normal) {
+        if let Some((i, tiling, scale)) = surfacing.and_then(|s| s.normal) {
             counts.normal_lookups += 1;
-            let texel = self.texel(&(i, tiling), prim, hit, ray.dir, cone.at(hit.t));
+            let texel = lookup(&(i, tiling));
             let uv = self.soup.corner_uvs(prim);
             ns = normal_map::bend(ns, *tri, uv, texel, scale);
         }
@@ -818,13 +835,12 @@ impl<'a> Integrator<'a> {
 
         let mut l = Vec3::ZERO;
         if self.emission {
-            match self.surfacing.get(mat_index).and_then(|s| s.emission) {
-                Some(map) if mat.emission.max_element() > 0.0 => {
+            match surfacing.and_then(|s| s.emission) {
+                Some(map) => {
                     counts.emission_lookups += 1;
-                    let texel = self.texel(&map, prim, hit, ray.dir, cone.at(hit.t));
-                    l += mat.emission * texel.truncate();
+                    l += mat.emission * lookup(&map).truncate();
                 }
-                _ => l += mat.emission,
+                None => l += mat.emission,
             }
         }
         // A black albedo cannot show any light: no light is asked, no shadow ray traced.

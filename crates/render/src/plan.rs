@@ -245,14 +245,13 @@ impl Plan {
             },
         };
 
-        let emissive = mats
+        let glowing: Vec<&Material> = mats
             .iter()
             .filter(|m| m.emission.max_element() > 0.0)
-            .count();
-        let emission_mapped = mats
-            .iter()
-            .filter(|m| m.emission.max_element() > 0.0 && m.emission_map.is_some())
-            .count();
+            .copied()
+            .collect();
+        let emissive = glowing.len();
+        let emission_mapped = glowing.iter().filter(|m| m.emission_map.is_some()).count();
         let emission = Effect {
             enabled: emissive > 0,
             reason: if emissive > 0 {
@@ -321,8 +320,8 @@ impl Plan {
             .iter()
             .filter_map(|m| m.normal_map.map(|n| n.map.texture))
             .chain(
-                mats.iter()
-                    .filter(|m| m.emission.max_element() > 0.0)
+                glowing
+                    .iter()
                     .filter_map(|m| m.emission_map.map(|r| r.texture)),
             )
             .collect();

@@ -6,7 +6,7 @@
 //! material and the file.
 
 use crate::emit::Emitter;
-use crate::texture::{albedo_slot, emission_slot, load, normal_slot, Import};
+use crate::texture::{albedo_slot, emission_slot, load, normal_slot, Import, TextureSlot};
 use crate::yaml::Node;
 use formats::texture::{TextureRef, Tiling};
 use formats::{Material, NormalMap};
@@ -31,14 +31,21 @@ impl Emitter<'_, '_> {
     /// The albedo map of Material `body`; `what` names the material in warnings.
     pub(crate) fn mat_albedo(&mut self, body: &Node, what: &str) -> Option<TextureRef> {
         let slot = albedo_slot(body)?;
-        let Some(path) = self.g.project.resolve(&slot.guid).cloned() else {
+        let path = self.slot_file(&slot, what, TINT_ALONE)?;
+        self.texture_ref(&path, Import::read(&path), slot.tiling, what, TINT_ALONE)
+    }
+
+    /// The file slot `slot` names, or None with one warning naming the material (`what`),
+    /// the slot, and what the material is drawn `without`.
+    fn slot_file(&mut self, slot: &TextureSlot, what: &str, without: &str) -> Option<PathBuf> {
+        let path = self.g.project.resolve(&slot.guid).cloned();
+        if path.is_none() {
             self.soup.warnings.push(format!(
-                "{what}: {}: texture GUID {} is not in the project; drawn with its tint alone",
+                "{what}: {}: texture GUID {} is not in the project; {without}",
                 slot.property, slot.guid
             ));
-            return None;
-        };
-        self.texture_ref(&path, Import::read(&path), slot.tiling, what, TINT_ALONE)
+        }
+        path
     }
 
     /// The emission map of Material `body` where it can show: the material glows
@@ -53,13 +60,7 @@ impl Emitter<'_, '_> {
             return None;
         }
         let slot = emission_slot(body)?;
-        let Some(path) = self.g.project.resolve(&slot.guid).cloned() else {
-            self.soup.warnings.push(format!(
-                "{what}: {}: texture GUID {} is not in the project; {EMISSION_COLOUR_ALONE}",
-                slot.property, slot.guid
-            ));
-            return None;
-        };
+        let path = self.slot_file(&slot, what, EMISSION_COLOUR_ALONE)?;
         let import = Import::read(&path);
         self.texture_ref(&path, import, slot.tiling, what, EMISSION_COLOUR_ALONE)
     }
@@ -69,13 +70,7 @@ impl Emitter<'_, '_> {
     /// box says.
     pub(crate) fn mat_normal(&mut self, body: &Node, what: &str) -> Option<NormalMap> {
         let (slot, scale) = normal_slot(body)?;
-        let Some(path) = self.g.project.resolve(&slot.guid).cloned() else {
-            self.soup.warnings.push(format!(
-                "{what}: {}: texture GUID {} is not in the project; {NO_NORMAL_MAP}",
-                slot.property, slot.guid
-            ));
-            return None;
-        };
+        let path = self.slot_file(&slot, what, NO_NORMAL_MAP)?;
         let import = Import {
             srgb: false,
             ..Import::read(&path)

@@ -1,4 +1,4 @@
-//! Albedo and normal maps: which textures a `.mat` draws with, how their `.meta`
+//! Albedo, normal and emission maps: which textures a `.mat` draws with, how their `.meta`
 //! TextureImporter says to import them, and decoding the image file into a [`formats::texture::Texture`] the
 //! way Unity's importer would hand it to the shader (power-of-two rounding, size limit,
 //! bottom row first).
@@ -55,19 +55,11 @@ pub struct TextureSlot {
 /// The albedo texture slot of a Material body, in either `m_TexEnvs` layout. `None` when
 /// the material's albedo property is empty (`{fileID: 0}`) or absent.
 pub fn albedo_slot(body: &Node) -> Option<TextureSlot> {
-    let saved = body.get("m_SavedProperties")?;
-    let envs = props(saved, "m_TexEnvs");
-    let slot = |name: &str| envs.iter().find(|(k, _)| *k == name).map(|(_, v)| *v);
-    let shader = body.get("m_Shader").and_then(|s| s.str_at("guid"));
-    let own = match shader {
-        Some(URP_LIT) => Some("_BaseMap"),
-        Some(HDRP_LIT) => Some("_BaseColorMap"),
-        Some(BUILTIN_SHADERS) => Some("_MainTex"),
-        _ => None,
-    };
+    let envs = tex_envs(body)?;
+    let slot = |name: &str| env_of(&envs, name);
     // A known shader reads only its own property: an empty one means untextured even
     // when a stale slot from an earlier shader still names a texture.
-    if let Some(name) = own {
+    if let Some(name) = own_albedo(body) {
         if let Some(env) = slot(name) {
             return texture_of(name, env);
         }
@@ -75,6 +67,25 @@ pub fn albedo_slot(body: &Node) -> Option<TextureSlot> {
     ALBEDO_PROPERTIES
         .iter()
         .find_map(|name| slot(name).and_then(|env| texture_of(name, env)))
+}
+
+/// The albedo property of the material's shader, where it is one whose property is known.
+fn own_albedo(body: &Node) -> Option<&'static str> {
+    match body.get("m_Shader").and_then(|s| s.str_at("guid")) {
+        Some(URP_LIT) => Some("_BaseMap"),
+        Some(HDRP_LIT) => Some("_BaseColorMap"),
+        Some(BUILTIN_SHADERS) => Some("_MainTex"),
+        _ => None,
+    }
+}
+
+/// The `m_TexEnvs` entries of a Material body, in either layout.
+fn tex_envs(body: &Node) -> Option<Vec<(&str, &Node)>> {
+    Some(props(body.get("m_SavedProperties")?, "m_TexEnvs"))
+}
+
+fn env_of<'a>(envs: &[(&str, &'a Node)], name: &str) -> Option<&'a Node> {
+    envs.iter().find(|(k, _)| *k == name).map(|(_, v)| *v)
 }
 
 /// The normal map of a Material body and its scale, where the shader samples one: Standard
@@ -86,20 +97,15 @@ pub fn normal_slot(body: &Node) -> Option<(TextureSlot, f32)> {
     if crate::material::keyword_on(body, "_NORMALMAP") == Some(false) {
         return None;
     }
-    let saved = body.get("m_SavedProperties")?;
-    let envs = props(saved, "m_TexEnvs");
-    let slot = |name: &str| envs.iter().find(|(k, _)| *k == name).map(|(_, v)| *v);
     let shader = body.get("m_Shader").and_then(|s| s.str_at("guid"));
     let (texture, scale) = match shader {
         Some(HDRP_LIT) => ("_NormalMap", "_NormalScale"),
         _ => ("_BumpMap", "_BumpScale"),
     };
-    let mut found = texture_of(texture, slot(texture)?)?;
-    found.tiling = main_env(body, &envs).map_or_else(Tiling::default, tiling_of);
-    let scale = props(saved, "m_Floats")
-        .iter()
-        .find(|(k, _)| *k == scale)
-        .and_then(|(_, v)| v.as_f32())
+    let found = map_slot(body, texture)?;
+    let floats = props(body.get("m_SavedProperties")?, "m_Floats");
+    let scale = env_of(&floats, scale)
+        .and_then(Node::as_f32)
         .filter(|x| x.is_finite())
         .unwrap_or(1.0);
     Some((found, scale))
@@ -110,23 +116,22 @@ pub fn normal_slot(body: &Node) -> Option<(TextureSlot, f32)> {
 /// UVs. Whether it shows is the emission colour's and keyword's business
 /// ([`crate::material::convert`]).
 pub fn emission_slot(body: &Node) -> Option<TextureSlot> {
-    let saved = body.get("m_SavedProperties")?;
-    let envs = props(saved, "m_TexEnvs");
-    let env = envs.iter().find(|(k, _)| *k == "_EmissionMap")?.1;
-    let mut found = texture_of("_EmissionMap", env)?;
-    found.tiling = main_env(body, &envs).map_or_else(Tiling::default, tiling_of);
-    Some(found)
+    map_slot(body, "_EmissionMap")
 }
 
-/// The albedo property's entry of `envs`: the shader's own, else the first present.
-fn main_env<'a>(body: &Node, envs: &[(&'a str, &'a Node)]) -> Option<&'a Node> {
-    let slot = |name: &str| envs.iter().find(|(k, _)| *k == name).map(|(_, v)| *v);
-    let own = match body.get("m_Shader").and_then(|s| s.str_at("guid")) {
-        Some(URP_LIT) => "_BaseMap",
-        Some(HDRP_LIT) => "_BaseColorMap",
-        _ => "_MainTex",
-    };
-    slot(own).or_else(|| ALBEDO_PROPERTIES.iter().find_map(|name| slot(name)))
+/// The texture in slot `property`, tiled by the albedo property's scale and offset (the
+/// shader's own albedo property, else the first present), as Unity's shaders tile every
+/// map by the main texture's.
+fn map_slot(body: &Node, property: &str) -> Option<TextureSlot> {
+    let envs = tex_envs(body)?;
+    let mut found = texture_of(property, env_of(&envs, property)?)?;
+    let main = env_of(&envs, own_albedo(body).unwrap_or("_MainTex")).or_else(|| {
+        ALBEDO_PROPERTIES
+            .iter()
+            .find_map(|name| env_of(&envs, name))
+    });
+    found.tiling = main.map_or_else(Tiling::default, tiling_of);
+    Some(found)
 }
 
 fn texture_of(property: &str, env: &Node) -> Option<TextureSlot> {

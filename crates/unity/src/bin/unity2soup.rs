@@ -1,6 +1,7 @@
 //! unity2soup SCENE.unity -o scene.soup [--assets DIR] [--json] [--strict]
 use anyhow::Context;
 use clap::Parser;
+use formats::TextureRef;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -143,40 +144,30 @@ fn list(report: &unity::Report) {
             }
         );
     }
+    // A map's image as the lines name it: its file and imported size.
+    let image = |r: &TextureRef| {
+        let t = &soup.textures[r.texture as usize];
+        format!("{} {}x{}", t.source, t.width, t.height)
+    };
     for m in &soup.materials {
         let texture = match &m.albedo_map {
-            Some(r) => {
-                let t = &soup.textures[r.texture as usize];
-                format!(
-                    "texture {} {}x{} scale ({}, {}) offset ({}, {})",
-                    t.source,
-                    t.width,
-                    t.height,
-                    r.tiling.scale[0],
-                    r.tiling.scale[1],
-                    r.tiling.offset[0],
-                    r.tiling.offset[1]
-                )
-            }
+            Some(r) => format!(
+                "texture {} scale ({}, {}) offset ({}, {})",
+                image(r),
+                r.tiling.scale[0],
+                r.tiling.scale[1],
+                r.tiling.offset[0],
+                r.tiling.offset[1]
+            ),
             None => "no texture".to_string(),
         };
-        let normal = match &m.normal_map {
-            Some(n) => {
-                let t = &soup.textures[n.map.texture as usize];
-                format!(
-                    ", normal map {} {}x{} scale {}",
-                    t.source, t.width, t.height, n.scale
-                )
-            }
-            None => String::new(),
-        };
-        let glow = match &m.emission_map {
-            Some(r) => {
-                let t = &soup.textures[r.texture as usize];
-                format!(", emission map {} {}x{}", t.source, t.width, t.height)
-            }
-            None => String::new(),
-        };
+        let normal = m.normal_map.as_ref().map_or(String::new(), |n| {
+            format!(", normal map {} scale {}", image(&n.map), n.scale)
+        });
+        let glow = m
+            .emission_map
+            .as_ref()
+            .map_or(String::new(), |r| format!(", emission map {}", image(r)));
         eprintln!(
             "material {:?} ({}): {texture}{normal}{glow}, opacity {}, alpha {:?}",
             m.name, m.source, m.opacity, m.alpha

@@ -115,44 +115,42 @@ fn errors_exit_1_with_one_line_and_bad_usage_exits_2() {
 #[test]
 fn unity2soup_list_says_where_each_material_came_from() {
     // Both primitives' slots name Unity's built-in Default-Material.
-    let (d, scene) = scene();
-    let o = Command::new(env!("CARGO_BIN_EXE_unity2soup"))
-        .arg(&scene)
-        .arg("-o")
-        .arg(d.path().join("s.soup"))
-        .arg("--list")
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let stderr = String::from_utf8_lossy(&o.stderr);
+    let (_d, scene) = scene();
+    let stderr = list(&scene);
     assert!(
         stderr.contains("object \"Box A\": 12 triangles from builtin:Cube [Default-Material rgb(1.000,1.000,1.000) cull Back from default], layer 0, shadows On"),
         "{stderr}"
     );
 }
 
+/// What `unity2soup SCENE -o s.soup --list` prints, asserting it succeeds.
+fn list(scene: &std::path::Path) -> String {
+    let d = tempfile::tempdir().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_unity2soup"))
+        .arg(scene)
+        .arg("-o")
+        .arg(d.path().join("s.soup"))
+        .arg("--list")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
 #[test]
 fn unity2soup_list_names_each_materials_maps() {
-    let list = |name: &str| {
-        let scene = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-            .join(format!("../../scenes/textures/Assets/Scenes/{name}.unity"));
-        let d = tempfile::tempdir().unwrap();
-        let o = Command::new(env!("CARGO_BIN_EXE_unity2soup"))
-            .arg(&scene)
-            .arg("-o")
-            .arg(d.path().join("s.soup"))
-            .arg("--list")
-            .output()
-            .unwrap();
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        String::from_utf8_lossy(&o.stderr).into_owned()
+    let textures = |name: &str| {
+        list(
+            &std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+                .join(format!("../../scenes/textures/Assets/Scenes/{name}.unity")),
+        )
     };
-    let bent = list("NormalMap");
+    let bent = textures("NormalMap");
     assert!(
         bent.contains("material \"Bent\" (Assets/Materials/Bent.mat): no texture, normal map Assets/Textures/Bent.png 2x2 scale 1, opacity 1, alpha Opaque"),
         "{bent}"
     );
-    let glow = list("EmissionMap");
+    let glow = textures("EmissionMap");
     assert!(
         glow.contains("material \"Glow\" (Assets/Materials/Glow.mat): no texture, emission map Assets/Textures/Quadrants.png 2x2, opacity 1, alpha Opaque"),
         "{glow}"
