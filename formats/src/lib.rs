@@ -18,8 +18,9 @@ pub use error::FormatError;
 pub use kd::{BuildParams, KdFile, KdHeader, KdNode, TreeStats};
 pub use rays::{Hit, RayRecord};
 pub use soup::{
-    Alpha, Ambient, AmbientMode, Camera, CastShadows, ClearFlags, Cull, Environment, Light,
-    LightKind, Material, NormalMap, Object, Projection, Shadows, Soup, SoupGeometry, SoupKey,
+    Alpha, Ambient, AmbientMode, Camera, CastShadows, ClearFlags, Cull, Environment, Fog, FogMode,
+    Light, LightKind, Material, NormalMap, Object, Projection, Shadows, Soup, SoupGeometry,
+    SoupKey,
 };
 pub use texture::{Texture, TextureRef, Tiling};
 

@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 pub const MAGIC: &[u8; 8] = b"UTSOUP\0\0";
-pub const VERSION: u32 = 5;
+pub const VERSION: u32 = 6;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Soup {
@@ -285,6 +285,8 @@ pub struct Camera {
     pub up: Vec3,
     pub projection: Projection,
     pub near: f32,
+    /// Far clip plane, along `forward`: nothing further is seen (infinite: no limit).
+    pub far: f32,
 }
 
 impl Camera {
@@ -306,6 +308,7 @@ impl Default for Camera {
             up: Vec3::Y,
             projection: Projection::Perspective { fov_y: 60.0 },
             near: 0.3,
+            far: 1000.0,
         }
     }
 }
@@ -335,12 +338,57 @@ pub struct Ambient {
     pub ground: Vec3,
 }
 
+/// How fog thickens with the fog coordinate `c` (metres): the share of a surface's own
+/// colour that is left is `(end − c) / (end − start)`, `e^(−density·c)` or
+/// `e^(−(density·c)²)`, clamped to [0, 1], Unity's three fog modes.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum FogMode {
+    Linear { start: f32, end: f32 },
+    Exponential { density: f32 },
+    ExponentialSquared { density: f32 },
+}
+
+/// RenderSettings fog: each surface's colour is mixed toward `colour` by its distance.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Fog {
+    pub mode: FogMode,
+    /// Linear RGB.
+    pub colour: Vec3,
+}
+
+impl Fog {
+    /// The share of a surface's colour left at fog coordinate `c`, in [0, 1].
+    pub fn keep(&self, c: f32) -> f32 {
+        let f = match self.mode {
+            FogMode::Linear { start, end } if end == start => (c < end) as u8 as f32,
+            FogMode::Linear { start, end } => (end - c) / (end - start),
+            FogMode::Exponential { density } => (-density * c).exp(),
+            FogMode::ExponentialSquared { density } => (-(density * c) * (density * c)).exp(),
+        };
+        f.clamp(0.0, 1.0)
+    }
+
+    fn validate(&self) -> Result<(), String> {
+        let ok = match self.mode {
+            FogMode::Linear { start, end } => start.is_finite() && end.is_finite(),
+            FogMode::Exponential { density } | FogMode::ExponentialSquared { density } => {
+                density.is_finite()
+            }
+        };
+        if !ok || !self.colour.is_finite() || self.colour.min_element() < 0.0 {
+            return Err(format!("fog {:?} with colour {}", self.mode, self.colour));
+        }
+        Ok(())
+    }
+}
+
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Environment {
     pub clear: ClearFlags,
     /// The camera's solid background colour, linear RGB (used when `clear` is SolidColor).
     pub background: Vec3,
     pub ambient: Ambient,
+    pub fog: Option<Fog>,
 }
 
 impl Default for Environment {
@@ -354,6 +402,7 @@ impl Default for Environment {
                 equator: Vec3::ZERO,
                 ground: Vec3::ZERO,
             },
+            fog: None,
         }
     }
 }
@@ -510,6 +559,9 @@ impl Soup {
             ));
         }
         self.validate_textures()?;
+        if let Some(fog) = &self.environment.fog {
+            fog.validate()?;
+        }
         if let Some(i) = self.objects.iter().position(|o| o.layer >= 32) {
             return Err(format!(
                 "object {i} is on layer {}; Unity has 32",

@@ -77,6 +77,14 @@ fn sample_soup() -> Soup {
         shadow_radius: 0.1,
         culling_mask: 0xffff_fdff,
     }];
+    s.environment.fog = Some(Fog {
+        mode: FogMode::Linear {
+            start: 2.0,
+            end: 30.0,
+        },
+        colour: Vec3::new(0.3, 0.4, 0.5),
+    });
+    s.camera.far = 250.0;
     s.warnings = vec!["a warning".into()];
     s.seal();
     s
@@ -111,7 +119,7 @@ fn soup_round_trips_through_a_file() {
     assert_eq!(Soup::read(&path).unwrap(), s);
     let bytes = std::fs::read(&path).unwrap();
     assert_eq!(&bytes[..8], b"UTSOUP\0\0");
-    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 5);
+    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 6);
     // Nothing but the artifact is left in the folder (the temp file was renamed).
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
 }
@@ -741,13 +749,13 @@ fn atomic_outputs_get_the_umask_permissions_not_the_temporary_files() {
 }
 
 #[test]
-fn a_version_4_soup_is_refused_with_the_versions_named() {
+fn a_version_5_soup_is_refused_with_the_versions_named() {
     let p = Path::new("old.soup");
     let mut b = sample_soup().to_bytes(p).unwrap();
-    b[8..12].copy_from_slice(&4u32.to_le_bytes());
+    b[8..12].copy_from_slice(&5u32.to_le_bytes());
     let msg = Soup::from_bytes(&b, p).unwrap_err().to_string();
     assert!(
-        msg.contains("soup format version 4, this build reads version 5"),
+        msg.contains("soup format version 5, this build reads version 6"),
         "{msg}"
     );
     assert!(msg.contains("re-run the stage that made it"), "{msg}");
@@ -786,6 +794,27 @@ fn draw_rule_fields_are_encoded_in_unitys_numbering() {
     let cull = m + 12 + 4 + 4 + 1 + 12;
     assert_eq!(&payload[cull..cull + 4], &1u32.to_le_bytes(), "Front is 1");
     assert_eq!(Soup::from_bytes(&b, p).unwrap(), s);
+}
+
+#[test]
+fn fog_that_is_not_finite_or_glows_negative_is_corrupt() {
+    fn fog(s: &mut Soup) -> &mut Fog {
+        s.environment.fog.as_mut().unwrap()
+    }
+    refused(
+        &|s| {
+            fog(s).mode = FogMode::Linear {
+                start: 0.0,
+                end: f32::INFINITY,
+            }
+        },
+        "fog Linear { start: 0.0, end: inf }",
+    );
+    refused(
+        &|s| fog(s).mode = FogMode::ExponentialSquared { density: f32::NAN },
+        "fog ExponentialSquared { density: NaN }",
+    );
+    refused(&|s| fog(s).colour.y = -0.5, "with colour [0.3, -0.5, 0.5]");
 }
 
 #[test]

@@ -18,6 +18,8 @@ pub struct CameraModel {
     half_h: f32,
     ortho: bool,
     near: f32,
+    /// Infinite when the camera sets no far limit beyond `near`.
+    far: f32,
     width: f32,
     height: f32,
 }
@@ -71,6 +73,11 @@ impl CameraModel {
             } else {
                 0.0
             },
+            far: if cam.far > cam.near {
+                cam.far
+            } else {
+                f32::INFINITY
+            },
             width: width as f32,
             height: height as f32,
         })
@@ -95,7 +102,8 @@ impl CameraModel {
 
     /// The ray through image position (`px`, `py`) in pixels of the full image, with
     /// (0, 0) the top-left corner of the top-left pixel and y growing downwards. Geometry
-    /// nearer than the camera's near clip plane is not seen, as in Unity.
+    /// nearer than the camera's near clip plane or beyond its far one is not seen, as in
+    /// Unity.
     pub fn ray(&self, px: f32, py: f32) -> Ray {
         let sx = (2.0 * px / self.width - 1.0) * self.half_w;
         let sy = (1.0 - 2.0 * py / self.height) * self.half_h;
@@ -104,16 +112,18 @@ impl CameraModel {
                 origin: self.position + self.right * sx + self.up * sy,
                 dir: self.forward,
                 tmin: self.near,
-                tmax: f32::INFINITY,
+                tmax: self.far,
             }
         } else {
             let dir = (self.forward + self.right * sx + self.up * sy).normalize();
+            // The clip planes are at `near` and `far` along forward: further along an
+            // oblique ray.
+            let along = dir.dot(self.forward);
             Ray {
                 origin: self.position,
                 dir,
-                // The near plane is at `near` along forward: further along an oblique ray.
-                tmin: self.near / dir.dot(self.forward),
-                tmax: f32::INFINITY,
+                tmin: self.near / along,
+                tmax: self.far / along,
             }
         }
     }

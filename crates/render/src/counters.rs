@@ -37,6 +37,8 @@ pub struct RayCounts {
     /// Alpha lookups: cut-out tests inside the traversals and blended surfaces' alpha where
     /// no albedo lookup gave it.
     pub alpha_lookups: u64,
+    /// Surface hits mixed toward the fog colour (camera, reflection and continued rays).
+    pub fogged: u64,
     /// Samples whose radiance was NaN or infinite and were replaced by 0 (not a ray kind).
     #[serde(skip)]
     pub sanitized: u64,
@@ -58,6 +60,7 @@ impl RayCounts {
         self.normal_lookups += o.normal_lookups;
         self.emission_lookups += o.emission_lookups;
         self.alpha_lookups += o.alpha_lookups;
+        self.fogged += o.fogged;
         self.sanitized += o.sanitized;
     }
     /// Queries traced: every ray kind, blend continuations included.
@@ -82,6 +85,7 @@ pub struct SharedCounts {
     normal_lookups: AtomicU64,
     emission_lookups: AtomicU64,
     alpha_lookups: AtomicU64,
+    fogged: AtomicU64,
     sanitized: AtomicU64,
 }
 
@@ -103,6 +107,7 @@ impl SharedCounts {
         self.normal_lookups.fetch_add(c.normal_lookups, Relaxed);
         self.emission_lookups.fetch_add(c.emission_lookups, Relaxed);
         self.alpha_lookups.fetch_add(c.alpha_lookups, Relaxed);
+        self.fogged.fetch_add(c.fogged, Relaxed);
         self.sanitized.fetch_add(c.sanitized, Relaxed);
     }
     pub fn load(&self) -> RayCounts {
@@ -121,6 +126,7 @@ impl SharedCounts {
             normal_lookups: self.normal_lookups.load(Relaxed),
             emission_lookups: self.emission_lookups.load(Relaxed),
             alpha_lookups: self.alpha_lookups.load(Relaxed),
+            fogged: self.fogged.load(Relaxed),
             sanitized: self.sanitized.load(Relaxed),
         }
     }

@@ -26,6 +26,7 @@ use crate::alpha::{alpha_use, AlphaUse};
 use crate::cone::RayCone;
 use crate::counters::RayCounts;
 use crate::environment;
+use crate::fog::FogModel;
 use crate::lights::{incident, Incident};
 use crate::normal_map;
 use crate::offset::{
@@ -228,6 +229,8 @@ pub struct Integrator<'a> {
     /// traversals' filters ask, one byte instead of the object's and the material's records
     /// (empty when no face is culled and every object casts).
     sides: Vec<u8>,
+    /// The scene's fog, when the plan turns it on.
+    fog: Option<FogModel>,
 }
 
 /// [`Integrator::sides`] bits: camera and reflection rays that meet the triangle's front
@@ -360,6 +363,11 @@ impl<'a> Integrator<'a> {
             } else {
                 Vec::new()
             },
+            fog: soup
+                .environment
+                .fog
+                .filter(|_| plan.fog.enabled)
+                .map(|f| FogModel::new(f, &soup.camera)),
         }
     }
 
@@ -511,6 +519,7 @@ impl<'a> Integrator<'a> {
                     out[i] = self.beyond(&layers[i], rays[i].dir);
                     continue;
                 };
+                let shaded = self.fogged(shaded, &rays[i], &hit, bounce, counts);
                 if let Some(done) = self.fold(&mut layers[i], weights[i], shaded) {
                     out[i] = done;
                     continue;
@@ -542,6 +551,26 @@ impl<'a> Integrator<'a> {
         layers.through *= 1.0 - a;
         let faint = self.cutoff.max(f32::MIN_POSITIVE);
         (a >= 1.0 || (weight * layers.through).max_element() < faint).then_some(layers.acc)
+    }
+
+    /// A layer's light `l` and α `a` as seen through the fog from where `ray` began (the
+    /// background is not fogged: it is not a surface).
+    #[inline(always)]
+    fn fogged(
+        &self,
+        (l, a): (Vec3, f32),
+        ray: &Ray,
+        hit: &Hit,
+        bounce: u32,
+        counts: &mut RayCounts,
+    ) -> (Vec3, f32) {
+        match &self.fog {
+            Some(fog) => {
+                counts.fogged += 1;
+                (fog.apply(l, ray, hit.t, bounce), a)
+            }
+            None => (l, a),
+        }
     }
 
     /// The radiance of a ray that leaves the scene along `dir` behind its blended layers.
@@ -605,6 +634,7 @@ impl<'a> Integrator<'a> {
                 counts,
                 &mut primary,
             );
+            let shaded = self.fogged(shaded, &r, &hit, bounce, counts);
             if let Some(done) = self.fold(&mut layers, weight, shaded) {
                 return done;
             }

@@ -24,6 +24,7 @@ pub mod environment;
 pub mod error;
 pub mod exrio;
 pub mod exrread;
+pub mod fog;
 pub mod frame;
 pub mod integrator;
 pub mod lights;

@@ -4,7 +4,9 @@
 
 use crate::alpha::{alpha_use, min_alphas, AlphaUse};
 use crate::{RenderOptions, TextureFilter};
-use formats::{AmbientMode, CastShadows, ClearFlags, Cull, LightKind, Material, Shadows, Soup};
+use formats::{
+    AmbientMode, CastShadows, ClearFlags, Cull, Fog, FogMode, LightKind, Material, Shadows, Soup,
+};
 use glam::Vec3;
 use serde::Serialize;
 
@@ -139,6 +141,8 @@ pub struct Plan {
     pub reflections: ReflectionPlan,
     pub ambient: Effect,
     pub emission: Effect,
+    /// RenderSettings fog: on when the scene has fog that can thin a surface's colour.
+    pub fog: Effect,
     pub anti_aliasing: AntiAliasing,
     pub background: String,
 }
@@ -261,6 +265,8 @@ impl Plan {
             },
         };
 
+        let fog = fog_plan(soup.environment.fog.as_ref());
+
         let anti_aliasing = AntiAliasing {
             enabled: opts.spp > 1,
             spp: opts.spp,
@@ -338,6 +344,7 @@ impl Plan {
             reflections,
             ambient,
             emission,
+            fog,
             anti_aliasing,
             background,
         }
@@ -404,6 +411,11 @@ impl Plan {
             self.emission.reason
         );
         s += &format!(
+            "  fog            {}  {}\n",
+            on(self.fog.enabled),
+            self.fog.reason
+        );
+        s += &format!(
             "  anti-aliasing  {}  {} ({})\n",
             on(self.anti_aliasing.enabled),
             self.anti_aliasing.reason,
@@ -415,6 +427,46 @@ impl Plan {
 
     pub fn to_json(&self) -> serde_json::Value {
         serde_json::to_value(self).unwrap_or(serde_json::Value::Null)
+    }
+}
+
+/// Fog is on when the scene has some and it thins what lies at some distance: an
+/// exponential fog of density 0 never does.
+fn fog_plan(fog: Option<&Fog>) -> Effect {
+    let Some(fog) = fog else {
+        return Effect {
+            enabled: false,
+            reason: "the scene has no fog".into(),
+        };
+    };
+    let colour = vec(fog.colour);
+    // A negative density is squared away by the squared mode, but leaves the plain one
+    // clear: its factor exceeds 1 and is clamped.
+    match fog.mode {
+        FogMode::Exponential { density } | FogMode::ExponentialSquared { density }
+            if density == 0.0 =>
+        {
+            Effect {
+                enabled: false,
+                reason: "fog density 0".into(),
+            }
+        }
+        FogMode::Exponential { density } if density < 0.0 => Effect {
+            enabled: false,
+            reason: format!("exponential fog of negative density {density} is clear"),
+        },
+        FogMode::Linear { start, end } => Effect {
+            enabled: true,
+            reason: format!("linear fog from {start} to {end} m, colour {colour}"),
+        },
+        FogMode::Exponential { density } => Effect {
+            enabled: true,
+            reason: format!("exponential fog, density {density}, colour {colour}"),
+        },
+        FogMode::ExponentialSquared { density } => Effect {
+            enabled: true,
+            reason: format!("exponential squared fog, density {density}, colour {colour}"),
+        },
     }
 }
 

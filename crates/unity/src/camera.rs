@@ -33,6 +33,7 @@ pub fn convert(b: &Node, world: Mat4, name: String) -> Option<Camera> {
         up,
         projection,
         near: b.f32_at("near clip plane").unwrap_or(0.3),
+        far: b.f32_at("far clip plane").unwrap_or(1000.0),
     })
 }
 
@@ -74,9 +75,19 @@ impl Emitter<'_, '_> {
         }
         let b = &g.objs[c].body;
         let world = self.checked_world(go)?;
-        let Some(camera) = convert(b, world, self.path(go)) else {
+        let Some(mut camera) = convert(b, world, self.path(go)) else {
             return Err(self.non_finite(go, "camera orientation is degenerate".into()));
         };
+        // Unity's inspector keeps the far plane beyond the near one; a file that does not
+        // is drawn without a far limit rather than empty.
+        if !(camera.far > camera.near) {
+            self.soup.warnings.push(format!(
+                "{scene_rel}: camera '{}': far clip plane {} is not beyond the near plane {}; \
+                 drawn without a far limit",
+                camera.name, camera.far, camera.near
+            ));
+            camera.far = f32::INFINITY;
+        }
         self.lod_camera = Some((world.w_axis.xyz(), camera.projection));
         self.soup.camera = camera;
         self.camera_mask = crate::layer::culling_mask(b);

@@ -166,6 +166,15 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
     {
         e.soup.environment.ambient = ambient;
     }
+    if let Some(rs) = &g.render_settings {
+        match crate::environment::fog(rs, g.project.hdrp) {
+            Ok(fog) => e.soup.environment.fog = fog,
+            Err(why) => e
+                .soup
+                .warnings
+                .push(format!("{scene_rel}: RenderSettings: {why}")),
+        }
+    }
     let placements = std::mem::take(&mut e.placements);
     placements.fill(&mut e.soup, &mut e.material_origins);
     e.soup.seal();

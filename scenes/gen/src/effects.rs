@@ -5,7 +5,8 @@ use crate::material::{write_material, write_surface, MatDesc, Surface};
 use crate::meta;
 use crate::project::Project;
 use crate::unity::{
-    self, Ambient, Body, CameraDesc, LightDesc, LightType, MeshRef, Object, SceneDesc, Xform,
+    self, Ambient, Body, CameraDesc, FogDesc, LightDesc, LightType, MeshRef, Object, SceneDesc,
+    Xform,
 };
 use std::collections::BTreeMap;
 
@@ -15,6 +16,7 @@ pub struct Builder {
     project: Project,
     mats: BTreeMap<&'static str, String>,
     objects: Vec<Object>,
+    fog: Option<FogDesc>,
 }
 
 impl Builder {
@@ -32,7 +34,14 @@ impl Builder {
             project,
             mats,
             objects: Vec::new(),
+            fog: None,
         }
+    }
+
+    /// Turn on RenderSettings fog in the scene written next.
+    pub fn fog(&mut self, fog: FogDesc) -> &mut Self {
+        self.fog = Some(fog);
+        self
     }
 
     /// Add a look that draws with a texture or alpha.
@@ -66,6 +75,7 @@ impl Builder {
         let key = format!("{}/{scene_name}", self.project.name);
         let scene = SceneDesc {
             ambient,
+            fog: self.fog.take(),
             objects: std::mem::take(&mut self.objects),
         };
         self.project
@@ -115,6 +125,7 @@ impl Builder {
         let key = format!("{}/{scene_name}", self.project.name);
         let scene = SceneDesc {
             ambient,
+            fog: self.fog.take(),
             objects: std::mem::take(&mut self.objects),
         };
         self.project
@@ -374,6 +385,54 @@ pub fn orthographic() -> Project {
     b.finish("Orthographic", NO_AMBIENT)
 }
 
+/// The fog colour, also the camera's background: the sky Unity leaves unfogged matches
+/// the distance, as scenes with fog usually set it.
+const FOG_GREY: [f32; 3] = [0.62, 0.66, 0.72];
+
+/// A row of pillars walking away from the camera into exponential squared fog (density
+/// 0.04): each farther pillar keeps less of its own colour.
+pub fn fog() -> Project {
+    let mut b = Builder::new("fog", &basic_looks());
+    b.camera(
+        Xform::at(0.0, 1.6, -6.0).euler(4.0, 0.0, 0.0),
+        CameraDesc {
+            background: FOG_GREY,
+            ..CameraDesc::default()
+        },
+    )
+    .mesh(
+        "Ground",
+        unity::PLANE,
+        "Grey",
+        Xform::at(0.0, 0.0, 40.0).scale(4.0, 1.0, 10.0),
+    );
+    for i in 0..6 {
+        let (x, look) = if i % 2 == 0 {
+            (-1.5, "Red")
+        } else {
+            (1.5, "Blue")
+        };
+        let at = Xform::at(x, 1.5, 8.0 * i as f32).scale(1.0, 3.0, 1.0);
+        b.mesh(&format!("Pillar {i}"), unity::CUBE, look, at);
+    }
+    b.light(
+        "Directional Light",
+        Xform::at(0.0, 3.0, 0.0).euler(50.0, -30.0, 0.0),
+        LightDesc {
+            kind: LightType::Directional,
+            ..point([1.0, 0.96, 0.84], 1.0, 10.0, 1)
+        },
+    )
+    .fog(FogDesc {
+        mode: 3,
+        colour: FOG_GREY,
+        density: 0.04,
+        start: 0.0,
+        end: 300.0,
+    });
+    b.finish("Fog", Ambient::Flat([0.2, 0.2, 0.22]))
+}
+
 /// Every effect project, in gallery order.
 pub fn all() -> Vec<Project> {
     vec![
@@ -385,6 +444,7 @@ pub fn all() -> Vec<Project> {
         ambient(),
         emission(),
         orthographic(),
+        fog(),
     ]
 }
 
@@ -422,6 +482,10 @@ mod tests {
             .iter()
             .any(|(k, v)| k.ends_with(".mat")
                 && String::from_utf8_lossy(v).contains("  - _EMISSION\n")));
+        let fog = scene_text(&fog());
+        assert!(fog.contains("  m_Fog: 1\n") && fog.contains("  m_FogMode: 3\n"));
+        assert!(fog.contains("  m_FogDensity: 0.04\n"));
+        assert!(scene_text(&ambient()).contains("  m_Fog: 0\n"));
         let mirrors = scene_text(&reflection_depth());
         assert_eq!(mirrors.matches("  m_Name: Mirror ").count(), 2);
     }

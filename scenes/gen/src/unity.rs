@@ -97,6 +97,7 @@ impl LightDesc {
 pub struct CameraDesc {
     pub fov: f32,
     pub near: f32,
+    pub far: f32,
     pub orthographic: Option<f32>,
     /// sRGB solid clear colour.
     pub background: [f32; 3],
@@ -107,6 +108,7 @@ impl Default for CameraDesc {
         CameraDesc {
             fov: 60.0,
             near: 0.3,
+            far: 1000.0,
             orthographic: None,
             background: [0.0, 0.0, 0.0],
         }
@@ -142,7 +144,19 @@ pub enum Ambient {
 
 pub struct SceneDesc {
     pub ambient: Ambient,
+    pub fog: Option<FogDesc>,
     pub objects: Vec<Object>,
+}
+
+/// RenderSettings fog: `mode` 1 linear (`start`, `end`), 2 exponential, 3 exponential
+/// squared (`density`); `colour` sRGB.
+#[derive(Clone, Copy, Debug)]
+pub struct FogDesc {
+    pub mode: i64,
+    pub colour: [f32; 3],
+    pub density: f32,
+    pub start: f32,
+    pub end: f32,
 }
 
 /// Unity writes floats in their shortest round-trip form (`0.38268343`, `15.000001`),
@@ -216,7 +230,7 @@ pub fn write_scene(scene_key: &str, scene: &SceneDesc) -> String {
     docs.sort_by_key(|(id, _)| *id);
     let mut s = String::from("%YAML 1.1\n%TAG !u! tag:unity3d.com,2011:\n");
     s += OCCLUSION_LIGHTMAP_NAVMESH_HEAD;
-    s += &render_settings(&scene.ambient);
+    s += &render_settings(&scene.ambient, scene.fog.as_ref());
     s += LIGHTMAP_NAVMESH;
     for (_, d) in docs {
         s += &d;
@@ -507,7 +521,7 @@ Camera:
     width: 1
     height: 1
   near clip plane: {near}
-  far clip plane: 1000
+  far clip plane: {far}
   field of view: {fov}
   orthographic: {ortho}
   orthographic size: {size}
@@ -529,6 +543,7 @@ Camera:
 ",
         bg = rgba(c.background, 1.0),
         near = num(c.near),
+        far = num(c.far),
         fov = num(c.fov),
         size = num(size),
     )
@@ -538,8 +553,17 @@ fn audio_listener(id: i64, go: i64) -> String {
     format!("--- !u!81 &{id}\nAudioListener:\n{PREFAB_FIELDS}  m_GameObject: {{fileID: {go}}}\n  m_Enabled: 1\n")
 }
 
-fn render_settings(ambient: &Ambient) -> String {
+fn render_settings(ambient: &Ambient, fog: Option<&FogDesc>) -> String {
     let black = [0.0, 0.0, 0.0];
+    // Unity's new-scene fog settings, switched off, unless the scene asks for fog.
+    let off = FogDesc {
+        mode: 3,
+        colour: [0.5, 0.5, 0.5],
+        density: 0.01,
+        start: 0.0,
+        end: 300.0,
+    };
+    let (on, f) = fog.map_or((0, &off), |f| (1, f));
     let (mode, sky, equator, ground) = match *ambient {
         Ambient::Flat(c) => (3, c, black, black),
         Ambient::Trilight(s, e, g) => (1, s, e, g),
@@ -549,12 +573,12 @@ fn render_settings(ambient: &Ambient) -> String {
 RenderSettings:
   m_ObjectHideFlags: 0
   serializedVersion: 9
-  m_Fog: 0
-  m_FogColor: {{r: 0.5, g: 0.5, b: 0.5, a: 1}}
-  m_FogMode: 3
-  m_FogDensity: 0.01
-  m_LinearFogStart: 0
-  m_LinearFogEnd: 300
+  m_Fog: {on}
+  m_FogColor: {fog_colour}
+  m_FogMode: {fog_mode}
+  m_FogDensity: {density}
+  m_LinearFogStart: {start}
+  m_LinearFogEnd: {end}
   m_AmbientSkyColor: {sky}
   m_AmbientEquatorColor: {equator}
   m_AmbientGroundColor: {ground}
@@ -579,6 +603,11 @@ RenderSettings:
         sky = rgba(sky, 1.0),
         equator = rgba(equator, 1.0),
         ground = rgba(ground, 1.0),
+        fog_colour = rgba(f.colour, 1.0),
+        fog_mode = f.mode,
+        density = num(f.density),
+        start = num(f.start),
+        end = num(f.end),
     )
 }
 

@@ -99,6 +99,7 @@ fn environment(background: Vec3, ambient: Vec3) -> Environment {
             equator: ambient,
             ground: ambient,
         },
+        fog: None,
     }
 }
 
@@ -112,6 +113,7 @@ fn look(position: Vec3, target: Vec3, fov_y: f32) -> Camera {
         up: right.cross(forward),
         projection: Projection::Perspective { fov_y },
         near: 0.1,
+        far: f32::INFINITY,
     }
 }
 

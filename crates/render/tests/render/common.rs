@@ -266,6 +266,7 @@ pub fn top_down_camera(position: Vec3, half_height: f32) -> Camera {
         up: Vec3::Z,
         projection: Projection::Orthographic { half_height },
         near: 0.0,
+        far: f32::INFINITY,
     }
 }
 

@@ -114,6 +114,7 @@ fn mirror_scene(reflectivity: f32) -> SceneBuilder {
         up: Vec3::Y,
         projection: Projection::Perspective { fov_y: 40.0 },
         near: 0.3,
+        far: f32::INFINITY,
     });
     s
 }
@@ -284,6 +285,7 @@ fn ambient_lights_a_face_no_light_reaches() {
             up: Vec3::Y,
             projection: Projection::Perspective { fov_y: 30.0 },
             near: 0.3,
+            far: f32::INFINITY,
         });
         if ambient_on {
             s.soup.environment.ambient = formats::Ambient {
@@ -324,6 +326,7 @@ fn flat_ambient_and_a_face_turned_down_get_their_colours() {
         up: Vec3::Z,
         projection: Projection::Orthographic { half_height: 2.0 },
         near: 0.0,
+        far: f32::INFINITY,
     });
     let ground = Vec3::new(0.03, 0.02, 0.01);
     s.soup.environment.ambient = formats::Ambient {
@@ -420,6 +423,7 @@ fn an_orthographic_camera_spans_its_half_height() {
         up: Vec3::Y,
         projection: Projection::Orthographic { half_height: 2.0 },
         near: 0.1,
+        far: f32::INFINITY,
     });
     let (soup, kd) = s.build();
     let (out, _) = render(&soup, &kd, &opts(8, 8));

@@ -6,6 +6,7 @@ mod cli;
 mod common;
 mod draw_rules;
 mod exr;
+mod fog;
 mod lighting;
 mod plan;
 mod robustness;

@@ -134,6 +134,7 @@ fn the_path_weight_cutoff_ends_reflections() {
         up: Vec3::Y,
         projection: formats::Projection::Orthographic { half_height: 1.0 },
         near: 0.0,
+        far: f32::INFINITY,
     });
     s.soup.environment.background = Vec3::ONE;
     let (soup, kd) = s.build();

@@ -205,6 +205,7 @@ fn facing_mirrors_at_depth_16_stay_finite() {
         up: Vec3::Y,
         projection: Projection::Perspective { fov_y: 60.0 },
         near: 0.01,
+        far: f32::INFINITY,
     });
     s.soup.environment.background = Vec3::splat(1e30);
     let (soup, kd) = s.build();

@@ -46,6 +46,7 @@ fn front_camera(half_height: f32) -> Camera {
         up: Vec3::Y,
         projection: Projection::Orthographic { half_height },
         near: 0.0,
+        far: f32::INFINITY,
     }
 }
 

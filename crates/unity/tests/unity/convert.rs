@@ -2,7 +2,7 @@
 //! primitives, fileID schemes, prefab instances, visibility, lights and camera.
 
 use crate::support::*;
-use formats::{LightKind, Shadows};
+use formats::{FogMode, LightKind, Shadows};
 use glam::Vec3;
 use std::f32::consts::FRAC_1_SQRT_2;
 use std::path::{Path, PathBuf};
@@ -116,6 +116,45 @@ fn object_at_unity_plus_x_is_right_of_the_camera() {
     );
     // Solid background, sRGB 0.5 → linear.
     assert!((soup.environment.background.x - 0.21404114).abs() < 1e-6);
+}
+
+#[test]
+fn the_far_clip_plane_is_read_and_one_not_beyond_the_near_plane_is_dropped() {
+    let mut sc = Scene::default();
+    sc.camera(&Tf::at(0.0, 0.0, 0.0));
+    // No far plane written: Unity's default.
+    assert_eq!(convert_scene(&sc.text).camera.far, 1000.0);
+    let far = |f: &str| {
+        let text = sc.text.replace(
+            "  near clip plane: 0.3\n",
+            &format!("  near clip plane: 0.3\n  far clip plane: {f}\n"),
+        );
+        convert_scene(&text)
+    };
+    assert_eq!(far("55.5").camera.far, 55.5);
+    let bad = far("0.2");
+    assert_eq!(bad.camera.far, f32::INFINITY);
+    assert!(
+        bad.warnings
+            .iter()
+            .any(|w| w.contains("far clip plane 0.2 is not beyond the near plane 0.3")),
+        "{:?}",
+        bad.warnings
+    );
+}
+
+/// The bundled fog scene: its RenderSettings fog arrives in the soup, colour decoded.
+#[test]
+fn render_settings_fog_reaches_the_soup() {
+    let scene =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/fog/Assets/Scenes/Fog.unity");
+    let soup = convert(&scene);
+    let fog = soup.environment.fog.expect("the scene has fog");
+    assert_eq!(fog.mode, FogMode::ExponentialSquared { density: 0.04 });
+    let grey = [0.62f32, 0.66, 0.72].map(unity::material::srgb_to_linear);
+    assert_eq!(fog.colour, Vec3::from_array(grey));
+    assert_eq!(soup.environment.background, fog.colour);
+    assert!(soup.warnings.is_empty(), "{:?}", soup.warnings);
 }
 
 #[test]

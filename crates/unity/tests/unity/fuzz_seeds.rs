@@ -1,5 +1,5 @@
 //! The seeds of the `soup` and `unity_texture` fuzz targets are made here, from the
-//! generated `textures` project, so they follow the soup format and the decoder's
+//! generated `textures` and `fog` projects, so they follow the soup format and the decoder's
 //! formats: stale seeds fail this test, and `UNITRACE_WRITE_FUZZ_SEEDS=1` rewrites them.
 
 use image::{ImageFormat, RgbaImage};
@@ -59,12 +59,22 @@ fn seeds() -> Vec<(PathBuf, Vec<u8>)> {
     )
     .unwrap();
     assert!(bent.materials[0].normal_map.is_some());
+    let foggy = unity::convert(
+        &repo().join("scenes/fog/Assets/Scenes/Fog.unity"),
+        &unity::Options::default(),
+    )
+    .unwrap();
+    assert!(foggy.environment.fog.is_some());
     let fuzz = repo().join("fuzz/corpus");
     vec![
         (fuzz.join("soup/seed-4tri.soup"), framed),
         (
             fuzz.join("soup/seed-normal-map.soup"),
             bent.to_bytes(Path::new("seed-normal-map.soup")).unwrap(),
+        ),
+        (
+            fuzz.join("soup/seed-fog.soup"),
+            foggy.to_bytes(Path::new("seed-fog.soup")).unwrap(),
         ),
         (fuzz.join("soup/seed-4tri-payload.bin"), payload),
         (
