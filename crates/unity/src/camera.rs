@@ -80,7 +80,8 @@ impl Emitter<'_, '_> {
         };
         // Unity's inspector keeps the far plane beyond the near one; a file that does not
         // is drawn without a far limit rather than empty.
-        if !(camera.far > camera.near) {
+        let beyond = camera.far > camera.near;
+        if !beyond {
             self.soup.warnings.push(format!(
                 "{scene_rel}: camera '{}': far clip plane {} is not beyond the near plane {}; \
                  drawn without a far limit",
