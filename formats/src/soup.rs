@@ -256,6 +256,8 @@ pub struct Light {
     /// Soft shadows: emitter radius in metres (point, spot) or angular diameter in degrees
     /// (directional).
     pub shadow_radius: f32,
+    /// `m_Shadows.m_Strength`, 0–1: the share of the light a shadow takes away.
+    pub shadow_strength: f32,
     /// `m_CullingMask.m_Bits`: bit `l` set means the light lights objects on layer `l`.
     pub culling_mask: u32,
 }
@@ -561,6 +563,16 @@ impl Soup {
         self.validate_textures()?;
         if let Some(fog) = &self.environment.fog {
             fog.validate()?;
+        }
+        if let Some(i) = self
+            .lights
+            .iter()
+            .position(|l| !(0.0..=1.0).contains(&l.shadow_strength))
+        {
+            return Err(format!(
+                "light {i} has shadow strength {}",
+                self.lights[i].shadow_strength
+            ));
         }
         if let Some(i) = self.objects.iter().position(|o| o.layer >= 32) {
             return Err(format!(

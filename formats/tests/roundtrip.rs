@@ -75,6 +75,7 @@ fn sample_soup() -> Soup {
         range: 10.0,
         shadows: Shadows::Soft,
         shadow_radius: 0.1,
+        shadow_strength: 0.75,
         culling_mask: 0xffff_fdff,
     }];
     s.environment.fog = Some(Fog {
@@ -815,6 +816,18 @@ fn fog_that_is_not_finite_or_glows_negative_is_corrupt() {
         "fog ExponentialSquared { density: NaN }",
     );
     refused(&|s| fog(s).colour.y = -0.5, "with colour [0.3, -0.5, 0.5]");
+}
+
+#[test]
+fn a_shadow_strength_outside_0_to_1_is_corrupt() {
+    refused(
+        &|s| s.lights[0].shadow_strength = 1.5,
+        "light 0 has shadow strength 1.5",
+    );
+    refused(
+        &|s| s.lights[0].shadow_strength = f32::NAN,
+        "light 0 has shadow strength NaN",
+    );
 }
 
 #[test]

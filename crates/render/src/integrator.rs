@@ -67,6 +67,20 @@ struct ActiveLight<'a> {
     shadows: ShadowMode,
 }
 
+impl ActiveLight<'_> {
+    /// The share of the light that reaches a point whose shadow rays let `visible` of it
+    /// through: a shadow of strength s takes s of what it blocks away, as in Unity.
+    #[inline(always)]
+    fn unshadowed(&self, visible: f32) -> f32 {
+        let s = self.light.shadow_strength;
+        if s >= 1.0 {
+            visible
+        } else {
+            1.0 - s * (1.0 - visible)
+        }
+    }
+}
+
 /// A shaded point and what it takes to leave it robustly (see [`crate::offset`]).
 struct Surface {
     p: Vec3,
@@ -676,7 +690,7 @@ impl<'a> Integrator<'a> {
                 }
                 ShadowMode::Soft => self.soft_visibility(&lit.surf, al.light, &inc, rng, counts),
             };
-            lit.add(&inc, cos, visible);
+            lit.add(&inc, cos, al.unshadowed(visible));
         }
         self.reflect(lit, ray, hit, cone, bounce, weight, through, rng, counts)
     }
@@ -725,7 +739,7 @@ impl<'a> Integrator<'a> {
                     ShadowMode::Soft => {
                         let v =
                             self.soft_visibility(&lit.surf, al.light, &inc, &mut rngs[l], counts);
-                        lit.add(&inc, cos, v);
+                        lit.add(&inc, cos, al.unshadowed(v));
                     }
                 }
             }
@@ -734,7 +748,7 @@ impl<'a> Integrator<'a> {
                 let visible = self.transmittance4(&shadow, live, &mut None, counts);
                 for l in 0..LANES {
                     if let (Some(lit), Some((inc, cos))) = (lit[l].as_mut(), hard[l]) {
-                        lit.add(&inc, cos, visible[l]);
+                        lit.add(&inc, cos, al.unshadowed(visible[l]));
                     }
                 }
             }
@@ -1512,6 +1526,7 @@ mod tests {
             range: 50.0,
             shadows: Shadows::Soft,
             shadow_radius,
+            shadow_strength: 1.0,
             culling_mask: u32::MAX,
         }
     }

@@ -710,6 +710,11 @@ fn light_plan(l: &formats::Light, diffuse: bool, opts: &RenderOptions) -> LightP
     }
     let (shadows, shadow_rays, reason) = match l.shadows {
         Shadows::None => (ShadowMode::None, 0, "m_Shadows is none".to_string()),
+        Shadows::Hard | Shadows::Soft if l.shadow_strength <= 0.0 => (
+            ShadowMode::None,
+            0,
+            "shadow strength 0: its shadows take no light away".to_string(),
+        ),
         Shadows::Hard => (ShadowMode::Hard, 1, "hard shadows".to_string()),
         Shadows::Soft if l.shadow_radius.is_nan() || l.shadow_radius <= 0.0 => (
             ShadowMode::Hard,
@@ -738,6 +743,14 @@ fn light_plan(l: &formats::Light, diffuse: bool, opts: &RenderOptions) -> LightP
                 rim_probe(l, opts)
             ),
         ),
+    };
+    let reason = if shadows != ShadowMode::None && l.shadow_strength < 1.0 {
+        format!(
+            "{reason}, at strength {} (they take that share of the light away)",
+            l.shadow_strength
+        )
+    } else {
+        reason
     };
     let reason = if l.culling_mask == u32::MAX {
         reason

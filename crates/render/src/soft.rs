@@ -253,6 +253,7 @@ pub(crate) mod tests {
             range: 10.0,
             shadows: Shadows::Soft,
             shadow_radius,
+            shadow_strength: 1.0,
             culling_mask: u32::MAX,
         }
     }

@@ -54,6 +54,11 @@ pub fn convert(
         2 => Shadows::Soft,
         _ => Shadows::None,
     };
+    // Unity's inspector keeps the strength within 0–1.
+    let shadow_strength = b
+        .path(&["m_Shadows", "m_Strength"])
+        .and_then(Node::as_f32)
+        .unwrap_or(1.0);
     let shadow_radius = if directional {
         b.f32_at("m_ShadowAngle")
             .filter(|&a| a > 0.0)
@@ -84,6 +89,7 @@ pub fn convert(
         range,
         angle,
         shadow_radius,
+        shadow_strength,
     ];
     if all.iter().any(|v| !v.is_finite()) || direction == Vec3::ZERO {
         return None;
@@ -98,6 +104,7 @@ pub fn convert(
         range,
         shadows,
         shadow_radius,
+        shadow_strength: shadow_strength.clamp(0.0, 1.0),
         culling_mask: crate::layer::culling_mask(b),
     };
     Some((light, note))

@@ -85,6 +85,7 @@ fn point_light(name: &str, position: Vec3, intensity: f32, radius: f32) -> Light
         range: 30.0,
         shadows: Shadows::Soft,
         shadow_radius: radius,
+        shadow_strength: 1.0,
         culling_mask: u32::MAX,
     }
 }
@@ -186,6 +187,7 @@ pub fn mesh_on_mirror(path: &Path) -> Result<Scene> {
             range: 0.0,
             shadows: Shadows::Hard,
             shadow_radius: 0.0,
+            shadow_strength: 1.0,
             culling_mask: u32::MAX,
         },
     ];
@@ -273,6 +275,7 @@ pub fn checkerboard() -> Scene {
         range: 0.0,
         shadows: Shadows::None,
         shadow_radius: 0.0,
+        shadow_strength: 1.0,
         culling_mask: u32::MAX,
     }];
     soup.camera = look(Vec3::new(0.0, 1.0, -1.0), Vec3::new(0.0, 0.0, 8.0), 50.0);
@@ -322,6 +325,7 @@ pub fn with_sun(scene: &Scene, name: &str, cone: f32) -> Scene {
         range: 0.0,
         shadows: Shadows::Soft,
         shadow_radius: cone,
+        shadow_strength: 1.0,
         culling_mask: u32::MAX,
     }];
     Scene {

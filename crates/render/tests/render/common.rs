@@ -201,6 +201,7 @@ pub fn point_light(position: Vec3, intensity: f32, range: f32, shadows: Shadows)
         range,
         shadows,
         shadow_radius: 0.0,
+        shadow_strength: 1.0,
         culling_mask: u32::MAX,
     }
 }
@@ -222,6 +223,7 @@ pub fn spot_light(
         range,
         shadows: Shadows::None,
         shadow_radius: 0.0,
+        shadow_strength: 1.0,
         culling_mask: u32::MAX,
     }
 }
@@ -237,6 +239,7 @@ pub fn directional_light(direction: Vec3, intensity: f32, shadows: Shadows) -> L
         range: 0.0,
         shadows,
         shadow_radius: 0.0,
+        shadow_strength: 1.0,
         culling_mask: u32::MAX,
     }
 }

@@ -4,6 +4,7 @@
 use crate::common::*;
 use formats::{AmbientMode, Camera, Projection, Shadows};
 use glam::Vec3;
+use render::plan::ShadowMode;
 
 const ALBEDO: Vec3 = Vec3::new(0.8, 0.6, 0.4);
 
@@ -84,6 +85,55 @@ fn a_shadowed_point_is_dark_and_lit_without_shadows() {
         let to = light_pos - q;
         let want = ALBEDO * unity_falloff(to.length(), 20.0) * (to.y / to.length());
         assert_close(out.frame.pixel(7, 20), want, 0.01, "unshadowed floor");
+    }
+}
+
+/// A shadow of strength s takes s of the light it blocks away, hard or soft, one ray at a
+/// time or in packets; at strength 0 no shadow ray is traced.
+#[test]
+fn shadow_strength_lets_the_rest_of_the_light_through() {
+    for shadows in [Shadows::Hard, Shadows::Soft] {
+        for strength in [1.0, 0.6, 0.0] {
+            let mut s = floor_scene();
+            let m = s.diffuse(Vec3::ONE);
+            // The occluder of the test above, wide enough that the soft light's disc is
+            // wholly hidden from the floor's centre too.
+            s.quad(
+                "occluder",
+                Vec3::new(0.5, 2.0, -2.0),
+                Vec3::new(0.0, 0.0, 4.0),
+                Vec3::new(2.0, 0.0, 0.0),
+                m,
+            );
+            let light_pos = Vec3::new(3.0, 4.0, 0.0);
+            s.light(formats::Light {
+                shadow_strength: strength,
+                shadow_radius: 0.05,
+                ..point_light(light_pos, 1.0, 20.0, shadows)
+            });
+            let (soup, kd) = s.build();
+            let out = render_alike_at_tiles(&soup, &kd, &opts(40, 40));
+            let (_, plan) = render(&soup, &kd, &opts(4, 4));
+            let p = ortho_point(&soup.camera, 40, 40, 20, 20, 0.0);
+            let to = light_pos - p;
+            let d = to.length();
+            let lit = ALBEDO * unity_falloff(d, 20.0) * (to.y / d);
+            let got = out.frame.pixel(20, 20);
+            let what = format!("{shadows:?} at strength {strength}");
+            if strength == 1.0 {
+                assert_eq!(got, Vec3::ZERO, "{what}");
+            } else {
+                assert_close(got, lit * (1.0 - strength), 0.01, &what);
+            }
+            let traced = out.counts.shadow + out.counts.soft_shadow;
+            assert_eq!(traced == 0, strength == 0.0, "{what}: {traced} shadow rays");
+            assert_eq!(
+                plan.lights[0].shadows == ShadowMode::None,
+                strength == 0.0,
+                "{what}: {}",
+                plan.lights[0].reason
+            );
+        }
     }
 }
 

@@ -158,6 +158,24 @@ fn render_settings_fog_reaches_the_soup() {
 }
 
 #[test]
+fn shadow_strength_is_read_and_kept_within_0_to_1() {
+    let strength = |line: &str| {
+        let mut sc = Scene::default();
+        sc.camera(&Tf::at(0.0, 0.0, 0.0));
+        sc.light(&Tf::at(0.0, 3.0, 0.0), 2, [1.0, 1.0, 1.0], 1);
+        let text = sc.text.replace(
+            "    m_Resolution: -1\n",
+            &format!("    m_Resolution: -1\n{line}"),
+        );
+        convert_scene(&text).lights[0].shadow_strength
+    };
+    assert_eq!(strength(""), 1.0, "Unity's default");
+    assert_eq!(strength("    m_Strength: 0.4\n"), 0.4);
+    assert_eq!(strength("    m_Strength: 1.7\n"), 1.0);
+    assert_eq!(strength("    m_Strength: -2\n"), 0.0);
+}
+
+#[test]
 fn primitives_have_unity_dimensions() {
     let cases = [
         (10202, "Cube", 12, Vec3::splat(-0.5), Vec3::splat(0.5)),
