@@ -19,8 +19,8 @@ pub use kd::{BuildParams, KdFile, KdHeader, KdNode, TreeStats};
 pub use rays::{Hit, RayRecord};
 pub use soup::{
     Alpha, Ambient, AmbientMode, Camera, CastShadows, ClearFlags, Cull, Environment, Fog, FogMode,
-    Light, LightKind, Material, NormalMap, Object, Projection, Shadows, Soup, SoupGeometry,
-    SoupKey,
+    Light, LightKind, Material, NormalMap, Object, ProceduralSky, Projection, Shadows, Soup,
+    SoupGeometry, SoupKey, SunDisk,
 };
 pub use texture::{Texture, TextureRef, Tiling};
 

@@ -86,6 +86,17 @@ fn sample_soup() -> Soup {
         colour: Vec3::new(0.3, 0.4, 0.5),
     });
     s.camera.far = 250.0;
+    s.environment.sky = Some(ProceduralSky {
+        sun_disk: SunDisk::Simple,
+        sun_size: 0.04,
+        sun_size_convergence: 5.0,
+        atmosphere_thickness: 0.5,
+        exposure: 1.3,
+        sky_tint: Vec3::splat(0.2),
+        ground: Vec3::splat(0.1),
+        sun_direction: Vec3::Y,
+        sun_colour: Vec3::ONE,
+    });
     s.warnings = vec!["a warning".into()];
     s.seal();
     s
@@ -816,6 +827,14 @@ fn fog_that_is_not_finite_or_glows_negative_is_corrupt() {
         "fog ExponentialSquared { density: NaN }",
     );
     refused(&|s| fog(s).colour.y = -0.5, "with colour [0.3, -0.5, 0.5]");
+}
+
+#[test]
+fn a_procedural_sky_with_a_non_finite_number_is_corrupt() {
+    refused(
+        &|s| s.environment.sky.as_mut().unwrap().exposure = f32::INFINITY,
+        "holds a non-finite number",
+    );
 }
 
 #[test]

@@ -1,6 +1,7 @@
 //! What the scene's surroundings contribute: the background seen by rays that miss and
 //! the ambient light on surfaces.
 
+use crate::sky::SkyModel;
 use formats::{AmbientMode, ClearFlags, Environment};
 use glam::Vec3;
 
@@ -23,11 +24,13 @@ pub fn trilight(sky: Vec3, equator: Vec3, ground: Vec3, y: f32) -> Vec3 {
 }
 
 /// Radiance of a ray that hits nothing, travelling along unit `dir`: the camera's solid
-/// colour, or for Skybox cameras a sky gradient by the direction's height (the scene's
-/// ambient sky/equator/ground colours, or [`DEFAULT_SKY`] when those are black).
-pub fn background(env: &Environment, dir: Vec3) -> Vec3 {
+/// colour, or for Skybox cameras the procedural sky `sky` where the scene has one, else a
+/// sky gradient by the direction's height (the scene's ambient sky/equator/ground colours,
+/// or [`DEFAULT_SKY`] when those are black).
+pub fn background(env: &Environment, sky: Option<&SkyModel>, dir: Vec3) -> Vec3 {
     match env.clear {
         ClearFlags::SolidColor => env.background,
+        ClearFlags::Skybox if sky.is_some() => sky.map_or(Vec3::ZERO, |s| s.radiance(dir)),
         ClearFlags::Skybox => {
             let a = &env.ambient;
             let [s, e, g] = if a.sky.max(a.equator).max(a.ground).max_element() > 0.0 {

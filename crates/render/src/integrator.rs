@@ -34,11 +34,12 @@ use crate::offset::{
 };
 use crate::plan::{colour_mapped, Plan, ShadowMode};
 use crate::sampling::{DiscSpiral, Rng};
+use crate::sky::SkyModel;
 use crate::soft::{probe_asked, probe_fits, SoftCone};
 use crate::texture::{cone_footprint, Sampler};
 use crate::RenderOptions;
 use crate::TextureFilter;
-use formats::{CastShadows, Hit, Light, Soup, Tiling};
+use formats::{CastShadows, ClearFlags, Hit, Light, Soup, Tiling};
 use glam::{Vec2, Vec3, Vec4};
 use kdtree::triangle::RayPre;
 use kdtree::{Accel, Ray, LANES};
@@ -245,6 +246,8 @@ pub struct Integrator<'a> {
     sides: Vec<u8>,
     /// The scene's fog, when the plan turns it on.
     fog: Option<FogModel>,
+    /// The procedural sky a Skybox camera shows, when the scene has one.
+    sky: Option<SkyModel>,
 }
 
 /// [`Integrator::sides`] bits: camera and reflection rays that meet the triangle's front
@@ -382,6 +385,11 @@ impl<'a> Integrator<'a> {
                 .fog
                 .filter(|_| plan.fog.enabled)
                 .map(|f| FogModel::new(f, &soup.camera)),
+            sky: soup
+                .environment
+                .sky
+                .filter(|_| soup.environment.clear == ClearFlags::Skybox)
+                .map(SkyModel::new),
         }
     }
 
@@ -590,7 +598,7 @@ impl<'a> Integrator<'a> {
     /// The radiance of a ray that leaves the scene along `dir` behind its blended layers.
     #[inline(always)]
     fn beyond(&self, layers: &Layers, dir: Vec3) -> Vec3 {
-        let bg = environment::background(&self.soup.environment, dir);
+        let bg = environment::background(&self.soup.environment, self.sky.as_ref(), dir);
         if layers.through == 1.0 {
             bg
         } else {

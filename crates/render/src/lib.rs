@@ -36,6 +36,7 @@ pub mod plan;
 pub mod preview;
 pub mod render;
 pub mod sampling;
+pub mod sky;
 mod soft;
 pub mod texture;
 

@@ -286,7 +286,17 @@ impl Plan {
 
         let background = match soup.environment.clear {
             ClearFlags::SolidColor => format!("solid colour {}", vec(soup.environment.background)),
-            ClearFlags::Skybox => "sky gradient".into(),
+            ClearFlags::Skybox => match &soup.environment.sky {
+                Some(sky) => format!(
+                    "Unity's procedural sky: sun disk {:?}, atmosphere thickness {}, exposure \
+                     {}, towards the sun {}",
+                    sky.sun_disk,
+                    sky.atmosphere_thickness,
+                    sky.exposure,
+                    vec(sky.sun_direction)
+                ),
+                None => "sky gradient".into(),
+            },
         };
 
         // The shading normal shows through diffuse light (direct, or an ambient that

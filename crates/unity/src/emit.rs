@@ -66,6 +66,9 @@ pub(crate) struct Emitter<'g, 'p> {
     pub(crate) skipped: Vec<String>,
     /// The meshes drawn so far, placed into the soup at the end.
     pub(crate) placements: crate::renderer::Placements,
+    /// Per soup light: the file and fileID of its Light component (RenderSettings names
+    /// the sun so).
+    pub(crate) light_ids: Vec<(usize, i64)>,
 }
 
 /// What [`emit`] produces.
@@ -103,6 +106,7 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
         lod_camera: None,
         skipped: Vec::new(),
         placements: Default::default(),
+        light_ids: Vec::new(),
     };
     e.soup.warnings = g.warnings.clone();
     for (i, o) in g.objs.iter().enumerate() {
@@ -174,6 +178,9 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
                 .warnings
                 .push(format!("{scene_rel}: RenderSettings: {why}")),
         }
+        if e.soup.environment.clear == formats::ClearFlags::Skybox {
+            e.sky(rs);
+        }
     }
     let placements = std::mem::take(&mut e.placements);
     placements.fill(&mut e.soup, &mut e.material_origins);
@@ -184,6 +191,29 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
         material_origins: e.material_origins,
         skipped: e.skipped,
     })
+}
+
+impl Emitter<'_, '_> {
+    /// The procedural sky a Skybox camera shows, aimed at the scene's sun (the top
+    /// scene's file is the graph's first).
+    fn sky(&mut self, rs: &crate::yaml::Node) {
+        match crate::skybox::procedural(rs, self.g.project) {
+            Ok(Some(mut sky)) => {
+                let sun = crate::reference::fref(rs.get("m_Sun")).0;
+                let named = self
+                    .light_ids
+                    .iter()
+                    .position(|&(file, id)| sun != 0 && file == 0 && id == sun);
+                crate::skybox::aim(&mut sky, &self.soup.lights, named);
+                self.soup.environment.sky = Some(sky);
+            }
+            Ok(None) => {}
+            Err(why) => self.soup.warnings.push(format!(
+                "{}: RenderSettings: {why}; a sky gradient stands in",
+                self.scene_rel
+            )),
+        }
+    }
 }
 
 /// A component's `m_Enabled` (on unless it says 0).

@@ -33,6 +33,7 @@ pub mod project;
 pub mod reference;
 pub mod renderer;
 pub mod skinned_renderer;
+pub mod skybox;
 pub mod texture;
 pub mod transform;
 pub mod yaml;

@@ -138,6 +138,7 @@ impl Emitter<'_, '_> {
             .warnings
             .extend(note.map(|n| format!("{what}: {n}")));
         self.soup.lights.push(light);
+        self.light_ids.push((o.file, o.file_id));
         Ok(())
     }
 }

@@ -101,6 +101,7 @@ fn environment(background: Vec3, ambient: Vec3) -> Environment {
             ground: ambient,
         },
         fog: None,
+        sky: None,
     }
 }
 

@@ -452,6 +452,29 @@ fn the_background_is_the_clear_colour_or_a_sky() {
     let top = out.frame.pixel(4, 0);
     assert!(top.z > top.x, "{top}");
     assert_ne!(top, out.frame.pixel(4, 63));
+
+    // With a procedural sky each background pixel is that sky along its camera ray, in
+    // single rays and in packets alike.
+    let sky = formats::ProceduralSky {
+        sun_disk: formats::SunDisk::HighQuality,
+        sun_size: 0.04,
+        sun_size_convergence: 5.0,
+        atmosphere_thickness: 1.0,
+        exposure: 1.3,
+        sky_tint: Vec3::splat(0.214),
+        ground: Vec3::splat(0.11),
+        sun_direction: Vec3::new(0.0, 0.5, 1.0).normalize(),
+        sun_colour: Vec3::ONE,
+    };
+    soup.environment.sky = Some(sky);
+    let out = render_alike_at_tiles(&soup, &kd, &opts(8, 64));
+    let camera = render::CameraModel::new(&soup.camera, 8, 64).unwrap();
+    let model = render::sky::SkyModel::new(sky);
+    for (x, y) in [(4, 0), (2, 40), (7, 63)] {
+        let dir = camera.ray(x as f32 + 0.5, y as f32 + 0.5).dir;
+        assert_eq!(out.frame.pixel(x, y), model.radiance(dir), "({x}, {y})");
+    }
+    assert!(out.frame.pixel(4, 0).z > out.frame.pixel(4, 0).x);
 }
 
 #[test]

@@ -175,6 +175,56 @@ fn shadow_strength_is_read_and_kept_within_0_to_1() {
     assert_eq!(strength("    m_Strength: -2\n"), 0.0);
 }
 
+/// A Skybox camera under Default-Skybox shows Unity's procedural sky, lit by the scene's
+/// directional light; a skybox on another shader is a warning and the gradient stays.
+#[test]
+fn the_default_skybox_is_a_procedural_sky_aimed_at_the_sun() {
+    let skybox = |material: &str| {
+        let mut sc = Scene::default();
+        sc.camera(&Tf::at(0.0, 0.0, 0.0));
+        // Unity's light shines along its local +Z: unrotated, towards +Z.
+        sc.light(&Tf::at(0.0, 3.0, 0.0), 1, [1.0, 1.0, 1.0], 0);
+        sc.raw(&format!(
+            "--- !u!104 &2\nRenderSettings:\n  m_SkyboxMaterial: {material}\n  m_Sun: {{fileID: 0}}\n"
+        ));
+        sc.text
+            .replace("  m_ClearFlags: 2\n", "  m_ClearFlags: 1\n")
+    };
+    let soup = convert_scene(&skybox(
+        "{fileID: 10304, guid: 0000000000000000f000000000000000, type: 0}",
+    ));
+    let sky = soup.environment.sky.expect("Default-Skybox is procedural");
+    assert_eq!(sky.sun_disk, formats::SunDisk::HighQuality);
+    assert_eq!((sky.exposure, sky.atmosphere_thickness), (1.3, 1.0));
+    assert_eq!(sky.sun_direction, -soup.lights[0].direction);
+    assert_eq!(sky.sun_direction, -Vec3::Z);
+    assert_eq!(
+        sky.sun_colour,
+        soup.lights[0].color * soup.lights[0].intensity
+    );
+
+    let cubemap =
+        "--- !u!21 &2100000\nMaterial:\n  m_Shader: {fileID: 103, guid: 0000000000000000f000000000000000, type: 0}\n";
+    let scene = skybox("{fileID: 2100000, guid: 5ca1ab1e5ca1ab1e5ca1ab1e5ca1ab1e, type: 2}");
+    let (_d, root) = project(&[
+        ("Assets/s.unity", scene.as_str()),
+        ("Assets/Sky.mat", cubemap),
+        (
+            "Assets/Sky.mat.meta",
+            "fileFormatVersion: 2\nguid: 5ca1ab1e5ca1ab1e5ca1ab1e5ca1ab1e\n",
+        ),
+    ]);
+    let soup = convert(&root.join("Assets/s.unity"));
+    assert!(soup.environment.sky.is_none());
+    assert!(
+        soup.warnings.iter().any(|w| w.contains(
+            "skybox Assets/Sky.mat is not a Skybox/Procedural material (shader fileID 103)"
+        )),
+        "{:?}",
+        soup.warnings
+    );
+}
+
 #[test]
 fn primitives_have_unity_dimensions() {
     let cases = [
