@@ -338,6 +338,8 @@ pub struct Ambient {
     pub sky: Vec3,
     pub equator: Vec3,
     pub ground: Vec3,
+    /// `m_AmbientIntensity`: it scales the procedural sky's light in Skybox mode.
+    pub intensity: f32,
 }
 
 /// How fog thickens with the fog coordinate `c` (metres): the share of a surface's own
@@ -454,6 +456,7 @@ impl Default for Environment {
                 sky: Vec3::ZERO,
                 equator: Vec3::ZERO,
                 ground: Vec3::ZERO,
+                intensity: 1.0,
             },
             fog: None,
             sky: None,
@@ -618,6 +621,12 @@ impl Soup {
         }
         if let Some(sky) = &self.environment.sky {
             sky.validate()?;
+        }
+        if !self.environment.ambient.intensity.is_finite() {
+            return Err(format!(
+                "ambient intensity {}",
+                self.environment.ambient.intensity
+            ));
         }
         if let Some(i) = self
             .lights

@@ -34,12 +34,12 @@ use crate::offset::{
 };
 use crate::plan::{colour_mapped, Plan, ShadowMode};
 use crate::sampling::{DiscSpiral, Rng};
-use crate::sky::SkyModel;
+use crate::sky::{SkyAmbient, SkyModel};
 use crate::soft::{probe_asked, probe_fits, SoftCone};
 use crate::texture::{cone_footprint, Sampler};
 use crate::RenderOptions;
 use crate::TextureFilter;
-use formats::{CastShadows, ClearFlags, Hit, Light, Soup, Tiling};
+use formats::{AmbientMode, CastShadows, ClearFlags, Hit, Light, Soup, Tiling};
 use glam::{Vec2, Vec3, Vec4};
 use kdtree::triangle::RayPre;
 use kdtree::{Accel, Ray, LANES};
@@ -248,6 +248,8 @@ pub struct Integrator<'a> {
     fog: Option<FogModel>,
     /// The procedural sky a Skybox camera shows, when the scene has one.
     sky: Option<SkyModel>,
+    /// The ambient light of the procedural sky, where the ambient mode is Skybox.
+    sky_ambient: Option<SkyAmbient>,
 }
 
 /// [`Integrator::sides`] bits: camera and reflection rays that meet the triangle's front
@@ -283,6 +285,17 @@ fn sides(soup: &Soup) -> Vec<u8> {
             .fold(0, |b, &(on, bit)| if on { b | bit } else { b })
         })
         .collect()
+}
+
+/// The procedural sky's ambient light, where the plan lights surfaces with skybox ambient.
+pub fn sky_ambient(soup: &Soup, plan: &Plan) -> Option<SkyAmbient> {
+    let env = &soup.environment;
+    let sky = env
+        .sky
+        .filter(|_| env.ambient.mode == AmbientMode::Skybox)?;
+    plan.ambient
+        .enabled
+        .then(|| SkyModel::new(sky).ambient(env.ambient.intensity))
 }
 
 /// Replace NaN and ±Inf channels by 0; true when something was replaced.
@@ -390,6 +403,7 @@ impl<'a> Integrator<'a> {
                 .sky
                 .filter(|_| soup.environment.clear == ClearFlags::Skybox)
                 .map(SkyModel::new),
+            sky_ambient: sky_ambient(soup, plan),
         }
     }
 
@@ -898,7 +912,11 @@ impl<'a> Integrator<'a> {
         // A black albedo cannot show any light: no light is asked, no shadow ray traced.
         let lit = albedo.max_element() > 0.0;
         if lit && self.ambient {
-            l += environment::ambient(&self.soup.environment, ns) * albedo;
+            let ambient = match &self.sky_ambient {
+                Some(sky) => sky.at(ns),
+                None => environment::ambient(&self.soup.environment, ns),
+            };
+            l += ambient * albedo;
         }
         Some(Lit {
             l,

@@ -223,8 +223,11 @@ impl Plan {
         };
 
         let amb = &soup.environment.ambient;
+        // Skybox ambient is the procedural sky's light where the scene has one.
+        let sky_lit = amb.mode == AmbientMode::Skybox && soup.environment.sky.is_some();
         let ambient_on = match amb.mode {
             AmbientMode::Flat => amb.sky.max_element() > 0.0,
+            _ if sky_lit => amb.intensity > 0.0,
             AmbientMode::Trilight | AmbientMode::Skybox => {
                 amb.sky.max(amb.equator).max(amb.ground).max_element() > 0.0
             }
@@ -235,6 +238,12 @@ impl Plan {
                 "the ambient light is black".into()
             } else if !diffuse {
                 "no material has a diffuse albedo".into()
+            } else if sky_lit {
+                format!(
+                    "skybox ambient: the procedural sky's light in nine spherical harmonics, \
+                     intensity {}",
+                    amb.intensity
+                )
             } else {
                 match amb.mode {
                     AmbientMode::Flat => format!("flat ambient {}", vec(amb.sky)),

@@ -70,6 +70,17 @@ impl SkyModel {
 
     /// The sky's radiance along unit direction `eye` (linear RGB).
     pub fn radiance(&self, eye: Vec3) -> Vec3 {
+        let (col, c_out) = self.scattered(eye);
+        if eye.y > 0.0 {
+            col + self.sun(c_out, self.sky.sun_direction, eye)
+        } else {
+            col
+        }
+    }
+
+    /// The light the sky sends down unit direction `eye` without the sun's disk, and the
+    /// Mie colour that scales that disk.
+    fn scattered(&self, eye: Vec3) -> (Vec3, Vec3) {
         let light = self.sky.sun_direction;
         let camera = Vec3::new(0.0, 1.0 + CAMERA_HEIGHT, 0.0);
         let (c_in, c_out) = if eye.y >= 0.0 {
@@ -116,13 +127,84 @@ impl SkyModel {
         let sky = exposure * c_in * (0.75 + 0.75 * cos * cos);
         // Below the horizon the sky fades into the ground within SKY_GROUND_THRESHOLD.
         let y = -eye.y / SKY_GROUND_THRESHOLD;
-        let mut col = sky.lerp(ground, y.clamp(0.0, 1.0));
-        if y < 0.0 {
-            col += self.sun(c_out, light, eye);
-        }
-        col
+        (sky.lerp(ground, y.clamp(0.0, 1.0)), c_out)
     }
 
+    /// The ambient light this sky gives a surface, `intensity` times, as Unity's ambient
+    /// probe holds it: the sky (without the sun's disk, which a few thousand directions
+    /// would alias) projected onto the nine spherical harmonics of bands 0–2 and convolved
+    /// with the cosine lobe.
+    pub fn ambient(&self, intensity: f32) -> SkyAmbient {
+        const ROWS: usize = 64;
+        const COLUMNS: usize = 128;
+        let mut coeffs = [Vec3::ZERO; 9];
+        // Equal-area cells: uniform in height (y) and in azimuth.
+        let area = 4.0 * PI / (ROWS * COLUMNS) as f32;
+        for r in 0..ROWS {
+            let y = 1.0 - 2.0 * (r as f32 + 0.5) / ROWS as f32;
+            let ring = (1.0 - y * y).max(0.0).sqrt();
+            for c in 0..COLUMNS {
+                let phi = 2.0 * PI * (c as f32 + 0.5) / COLUMNS as f32;
+                let dir = Vec3::new(ring * phi.cos(), y, ring * phi.sin());
+                let l = self.scattered(dir).0 * area;
+                for (k, b) in basis(dir).iter().enumerate() {
+                    coeffs[k] += l * *b;
+                }
+            }
+        }
+        // The cosine lobe's bands, divided by π: irradiance as the radiance of a white
+        // surface.
+        for (k, c) in coeffs.iter_mut().enumerate() {
+            let band = [
+                1.0,
+                2.0 / 3.0,
+                2.0 / 3.0,
+                2.0 / 3.0,
+                0.25,
+                0.25,
+                0.25,
+                0.25,
+                0.25,
+            ][k];
+            *c *= band * intensity;
+        }
+        SkyAmbient { coeffs }
+    }
+}
+
+/// The real spherical harmonics of bands 0–2 at unit `d`.
+fn basis(d: Vec3) -> [f32; 9] {
+    [
+        0.282_095,
+        0.488_603 * d.y,
+        0.488_603 * d.z,
+        0.488_603 * d.x,
+        1.092_548 * d.x * d.y,
+        1.092_548 * d.y * d.z,
+        0.315_392 * (3.0 * d.z * d.z - 1.0),
+        1.092_548 * d.x * d.z,
+        0.546_274 * (d.x * d.x - d.y * d.y),
+    ]
+}
+
+/// A procedural sky's ambient light as nine spherical-harmonic coefficients.
+#[derive(Clone, Copy, Debug)]
+pub struct SkyAmbient {
+    coeffs: [Vec3; 9],
+}
+
+impl SkyAmbient {
+    /// The ambient light on a surface with unit normal `n` (never negative).
+    pub fn at(&self, n: Vec3) -> Vec3 {
+        let l = basis(n)
+            .iter()
+            .zip(&self.coeffs)
+            .fold(Vec3::ZERO, |l, (b, c)| l + *c * *b);
+        l.max(Vec3::ZERO)
+    }
+}
+
+impl SkyModel {
     /// The sun's disk seen along `eye`.
     fn sun(&self, c_out: Vec3, light: Vec3, eye: Vec3) -> Vec3 {
         match self.sky.sun_disk {
@@ -179,6 +261,11 @@ mod tests {
         })
     }
 
+    /// Nine harmonics ring at the horizon's step: 0.3 % off for a wall, 6 % for the
+    /// floor's upward face, 10 % for a ceiling lit by the ground (Unity's probe has the
+    /// same nine).
+    const TOLERANCE: f32 = 0.11;
+
     fn close(got: Vec3, want: [f32; 3]) {
         let want = Vec3::from_array(want);
         let err = ((got - want).abs() / want).max_element();
@@ -204,6 +291,37 @@ mod tests {
             sky.radiance(Vec3::new(0.0, s, s)),
             [16.481407, 15.91454, 14.516068],
         );
+    }
+
+    /// The harmonics hold the sky's light on a surface: against a brute-force cosine
+    /// integral of the sky (a 512 × 1024 grid of directions), within what nine harmonics
+    /// can hold of a sky with a sharp horizon ([`TOLERANCE`]).
+    #[test]
+    fn the_ambient_harmonics_hold_the_skys_irradiance() {
+        let sky = default_sky();
+        let ambient = sky.ambient(1.0);
+        let irradiance = |n: Vec3| {
+            let (rows, columns) = (512, 1024);
+            let area = 4.0 * PI / (rows * columns) as f32;
+            let mut e = Vec3::ZERO;
+            for r in 0..rows {
+                let y = 1.0 - 2.0 * (r as f32 + 0.5) / rows as f32;
+                let ring = (1.0 - y * y).sqrt();
+                for c in 0..columns {
+                    let phi = 2.0 * PI * (c as f32 + 0.5) / columns as f32;
+                    let d = Vec3::new(ring * phi.cos(), y, ring * phi.sin());
+                    e += sky.scattered(d).0 * (d.dot(n).max(0.0) * area);
+                }
+            }
+            e / PI
+        };
+        for n in [Vec3::Y, -Vec3::Y, Vec3::X, Vec3::new(0.0, 0.6, 0.8)] {
+            let (got, want) = (ambient.at(n), irradiance(n));
+            let err = ((got - want).abs() / want).max_element();
+            assert!(err < TOLERANCE, "normal {n}: {got} against {want}");
+        }
+        // Twice the intensity, twice the light.
+        assert_eq!(sky.ambient(2.0).at(Vec3::Y), ambient.at(Vec3::Y) * 2.0);
     }
 
     #[test]

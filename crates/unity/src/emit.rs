@@ -178,7 +178,11 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
                 .warnings
                 .push(format!("{scene_rel}: RenderSettings: {why}")),
         }
-        if e.soup.environment.clear == formats::ClearFlags::Skybox {
+        // The skybox shows behind a Skybox camera and lights Skybox ambient.
+        let env = &e.soup.environment;
+        if env.clear == formats::ClearFlags::Skybox
+            || env.ambient.mode == formats::AmbientMode::Skybox
+        {
             e.sky(rs);
         }
     }

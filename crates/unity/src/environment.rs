@@ -26,11 +26,13 @@ pub fn ambient(rs: &Node) -> Option<Ambient> {
         sky: col("m_AmbientSkyColor"),
         equator: col("m_AmbientEquatorColor"),
         ground: col("m_AmbientGroundColor"),
+        intensity,
     };
-    [amb.sky, amb.equator, amb.ground]
+    ([amb.sky, amb.equator, amb.ground]
         .iter()
         .all(|c| c.is_finite())
-        .then_some(amb)
+        && intensity.is_finite())
+    .then_some(amb)
 }
 
 /// The fog a RenderSettings body turns on (`m_Fog: 1`), with Unity's defaults for what it

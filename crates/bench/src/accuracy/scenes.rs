@@ -99,6 +99,7 @@ fn environment(background: Vec3, ambient: Vec3) -> Environment {
             sky: ambient,
             equator: ambient,
             ground: ambient,
+            intensity: 1.0,
         },
         fog: None,
         sky: None,

@@ -343,6 +343,7 @@ fn ambient_lights_a_face_no_light_reaches() {
                 sky: Vec3::new(0.4, 0.4, 0.6),
                 equator: Vec3::new(0.2, 0.1, 0.05),
                 ground: Vec3::new(0.05, 0.05, 0.05),
+                intensity: 1.0,
             };
         }
         let (soup, kd) = s.build();
@@ -384,6 +385,7 @@ fn flat_ambient_and_a_face_turned_down_get_their_colours() {
         sky: Vec3::ONE,
         equator: Vec3::splat(0.5),
         ground,
+        intensity: 1.0,
     };
     let (soup, kd) = s.build();
     let (out, _) = render(&soup, &kd, &opts(8, 8));
@@ -475,6 +477,41 @@ fn the_background_is_the_clear_colour_or_a_sky() {
         assert_eq!(out.frame.pixel(x, y), model.radiance(dir), "({x}, {y})");
     }
     assert!(out.frame.pixel(4, 0).z > out.frame.pixel(4, 0).x);
+}
+
+/// Skybox ambient under a procedural sky is that sky's light, whatever the stored
+/// gradient colours say, scaled by the ambient intensity; the camera may clear to a colour.
+#[test]
+fn skybox_ambient_is_the_procedural_skys_light() {
+    let mut s = floor_scene();
+    let sky = formats::ProceduralSky {
+        sun_disk: formats::SunDisk::HighQuality,
+        sun_size: 0.04,
+        sun_size_convergence: 5.0,
+        atmosphere_thickness: 1.0,
+        exposure: 1.3,
+        sky_tint: Vec3::splat(0.214),
+        ground: Vec3::splat(0.11),
+        sun_direction: Vec3::new(0.0, 0.5, 1.0).normalize(),
+        sun_colour: Vec3::ONE,
+    };
+    s.soup.environment.sky = Some(sky);
+    s.soup.environment.ambient = formats::Ambient {
+        mode: AmbientMode::Skybox,
+        sky: Vec3::ZERO,
+        equator: Vec3::ZERO,
+        ground: Vec3::ZERO,
+        intensity: 1.5,
+    };
+    let (soup, kd) = s.build();
+    let (out, plan) = render(&soup, &kd, &opts(8, 8));
+    assert!(plan.ambient.enabled, "{}", plan.ambient.reason);
+    let want = ALBEDO * render::sky::SkyModel::new(sky).ambient(1.5).at(Vec3::Y);
+    assert_close(out.frame.pixel(4, 4), want, 1e-6, "the floor under the sky");
+    assert!(
+        want.z > want.x && want.x > 0.05,
+        "a bluish sky's light: {want}"
+    );
 }
 
 #[test]

@@ -203,6 +203,23 @@ fn the_default_skybox_is_a_procedural_sky_aimed_at_the_sun() {
         soup.lights[0].color * soup.lights[0].intensity
     );
 
+    // A solid-colour camera still needs the sky for Skybox ambient (mode 0), not for flat.
+    let solid = |mode: u8| {
+        let text = skybox("{fileID: 10304, guid: 0000000000000000f000000000000000, type: 0}")
+            .replace("  m_ClearFlags: 1\n", "  m_ClearFlags: 2\n")
+            .replace(
+                "  m_Sun: {fileID: 0}\n",
+                &format!(
+                    "  m_Sun: {{fileID: 0}}\n  m_AmbientMode: {mode}\n  m_AmbientIntensity: 0.5\n"
+                ),
+            );
+        convert_scene(&text).environment
+    };
+    let env = solid(0);
+    assert!(env.sky.is_some());
+    assert_eq!(env.ambient.intensity, 0.5);
+    assert!(solid(3).sky.is_none());
+
     let cubemap =
         "--- !u!21 &2100000\nMaterial:\n  m_Shader: {fileID: 103, guid: 0000000000000000f000000000000000, type: 0}\n";
     let scene = skybox("{fileID: 2100000, guid: 5ca1ab1e5ca1ab1e5ca1ab1e5ca1ab1e, type: 2}");
