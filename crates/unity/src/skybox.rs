@@ -37,6 +37,9 @@ pub fn procedural(rs: &Node, project: &Project) -> Result<Option<ProceduralSky>,
     if id == 0 {
         return Ok(None);
     }
+    if project.hdrp {
+        return Err("HDRP ignores RenderSettings' skybox (its sky is a Volume override)".into());
+    }
     if guid == BUILTIN_EXTRA && id == DEFAULT_SKYBOX {
         return Ok(Some(default_sky()));
     }

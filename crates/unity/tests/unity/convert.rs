@@ -233,6 +233,24 @@ fn the_default_skybox_is_a_procedural_sky_aimed_at_the_sun() {
     ]);
     let soup = convert(&root.join("Assets/s.unity"));
     assert!(soup.environment.sky.is_none());
+    // HDRP draws its sky from a Volume, whatever RenderSettings names.
+    let default = skybox("{fileID: 10304, guid: 0000000000000000f000000000000000, type: 0}");
+    let (_h, hdrp) = project(&[
+        ("Assets/s.unity", default.as_str()),
+        (
+            "Packages/manifest.json",
+            "{\"dependencies\": {\"com.unity.render-pipelines.high-definition\": \"14.0.9\"}}",
+        ),
+    ]);
+    let hd = convert(&hdrp.join("Assets/s.unity"));
+    assert!(hd.environment.sky.is_none());
+    assert!(
+        hd.warnings
+            .iter()
+            .any(|w| w.contains("HDRP ignores RenderSettings' skybox")),
+        "{:?}",
+        hd.warnings
+    );
     assert!(
         soup.warnings.iter().any(|w| w.contains(
             "skybox Assets/Sky.mat is not a Skybox/Procedural material (shader fileID 103)"
