@@ -352,6 +352,18 @@ pub enum FogMode {
     ExponentialSquared { density: f32 },
 }
 
+impl FogMode {
+    /// Whether its numbers are finite.
+    pub fn is_finite(&self) -> bool {
+        match *self {
+            FogMode::Linear { start, end } => start.is_finite() && end.is_finite(),
+            FogMode::Exponential { density } | FogMode::ExponentialSquared { density } => {
+                density.is_finite()
+            }
+        }
+    }
+}
+
 /// RenderSettings fog: each surface's colour is mixed toward `colour` by its distance.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Fog {
@@ -373,13 +385,7 @@ impl Fog {
     }
 
     fn validate(&self) -> Result<(), String> {
-        let ok = match self.mode {
-            FogMode::Linear { start, end } => start.is_finite() && end.is_finite(),
-            FogMode::Exponential { density } | FogMode::ExponentialSquared { density } => {
-                density.is_finite()
-            }
-        };
-        if !ok || !self.colour.is_finite() || self.colour.min_element() < 0.0 {
+        if !self.mode.is_finite() || !self.colour.is_finite() || self.colour.min_element() < 0.0 {
             return Err(format!("fog {:?} with colour {}", self.mode, self.colour));
         }
         Ok(())

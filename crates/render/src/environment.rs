@@ -28,10 +28,10 @@ pub fn trilight(sky: Vec3, equator: Vec3, ground: Vec3, y: f32) -> Vec3 {
 /// sky gradient by the direction's height (the scene's ambient sky/equator/ground colours,
 /// or [`DEFAULT_SKY`] when those are black).
 pub fn background(env: &Environment, sky: Option<&SkyModel>, dir: Vec3) -> Vec3 {
-    match env.clear {
-        ClearFlags::SolidColor => env.background,
-        ClearFlags::Skybox if sky.is_some() => sky.map_or(Vec3::ZERO, |s| s.radiance(dir)),
-        ClearFlags::Skybox => {
+    match (env.clear, sky) {
+        (ClearFlags::SolidColor, _) => env.background,
+        (ClearFlags::Skybox, Some(sky)) => sky.radiance(dir),
+        (ClearFlags::Skybox, None) => {
             let a = &env.ambient;
             let [s, e, g] = if a.sky.max(a.equator).max(a.ground).max_element() > 0.0 {
                 match a.mode {

@@ -288,7 +288,7 @@ fn sides(soup: &Soup) -> Vec<u8> {
 }
 
 /// The procedural sky's ambient light, where the plan lights surfaces with skybox ambient.
-pub fn sky_ambient(soup: &Soup, plan: &Plan) -> Option<SkyAmbient> {
+fn sky_ambient(soup: &Soup, plan: &Plan) -> Option<SkyAmbient> {
     let env = &soup.environment;
     let sky = env
         .sky

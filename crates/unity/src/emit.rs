@@ -197,29 +197,6 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
     })
 }
 
-impl Emitter<'_, '_> {
-    /// The procedural sky a Skybox camera shows, aimed at the scene's sun (the top
-    /// scene's file is the graph's first).
-    fn sky(&mut self, rs: &crate::yaml::Node) {
-        match crate::skybox::procedural(rs, self.g.project) {
-            Ok(Some(mut sky)) => {
-                let sun = crate::reference::fref(rs.get("m_Sun")).0;
-                let named = self
-                    .light_ids
-                    .iter()
-                    .position(|&(file, id)| sun != 0 && file == 0 && id == sun);
-                crate::skybox::aim(&mut sky, &self.soup.lights, named);
-                self.soup.environment.sky = Some(sky);
-            }
-            Ok(None) => {}
-            Err(why) => self.soup.warnings.push(format!(
-                "{}: RenderSettings: {why}; a sky gradient stands in",
-                self.scene_rel
-            )),
-        }
-    }
-}
-
 /// A component's `m_Enabled` (on unless it says 0).
 pub(crate) fn enabled(o: &Obj) -> bool {
     o.body.i64_at("m_Enabled") != Some(0)

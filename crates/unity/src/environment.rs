@@ -69,13 +69,7 @@ pub fn fog(rs: &Node, hdrp: bool) -> Result<Option<Fog>, String> {
             .and_then(Node::color)
             .unwrap_or(Vec4::new(0.5, 0.5, 0.5, 1.0)),
     );
-    let finite = match mode {
-        FogMode::Linear { start, end } => start.is_finite() && end.is_finite(),
-        FogMode::Exponential { density } | FogMode::ExponentialSquared { density } => {
-            density.is_finite()
-        }
-    };
-    if !finite || !colour.is_finite() {
+    if !mode.is_finite() || !colour.is_finite() {
         return Err(format!(
             "fog {mode:?}, colour {colour} is not finite; drawn without fog"
         ));

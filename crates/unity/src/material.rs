@@ -60,6 +60,11 @@ pub(crate) fn props<'a>(saved: &'a Node, section: &str) -> Vec<(&'a str, &'a Nod
     out
 }
 
+/// The property `name` among [`props`] of one section.
+pub(crate) fn prop<'a>(props: &[(&str, &'a Node)], name: &str) -> Option<&'a Node> {
+    props.iter().find(|(k, _)| *k == name).map(|(_, v)| *v)
+}
+
 /// Whether the material's shader keywords (`m_ShaderKeywords`, or 2021's
 /// `m_ValidKeywords`) include `keyword`; None when the file lists no keywords at all.
 pub(crate) fn keyword_on(body: &Node, keyword: &str) -> Option<bool> {
@@ -87,18 +92,8 @@ pub fn convert(body: &Node, source: &str) -> (Material, Vec<String>) {
     let saved = body.get("m_SavedProperties").unwrap_or(&empty);
     let floats = props(saved, "m_Floats");
     let colors = props(saved, "m_Colors");
-    let float = |n: &str| {
-        floats
-            .iter()
-            .find(|(k, _)| *k == n)
-            .and_then(|(_, v)| v.as_f32())
-    };
-    let color = |n: &str| {
-        colors
-            .iter()
-            .find(|(k, _)| *k == n)
-            .and_then(|(_, v)| v.color())
-    };
+    let float = |n: &str| prop(&floats, n).and_then(Node::as_f32);
+    let color = |n: &str| prop(&colors, n).and_then(Node::color);
 
     if let Some(c) = color("_BaseColor").or_else(|| color("_Color")) {
         m.color = linear_rgb(c);

@@ -2,7 +2,8 @@
 //! Default-Skybox, or a project material on the Skybox/Procedural shader), and the sun
 //! it shows.
 
-use crate::material::{keyword_on, linear_rgb, props};
+use crate::emit::Emitter;
+use crate::material::{keyword_on, linear_rgb, prop, props};
 use crate::project::Project;
 use crate::reference::fref;
 use crate::yaml::Node;
@@ -68,19 +69,8 @@ fn read_material(body: &Node) -> ProceduralSky {
     let saved = body.get("m_SavedProperties");
     let floats = saved.map(|s| props(s, "m_Floats")).unwrap_or_default();
     let colours = saved.map(|s| props(s, "m_Colors")).unwrap_or_default();
-    let float = |k: &str| {
-        floats
-            .iter()
-            .find(|(n, _)| *n == k)
-            .and_then(|(_, v)| v.as_f32())
-    };
-    let colour = |k: &str| {
-        colours
-            .iter()
-            .find(|(n, _)| *n == k)
-            .and_then(|(_, v)| v.color())
-            .map(linear_rgb)
-    };
+    let float = |k: &str| prop(&floats, k).and_then(Node::as_f32);
+    let colour = |k: &str| prop(&colours, k).and_then(Node::color).map(linear_rgb);
     sky.sun_size = float("_SunSize").unwrap_or(sky.sun_size);
     sky.sun_size_convergence = float("_SunSizeConvergence").unwrap_or(sky.sun_size_convergence);
     sky.atmosphere_thickness = float("_AtmosphereThickness").unwrap_or(sky.atmosphere_thickness);
@@ -124,6 +114,29 @@ pub fn aim(sky: &mut ProceduralSky, lights: &[Light], named: Option<usize>) {
     if let Some(sun) = sun {
         sky.sun_direction = -sun.direction;
         sky.sun_colour = sun.color * sun.intensity;
+    }
+}
+
+impl Emitter<'_, '_> {
+    /// The procedural sky RenderSettings `rs` names, aimed at the scene's sun (the top
+    /// scene's file is the graph's first).
+    pub(crate) fn sky(&mut self, rs: &Node) {
+        match procedural(rs, self.g.project) {
+            Ok(Some(mut sky)) => {
+                let sun = fref(rs.get("m_Sun")).0;
+                let named = self
+                    .light_ids
+                    .iter()
+                    .position(|&(file, id)| sun != 0 && file == 0 && id == sun);
+                aim(&mut sky, &self.soup.lights, named);
+                self.soup.environment.sky = Some(sky);
+            }
+            Ok(None) => {}
+            Err(why) => self.soup.warnings.push(format!(
+                "{}: RenderSettings: {why}; a sky gradient stands in",
+                self.scene_rel
+            )),
+        }
     }
 }
 

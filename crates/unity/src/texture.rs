@@ -3,7 +3,7 @@
 //! way Unity's importer would hand it to the shader (power-of-two rounding, size limit,
 //! bottom row first).
 
-use crate::material::props;
+use crate::material::{prop, props};
 use crate::project::{ext, Project};
 use crate::yaml::{self, Node};
 use formats::texture::{Filter, Texture, Tiling, Wrap, MAX_SIDE};
@@ -56,7 +56,7 @@ pub struct TextureSlot {
 /// the material's albedo property is empty (`{fileID: 0}`) or absent.
 pub fn albedo_slot(body: &Node) -> Option<TextureSlot> {
     let envs = tex_envs(body)?;
-    let slot = |name: &str| env_of(&envs, name);
+    let slot = |name: &str| prop(&envs, name);
     // A known shader reads only its own property: an empty one means untextured even
     // when a stale slot from an earlier shader still names a texture.
     if let Some(name) = own_albedo(body) {
@@ -84,10 +84,6 @@ fn tex_envs(body: &Node) -> Option<Vec<(&str, &Node)>> {
     Some(props(body.get("m_SavedProperties")?, "m_TexEnvs"))
 }
 
-fn env_of<'a>(envs: &[(&str, &'a Node)], name: &str) -> Option<&'a Node> {
-    envs.iter().find(|(k, _)| *k == name).map(|(_, v)| *v)
-}
-
 /// The normal map of a Material body and its scale, where the shader samples one: Standard
 /// and URP Lit `_BumpMap` (`_BumpScale`), HDRP Lit `_NormalMap` (`_NormalScale`), only
 /// with the `_NORMALMAP` keyword (or in a file that lists no keywords). Its UVs are tiled
@@ -104,7 +100,7 @@ pub fn normal_slot(body: &Node) -> Option<(TextureSlot, f32)> {
     };
     let found = map_slot(body, texture)?;
     let floats = props(body.get("m_SavedProperties")?, "m_Floats");
-    let scale = env_of(&floats, scale)
+    let scale = prop(&floats, scale)
         .and_then(Node::as_f32)
         .filter(|x| x.is_finite())
         .unwrap_or(1.0);
@@ -124,12 +120,9 @@ pub fn emission_slot(body: &Node) -> Option<TextureSlot> {
 /// map by the main texture's.
 fn map_slot(body: &Node, property: &str) -> Option<TextureSlot> {
     let envs = tex_envs(body)?;
-    let mut found = texture_of(property, env_of(&envs, property)?)?;
-    let main = env_of(&envs, own_albedo(body).unwrap_or("_MainTex")).or_else(|| {
-        ALBEDO_PROPERTIES
-            .iter()
-            .find_map(|name| env_of(&envs, name))
-    });
+    let mut found = texture_of(property, prop(&envs, property)?)?;
+    let main = prop(&envs, own_albedo(body).unwrap_or("_MainTex"))
+        .or_else(|| ALBEDO_PROPERTIES.iter().find_map(|name| prop(&envs, name)));
     found.tiling = main.map_or_else(Tiling::default, tiling_of);
     Some(found)
 }
