@@ -69,8 +69,19 @@ fn read_material(body: &Node) -> ProceduralSky {
     let saved = body.get("m_SavedProperties");
     let floats = saved.map(|s| props(s, "m_Floats")).unwrap_or_default();
     let colours = saved.map(|s| props(s, "m_Colors")).unwrap_or_default();
-    let float = |k: &str| prop(&floats, k).and_then(Node::as_f32);
-    let colour = |k: &str| prop(&colours, k).and_then(Node::color).map(linear_rgb);
+    // A number Unity cannot have written (NaN, infinite) leaves the shader's default, so
+    // the soup stays one every reader takes.
+    let float = |k: &str| {
+        prop(&floats, k)
+            .and_then(Node::as_f32)
+            .filter(|x| x.is_finite())
+    };
+    let colour = |k: &str| {
+        prop(&colours, k)
+            .and_then(Node::color)
+            .map(linear_rgb)
+            .filter(|c| c.is_finite())
+    };
     sky.sun_size = float("_SunSize").unwrap_or(sky.sun_size);
     sky.sun_size_convergence = float("_SunSizeConvergence").unwrap_or(sky.sun_size_convergence);
     sky.atmosphere_thickness = float("_AtmosphereThickness").unwrap_or(sky.atmosphere_thickness);
@@ -157,6 +168,19 @@ mod tests {
         assert_eq!(sky.sun_disk, SunDisk::Simple);
         assert_eq!(sky.sun_size, 0.04, "the shader's default");
         assert_eq!(sky.ground, default_sky().ground);
+    }
+
+    #[test]
+    fn a_property_that_is_not_a_finite_number_keeps_the_default() {
+        let m = parse(
+            "Material:\n  m_SavedProperties:\n    m_Floats:\n    - _Exposure: NaN\n    - _SunSize: Infinity\n    m_Colors:\n    - _SkyTint: {r: NaN, g: 1, b: 1, a: 1}\n",
+        );
+        let sky = read_material(m.get("Material").unwrap());
+        let default = default_sky();
+        assert_eq!(
+            (sky.exposure, sky.sun_size, sky.sky_tint),
+            (default.exposure, default.sun_size, default.sky_tint)
+        );
     }
 
     #[test]
