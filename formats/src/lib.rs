@@ -8,6 +8,7 @@ pub mod envelope;
 pub mod error;
 pub mod kd;
 pub mod rays;
+pub mod sky;
 pub mod soup;
 pub mod srgb;
 pub mod texture;
@@ -17,10 +18,11 @@ pub use envelope::write_atomic;
 pub use error::FormatError;
 pub use kd::{BuildParams, KdFile, KdHeader, KdNode, TreeStats};
 pub use rays::{Hit, RayRecord};
+pub use sky::{Panorama, ProceduralSky, Sky, SkyImage, SkyLayout, SunDisk, TexturedSky};
 pub use soup::{
     Alpha, Ambient, AmbientMode, Camera, CastShadows, ClearFlags, Cull, Environment, Fog, FogMode,
-    Light, LightKind, Material, NormalMap, Object, ProceduralSky, Projection, Shadows, Soup,
-    SoupGeometry, SoupKey, SunDisk,
+    Light, LightKind, Material, NormalMap, Object, Projection, Shadows, Soup, SoupGeometry,
+    SoupKey,
 };
 pub use texture::{Texture, TextureRef, Tiling};
 

@@ -4,6 +4,7 @@
 //! corners per triangle to write, hash, read and keep in memory. Right-handed, Y up, metres: Unity's left-handed positions with X negated, so an
 //! OBJ placed at the identity in Unity keeps its file's coordinates. Colours are linear RGB.
 
+use crate::sky::Sky;
 use crate::texture::{Texture, TextureRef};
 use crate::{envelope, Digest, FormatError};
 use glam::{Vec2, Vec3};
@@ -11,7 +12,7 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 pub const MAGIC: &[u8; 8] = b"UTSOUP\0\0";
-pub const VERSION: u32 = 6;
+pub const VERSION: u32 = 7;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Soup {
@@ -392,55 +393,6 @@ impl Fog {
     }
 }
 
-/// Which sun disk Unity's procedural sky draws (its `_SUNDISK_*` keyword).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub enum SunDisk {
-    None,
-    Simple,
-    HighQuality,
-}
-
-/// A Skybox/Procedural material's settings and the sun it shows: what a Skybox camera sees
-/// where no surface is.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct ProceduralSky {
-    pub sun_disk: SunDisk,
-    /// `_SunSize`, `_SunSizeConvergence`, `_AtmosphereThickness`, `_Exposure`.
-    pub sun_size: f32,
-    pub sun_size_convergence: f32,
-    pub atmosphere_thickness: f32,
-    pub exposure: f32,
-    /// `_SkyTint` and `_GroundColor`, linear RGB.
-    pub sky_tint: Vec3,
-    pub ground: Vec3,
-    /// Unit vector towards the sun light (Unity's `_WorldSpaceLightPos0`).
-    pub sun_direction: Vec3,
-    /// The sun light's colour × intensity, linear RGB; black without a sun.
-    pub sun_colour: Vec3,
-}
-
-impl ProceduralSky {
-    fn validate(&self) -> Result<(), String> {
-        let numbers = [
-            self.sun_size,
-            self.sun_size_convergence,
-            self.atmosphere_thickness,
-            self.exposure,
-        ];
-        let colours = [
-            self.sky_tint,
-            self.ground,
-            self.sun_direction,
-            self.sun_colour,
-        ];
-        if numbers.iter().all(|x| x.is_finite()) && colours.iter().all(|c| c.is_finite()) {
-            Ok(())
-        } else {
-            Err(format!("procedural sky {self:?} holds a non-finite number"))
-        }
-    }
-}
-
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Environment {
     pub clear: ClearFlags,
@@ -448,8 +400,8 @@ pub struct Environment {
     pub background: Vec3,
     pub ambient: Ambient,
     pub fog: Option<Fog>,
-    /// RenderSettings' skybox, when it is a procedural sky.
-    pub sky: Option<ProceduralSky>,
+    /// RenderSettings' skybox, when it is one the renderer draws.
+    pub sky: Option<Sky>,
 }
 
 impl Default for Environment {

@@ -86,7 +86,7 @@ fn sample_soup() -> Soup {
         colour: Vec3::new(0.3, 0.4, 0.5),
     });
     s.camera.far = 250.0;
-    s.environment.sky = Some(ProceduralSky {
+    s.environment.sky = Some(Sky::Procedural(ProceduralSky {
         sun_disk: SunDisk::Simple,
         sun_size: 0.04,
         sun_size_convergence: 5.0,
@@ -96,7 +96,7 @@ fn sample_soup() -> Soup {
         ground: Vec3::splat(0.1),
         sun_direction: Vec3::Y,
         sun_colour: Vec3::ONE,
-    });
+    }));
     s.warnings = vec!["a warning".into()];
     s.seal();
     s
@@ -131,7 +131,7 @@ fn soup_round_trips_through_a_file() {
     assert_eq!(Soup::read(&path).unwrap(), s);
     let bytes = std::fs::read(&path).unwrap();
     assert_eq!(&bytes[..8], b"UTSOUP\0\0");
-    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 6);
+    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 7);
     // Nothing but the artifact is left in the folder (the temp file was renamed).
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
 }
@@ -761,13 +761,13 @@ fn atomic_outputs_get_the_umask_permissions_not_the_temporary_files() {
 }
 
 #[test]
-fn a_version_5_soup_is_refused_with_the_versions_named() {
+fn a_version_6_soup_is_refused_with_the_versions_named() {
     let p = Path::new("old.soup");
     let mut b = sample_soup().to_bytes(p).unwrap();
-    b[8..12].copy_from_slice(&5u32.to_le_bytes());
+    b[8..12].copy_from_slice(&6u32.to_le_bytes());
     let msg = Soup::from_bytes(&b, p).unwrap_err().to_string();
     assert!(
-        msg.contains("soup format version 5, this build reads version 6"),
+        msg.contains("soup format version 6, this build reads version 7"),
         "{msg}"
     );
     assert!(msg.contains("re-run the stage that made it"), "{msg}");
@@ -832,8 +832,90 @@ fn fog_that_is_not_finite_or_glows_negative_is_corrupt() {
 #[test]
 fn a_procedural_sky_with_a_non_finite_number_is_corrupt() {
     refused(
-        &|s| s.environment.sky.as_mut().unwrap().exposure = f32::INFINITY,
+        &|s| {
+            if let Some(Sky::Procedural(p)) = &mut s.environment.sky {
+                p.exposure = f32::INFINITY;
+            }
+        },
         "holds a non-finite number",
+    );
+}
+
+fn image_sky(layout: SkyLayout) -> Sky {
+    Sky::Textured(TexturedSky {
+        scale: Vec3::splat(0.98),
+        rotation: 30.0,
+        layout,
+    })
+}
+
+fn sky_image(w: u32, h: u32) -> SkyImage {
+    let rgb: Vec<Vec3> = (0..w * h).map(|i| Vec3::splat(i as f32 * 0.25)).collect();
+    SkyImage::from_linear("sky.hdr", w, h, &rgb)
+}
+
+#[test]
+fn an_image_sky_survives_the_round_trip_byte_for_byte() {
+    let p = Path::new("sky.soup");
+    let mut s = sample_soup();
+    s.environment.sky = Some(image_sky(SkyLayout::LatLong {
+        image: sky_image(4, 2),
+        panorama: Panorama::HalfMirrored,
+    }));
+    s.seal();
+    let b = s.to_bytes(p).unwrap();
+    let back = Soup::from_bytes(&b, p).unwrap();
+    assert_eq!(back, s);
+    let Some(Sky::Textured(t)) = &back.environment.sky else {
+        panic!("not an image sky");
+    };
+    let SkyLayout::LatLong { image, .. } = &t.layout else {
+        panic!("not latitude-longitude");
+    };
+    // Texel 5 is 1.25 = 160·2^−7: mantissa 160, exponent byte 128 + 1.
+    assert_eq!(&image.texels[20..24], &[160, 160, 160, 129]);
+    assert_eq!(image.texel(1, 1), Vec3::splat(1.25));
+}
+
+#[test]
+fn an_image_sky_with_a_bad_image_or_number_is_corrupt() {
+    let cube = |faces: Vec<SkyImage>| {
+        move |s: &mut Soup| {
+            s.environment.sky = Some(image_sky(SkyLayout::Cube {
+                faces: faces.clone(),
+            }))
+        }
+    };
+    refused(&cube(vec![sky_image(2, 2); 5]), "a cube sky with 5 faces");
+    let mut short = vec![sky_image(2, 2); 6];
+    short[3].texels.pop();
+    refused(&cube(short), "15 texel bytes for 2x2 (want 16)");
+    let mut empty = vec![sky_image(2, 2); 6];
+    empty[0].width = 0;
+    refused(&cube(empty), "sky image sky.hdr: 0x2");
+    refused(
+        &|s| {
+            let mut sky = image_sky(SkyLayout::Cube {
+                faces: vec![sky_image(1, 1); 6],
+            });
+            if let Sky::Textured(t) = &mut sky {
+                t.rotation = f32::NAN;
+            }
+            s.environment.sky = Some(sky);
+        },
+        "sky rotation NaN",
+    );
+    refused(
+        &|s| {
+            let mut sky = image_sky(SkyLayout::Cube {
+                faces: vec![sky_image(1, 1); 6],
+            });
+            if let Sky::Textured(t) = &mut sky {
+                t.scale.y = -1.0;
+            }
+            s.environment.sky = Some(sky);
+        },
+        "is not a colour",
     );
 }
 

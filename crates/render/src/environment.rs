@@ -1,7 +1,7 @@
 //! What the scene's surroundings contribute: the background seen by rays that miss and
 //! the ambient light on surfaces.
 
-use crate::sky::SkyModel;
+use crate::sky::Skybox;
 use formats::{AmbientMode, ClearFlags, Environment};
 use glam::Vec3;
 
@@ -24,10 +24,10 @@ pub fn trilight(sky: Vec3, equator: Vec3, ground: Vec3, y: f32) -> Vec3 {
 }
 
 /// Radiance of a ray that hits nothing, travelling along unit `dir`: the camera's solid
-/// colour, or for Skybox cameras the procedural sky `sky` where the scene has one, else a
+/// colour, or for Skybox cameras the skybox `sky` where the scene has one, else a
 /// sky gradient by the direction's height (the scene's ambient sky/equator/ground colours,
 /// or [`DEFAULT_SKY`] when those are black).
-pub fn background(env: &Environment, sky: Option<&SkyModel>, dir: Vec3) -> Vec3 {
+pub fn background(env: &Environment, sky: Option<&Skybox>, dir: Vec3) -> Vec3 {
     match (env.clear, sky) {
         (ClearFlags::SolidColor, _) => env.background,
         (ClearFlags::Skybox, Some(sky)) => sky.radiance(dir),

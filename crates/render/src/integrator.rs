@@ -34,7 +34,7 @@ use crate::offset::{
 };
 use crate::plan::{colour_mapped, Plan, ShadowMode};
 use crate::sampling::{DiscSpiral, Rng};
-use crate::sky::{SkyAmbient, SkyModel};
+use crate::sky::{SkyAmbient, Skybox};
 use crate::soft::{probe_asked, probe_fits, SoftCone};
 use crate::texture::{cone_footprint, Sampler};
 use crate::RenderOptions;
@@ -246,9 +246,9 @@ pub struct Integrator<'a> {
     sides: Vec<u8>,
     /// The scene's fog, when the plan turns it on.
     fog: Option<FogModel>,
-    /// The procedural sky a Skybox camera shows, when the scene has one.
-    sky: Option<SkyModel>,
-    /// The ambient light of the procedural sky, where the ambient mode is Skybox.
+    /// The skybox a Skybox camera shows, when the scene has one.
+    sky: Option<Skybox<'a>>,
+    /// The ambient light of the skybox, where the ambient mode is Skybox.
     sky_ambient: Option<SkyAmbient>,
 }
 
@@ -287,15 +287,16 @@ fn sides(soup: &Soup) -> Vec<u8> {
         .collect()
 }
 
-/// The procedural sky's ambient light, where the plan lights surfaces with skybox ambient.
+/// The skybox's ambient light, where the plan lights surfaces with skybox ambient.
 fn sky_ambient(soup: &Soup, plan: &Plan) -> Option<SkyAmbient> {
     let env = &soup.environment;
     let sky = env
         .sky
+        .as_ref()
         .filter(|_| env.ambient.mode == AmbientMode::Skybox)?;
     plan.ambient
         .enabled
-        .then(|| SkyModel::new(sky).ambient(env.ambient.intensity))
+        .then(|| Skybox::new(sky).ambient(env.ambient.intensity))
 }
 
 /// Replace NaN and ±Inf channels by 0; true when something was replaced.
@@ -401,8 +402,9 @@ impl<'a> Integrator<'a> {
             sky: soup
                 .environment
                 .sky
+                .as_ref()
                 .filter(|_| soup.environment.clear == ClearFlags::Skybox)
-                .map(SkyModel::new),
+                .map(Skybox::new),
             sky_ambient: sky_ambient(soup, plan),
         }
     }

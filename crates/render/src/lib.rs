@@ -37,6 +37,7 @@ pub mod preview;
 pub mod render;
 pub mod sampling;
 pub mod sky;
+pub mod sky_image;
 mod soft;
 pub mod texture;
 

@@ -5,7 +5,8 @@
 use crate::alpha::{alpha_use, min_alphas, AlphaUse};
 use crate::{RenderOptions, TextureFilter};
 use formats::{
-    AmbientMode, CastShadows, ClearFlags, Cull, Fog, FogMode, LightKind, Material, Shadows, Soup,
+    AmbientMode, CastShadows, ClearFlags, Cull, Fog, FogMode, LightKind, Material, Panorama,
+    Shadows, Sky, SkyLayout, Soup,
 };
 use glam::Vec3;
 use serde::Serialize;
@@ -149,6 +150,29 @@ pub struct Plan {
 
 fn vec(v: Vec3) -> String {
     format!("({:.3}, {:.3}, {:.3})", v.x, v.y, v.z)
+}
+
+/// An image sky's images, for the plan.
+fn sky_images(layout: &SkyLayout) -> String {
+    match layout {
+        SkyLayout::LatLong { image, panorama } => format!(
+            "latitude-longitude sky {} ({}x{}{})",
+            image.source,
+            image.width,
+            image.height,
+            match panorama {
+                Panorama::Full => "",
+                Panorama::Half => ", 180°, black behind",
+                Panorama::HalfMirrored => ", 180°, mirrored behind",
+            }
+        ),
+        SkyLayout::Cube { faces } => format!(
+            "cube sky of {} faces ({}x{} first)",
+            faces.len(),
+            faces.first().map_or(0, |f| f.width),
+            faces.first().map_or(0, |f| f.height)
+        ),
+    }
 }
 
 impl Plan {
@@ -296,13 +320,19 @@ impl Plan {
         let background = match soup.environment.clear {
             ClearFlags::SolidColor => format!("solid colour {}", vec(soup.environment.background)),
             ClearFlags::Skybox => match &soup.environment.sky {
-                Some(sky) => format!(
+                Some(Sky::Procedural(sky)) => format!(
                     "Unity's procedural sky: sun disk {:?}, atmosphere thickness {}, exposure \
                      {}, towards the sun {}",
                     sky.sun_disk,
                     sky.atmosphere_thickness,
                     sky.exposure,
                     vec(sky.sun_direction)
+                ),
+                Some(Sky::Textured(sky)) => format!(
+                    "{}, times {}, turned {}°",
+                    sky_images(&sky.layout),
+                    vec(sky.scale),
+                    sky.rotation
                 ),
                 None => "sky gradient".into(),
             },

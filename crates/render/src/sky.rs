@@ -4,7 +4,8 @@
 //! constants), the ground below the horizon, and the sun's disk. Unity evaluates the
 //! scattering at the sky mesh's vertices and interpolates; here each ray gets its own.
 
-use formats::{ProceduralSky, SunDisk};
+use crate::sky_image::ImageSky;
+use formats::{ProceduralSky, Sky, SunDisk};
 use glam::Vec3;
 use std::f32::consts::PI;
 
@@ -137,38 +138,19 @@ impl SkyModel {
     pub fn ambient(&self, intensity: f32) -> SkyAmbient {
         const ROWS: usize = 64;
         const COLUMNS: usize = 128;
-        let mut coeffs = [Vec3::ZERO; 9];
         // Equal-area cells: uniform in height (y) and in azimuth.
         let area = 4.0 * PI / (ROWS * COLUMNS) as f32;
-        for r in 0..ROWS {
-            let y = 1.0 - 2.0 * (r as f32 + 0.5) / ROWS as f32;
-            let ring = (1.0 - y * y).max(0.0).sqrt();
-            for c in 0..COLUMNS {
-                let phi = 2.0 * PI * (c as f32 + 0.5) / COLUMNS as f32;
-                let dir = Vec3::new(ring * phi.cos(), y, ring * phi.sin());
-                let l = self.scattered(dir).0 * area;
-                for (k, b) in basis(dir).iter().enumerate() {
-                    coeffs[k] += l * *b;
+        SkyAmbient::project(intensity, |add| {
+            for r in 0..ROWS {
+                let y = 1.0 - 2.0 * (r as f32 + 0.5) / ROWS as f32;
+                let ring = (1.0 - y * y).max(0.0).sqrt();
+                for c in 0..COLUMNS {
+                    let phi = 2.0 * PI * (c as f32 + 0.5) / COLUMNS as f32;
+                    let dir = Vec3::new(ring * phi.cos(), y, ring * phi.sin());
+                    add(dir, self.scattered(dir).0 * area);
                 }
             }
-        }
-        // The cosine lobe's bands, divided by π: irradiance as the radiance of a white
-        // surface.
-        for (k, c) in coeffs.iter_mut().enumerate() {
-            let band = [
-                1.0,
-                2.0 / 3.0,
-                2.0 / 3.0,
-                2.0 / 3.0,
-                0.25,
-                0.25,
-                0.25,
-                0.25,
-                0.25,
-            ][k];
-            *c *= band * intensity;
-        }
-        SkyAmbient { coeffs }
+        })
     }
 }
 
@@ -187,13 +169,40 @@ fn basis(d: Vec3) -> [f32; 9] {
     ]
 }
 
-/// A procedural sky's ambient light as nine spherical-harmonic coefficients.
+/// A sky's ambient light as nine spherical-harmonic coefficients.
 #[derive(Clone, Copy, Debug)]
 pub struct SkyAmbient {
     coeffs: [Vec3; 9],
 }
 
 impl SkyAmbient {
+    /// The harmonics of the radiance `sample` hands over, each as a unit direction and
+    /// its radiance times the solid angle it stands for, convolved with the cosine lobe
+    /// and divided by π (irradiance as the radiance of a white surface), `intensity` times.
+    pub fn project(intensity: f32, sample: impl FnOnce(&mut dyn FnMut(Vec3, Vec3))) -> Self {
+        let mut coeffs = [Vec3::ZERO; 9];
+        sample(&mut |dir, l| {
+            for (k, b) in basis(dir).iter().enumerate() {
+                coeffs[k] += l * *b;
+            }
+        });
+        const BANDS: [f32; 9] = [
+            1.0,
+            2.0 / 3.0,
+            2.0 / 3.0,
+            2.0 / 3.0,
+            0.25,
+            0.25,
+            0.25,
+            0.25,
+            0.25,
+        ];
+        for (c, band) in coeffs.iter_mut().zip(BANDS) {
+            *c *= band * intensity;
+        }
+        SkyAmbient { coeffs }
+    }
+
     /// The ambient light on a surface with unit normal `n` (never negative).
     pub fn at(&self, n: Vec3) -> Vec3 {
         let l = basis(n)
@@ -201,6 +210,38 @@ impl SkyAmbient {
             .zip(&self.coeffs)
             .fold(Vec3::ZERO, |l, (b, c)| l + *c * *b);
         l.max(Vec3::ZERO)
+    }
+}
+
+/// RenderSettings' skybox, ready to draw.
+#[derive(Clone, Copy, Debug)]
+pub enum Skybox<'a> {
+    Procedural(SkyModel),
+    Image(ImageSky<'a>),
+}
+
+impl<'a> Skybox<'a> {
+    pub fn new(sky: &'a Sky) -> Self {
+        match sky {
+            Sky::Procedural(p) => Skybox::Procedural(SkyModel::new(*p)),
+            Sky::Textured(t) => Skybox::Image(ImageSky::new(t)),
+        }
+    }
+
+    /// Radiance along unit direction `dir`.
+    pub fn radiance(&self, dir: Vec3) -> Vec3 {
+        match self {
+            Skybox::Procedural(p) => p.radiance(dir),
+            Skybox::Image(i) => i.radiance(dir),
+        }
+    }
+
+    /// The sky's ambient light, `intensity` times.
+    pub fn ambient(&self, intensity: f32) -> SkyAmbient {
+        match self {
+            Skybox::Procedural(p) => p.ambient(intensity),
+            Skybox::Image(i) => i.ambient(intensity),
+        }
     }
 }
 

@@ -28,7 +28,7 @@ pub enum TextureError {
     Read { path: String, message: String },
     #[error("{path}: a Git LFS pointer, not the texture itself")]
     LfsPointer { path: String },
-    #[error("{path}: .{ext} textures are not supported (png, jpg, tga, tif, exr, psd are)")]
+    #[error("{path}: .{ext} textures are not supported (png, jpg, tga, tif, exr, hdr, psd are)")]
     Unsupported { path: String, ext: String },
     #[error("{path}: not a readable {format} image: {message}")]
     Decode {
@@ -127,6 +127,11 @@ fn map_slot(body: &Node, property: &str) -> Option<TextureSlot> {
     Some(found)
 }
 
+/// The texture a material's `property` names, with that property's own tiling.
+pub fn named_slot(body: &Node, property: &str) -> Option<TextureSlot> {
+    texture_of(property, prop(&tex_envs(body)?, property)?)
+}
+
 fn texture_of(property: &str, env: &Node) -> Option<TextureSlot> {
     let tex = env.get("m_Texture")?;
     if tex.i64_at("fileID").unwrap_or(0) == 0 {
@@ -181,6 +186,11 @@ pub struct Import {
     /// `bumpmap.flipGreenChannel` on a normal map (`textureType: 1`): the image's green
     /// channel points along decreasing v (DirectX's convention) and is inverted on import.
     pub flip_green: bool,
+    /// `textureShape: 2`: imported as a cubemap, laid out as `generateCubemap` says.
+    pub cube: bool,
+    /// `generateCubemap`: 1 sphere map, 2 cylindrical (latitude-longitude), 5 six faces,
+    /// 6 (the default) chosen by the image's aspect.
+    pub cube_mapping: i64,
 }
 
 impl Default for Import {
@@ -196,6 +206,8 @@ impl Default for Import {
             alpha_is_transparency: false,
             from_grayscale: false,
             flip_green: false,
+            cube: false,
+            cube_mapping: 6,
         }
     }
 }
@@ -283,6 +295,8 @@ impl Import {
         let bumpmap = |key: &str| imp.get("bumpmap").and_then(|b| b.i64_at(key)) == Some(1);
         im.from_grayscale = bumpmap("convertToNormalMap");
         im.flip_green = bumpmap("flipGreenChannel") && imp.i64_at("textureType") == Some(1);
+        im.cube = imp.i64_at("textureShape") == Some(2);
+        im.cube_mapping = imp.i64_at("generateCubemap").unwrap_or(6);
         im
     }
 
@@ -364,13 +378,14 @@ pub fn load(path: &Path, source: &str, import: &Import) -> Result<Texture, Textu
     decode(&bytes, &ext(path), source, import)
 }
 
-/// [`load`] on bytes already read, with the file's extension (lower case, no dot).
-pub fn decode(
+/// The image in `bytes` (a file with extension `extension`, lower case, no dot, named
+/// `source` in errors) as decoded, its size checked before anything is allocated, and
+/// whether its samples are floats (linear light).
+pub fn decode_image(
     bytes: &[u8],
     extension: &str,
     source: &str,
-    import: &Import,
-) -> Result<Texture, TextureError> {
+) -> Result<(DynamicImage, bool), TextureError> {
     if bytes.starts_with(b"version https://git-lfs.github.com/spec/") {
         return Err(TextureError::LfsPointer {
             path: source.to_string(),
@@ -386,7 +401,7 @@ pub fn decode(
         width,
         height,
     };
-    let (image, float) = if extension == "psd" {
+    Ok(if extension == "psd" {
         let (w, h) = psd_size(bytes).ok_or_else(|| decode_err("PSD", "no PSD header".into()))?;
         if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
             return Err(too_large(w, h));
@@ -403,6 +418,7 @@ pub fn decode(
             "tga" => ImageFormat::Tga,
             "tif" | "tiff" => ImageFormat::Tiff,
             "exr" => ImageFormat::OpenExr,
+            "hdr" => ImageFormat::Hdr,
             _ => {
                 return Err(TextureError::Unsupported {
                     path: source.to_string(),
@@ -440,7 +456,68 @@ pub fn decode(
             DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_)
         );
         (img, float)
+    })
+}
+
+/// An image as linear RGB, bottom row first: what a sky reads.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LinearImage {
+    pub width: u32,
+    pub height: u32,
+    pub rgb: Vec<glam::Vec3>,
+}
+
+/// The image at `path` (named `source`) as linear RGB, at the size `import` gives it when
+/// `resize`, else at its own: float images as they are, 8-bit ones decoded from sRGB when
+/// the import says so.
+pub fn load_linear(
+    path: &Path,
+    source: &str,
+    import: &Import,
+    resize: bool,
+) -> Result<LinearImage, TextureError> {
+    let bytes = std::fs::read(path).map_err(|e| TextureError::Read {
+        path: source.to_string(),
+        message: e.to_string(),
+    })?;
+    let (image, float) = decode_image(&bytes, &ext(path), source)?;
+    let mut img = image.into_rgb32f();
+    if !float && import.srgb {
+        img.pixels_mut().for_each(|p| {
+            p.0 =
+                p.0.map(|c| formats::texture::decode_u8((c * 255.0).round() as u8, true))
+        });
+    }
+    let (w, h) = if resize {
+        import.imported_size(img.width(), img.height())
+    } else {
+        img.dimensions()
     };
+    if (w, h) != img.dimensions() {
+        img = image::imageops::resize(&img, w, h, image::imageops::FilterType::Triangle);
+    }
+    let row = w as usize;
+    let texels: Vec<glam::Vec3> = img.pixels().map(|p| glam::Vec3::from_array(p.0)).collect();
+    Ok(LinearImage {
+        width: w,
+        height: h,
+        rgb: texels.chunks_exact(row).rev().flatten().copied().collect(),
+    })
+}
+
+/// [`load`] on bytes already read, with the file's extension (lower case, no dot).
+pub fn decode(
+    bytes: &[u8],
+    extension: &str,
+    source: &str,
+    import: &Import,
+) -> Result<Texture, TextureError> {
+    let decode_err = |format: &str, message: String| TextureError::Decode {
+        path: source.to_string(),
+        format: format.to_string(),
+        message,
+    };
+    let (image, float) = decode_image(bytes, extension, source)?;
     let (w, h) = import.imported_size(image.width(), image.height());
     let filter = image::imageops::FilterType::Triangle;
     // Float images hold linear light: stored sRGB-encoded, 8 bits lose least there.
@@ -818,6 +895,8 @@ m_SavedProperties:
     convertToNormalMap: 1
     flipGreenChannel: 1
   textureType: 1
+  textureShape: 2
+  generateCubemap: 2
   platformSettings:
   - buildTarget: DefaultTexturePlatform
     maxTextureSize: 256
@@ -836,6 +915,8 @@ m_SavedProperties:
                 alpha_is_transparency: true,
                 from_grayscale: true,
                 flip_green: true,
+                cube: true,
+                cube_mapping: 2,
             }
         );
         let old = Import::parse(

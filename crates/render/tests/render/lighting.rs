@@ -468,7 +468,7 @@ fn the_background_is_the_clear_colour_or_a_sky() {
         sun_direction: Vec3::new(0.0, 0.5, 1.0).normalize(),
         sun_colour: Vec3::ONE,
     };
-    soup.environment.sky = Some(sky);
+    soup.environment.sky = Some(formats::Sky::Procedural(sky));
     let out = render_alike_at_tiles(&soup, &kd, &opts(8, 64));
     let camera = render::CameraModel::new(&soup.camera, 8, 64).unwrap();
     let model = render::sky::SkyModel::new(sky);
@@ -495,7 +495,7 @@ fn skybox_ambient_is_the_procedural_skys_light() {
         sun_direction: Vec3::new(0.0, 0.5, 1.0).normalize(),
         sun_colour: Vec3::ONE,
     };
-    s.soup.environment.sky = Some(sky);
+    s.soup.environment.sky = Some(formats::Sky::Procedural(sky));
     s.soup.environment.ambient = formats::Ambient {
         mode: AmbientMode::Skybox,
         sky: Vec3::ZERO,
@@ -511,6 +511,74 @@ fn skybox_ambient_is_the_procedural_skys_light() {
     assert!(
         want.z > want.x && want.x > 0.05,
         "a bluish sky's light: {want}"
+    );
+}
+
+/// A sky from images: each background pixel is the image sky along its camera ray (single
+/// rays and packets alike), the plan names the image, and Skybox ambient under a uniform
+/// image is that image's radiance times the tint, exposure and ambient intensity.
+#[test]
+fn an_image_sky_is_the_background_and_the_skybox_ambient() {
+    use formats::{Panorama, Sky, SkyImage, SkyLayout, TexturedSky};
+    let rgb: Vec<Vec3> = (0..64 * 32)
+        .map(|i| Vec3::new((i % 64) as f32, (i / 64) as f32, 1.0) * 0.25)
+        .collect();
+    let gradient = TexturedSky {
+        scale: Vec3::new(0.98, 0.9, 1.1),
+        rotation: 40.0,
+        layout: SkyLayout::LatLong {
+            image: SkyImage::from_linear("Assets/Sky.hdr", 64, 32, &rgb),
+            panorama: Panorama::Full,
+        },
+    };
+    let mut s = SceneBuilder::new();
+    let m = s.diffuse(Vec3::ONE);
+    s.floor(-100.0, 0.0, 0.0, 1.0, m);
+    let (mut soup, kd) = s.build();
+    soup.environment.clear = formats::ClearFlags::Skybox;
+    soup.environment.sky = Some(Sky::Textured(gradient.clone()));
+    let out = render_alike_at_tiles(&soup, &kd, &opts(16, 16));
+    let camera = render::CameraModel::new(&soup.camera, 16, 16).unwrap();
+    let model = render::sky_image::ImageSky::new(&gradient);
+    for (x, y) in [(0, 0), (8, 3), (15, 15), (3, 12)] {
+        let dir = camera.ray(x as f32 + 0.5, y as f32 + 0.5).dir;
+        assert_eq!(out.frame.pixel(x, y), model.radiance(dir), "({x}, {y})");
+    }
+    // Higher rows of the image are higher in the sky.
+    assert!(out.frame.pixel(8, 0).y > out.frame.pixel(8, 15).y);
+    let (_, plan) = render(&soup, &kd, &opts(4, 4));
+    assert!(
+        plan.background
+            .starts_with("latitude-longitude sky Assets/Sky.hdr (64x32)"),
+        "{}",
+        plan.background
+    );
+
+    let l = Vec3::new(0.5, 1.0, 2.0);
+    let uniform = TexturedSky {
+        scale: Vec3::splat(0.98),
+        rotation: 0.0,
+        layout: SkyLayout::Cube {
+            faces: vec![SkyImage::from_linear("f", 8, 8, &[l; 64]); 6],
+        },
+    };
+    let mut s = floor_scene();
+    s.soup.environment.sky = Some(Sky::Textured(uniform));
+    s.soup.environment.ambient = formats::Ambient {
+        mode: AmbientMode::Skybox,
+        sky: Vec3::ZERO,
+        equator: Vec3::ZERO,
+        ground: Vec3::ZERO,
+        intensity: 1.5,
+    };
+    let (soup, kd) = s.build();
+    let (out, plan) = render(&soup, &kd, &opts(8, 8));
+    assert!(plan.ambient.enabled, "{}", plan.ambient.reason);
+    assert_close(
+        out.frame.pixel(4, 4),
+        ALBEDO * l * 0.98 * 1.5,
+        5e-3,
+        "the floor under a uniform sky",
     );
 }
 

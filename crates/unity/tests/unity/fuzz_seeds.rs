@@ -11,7 +11,7 @@ fn repo() -> PathBuf {
 }
 
 /// The texture target's first byte picks the claimed extension (index into its list:
-/// png, jpg, tga, tif, exr, psd, dds).
+/// png, jpg, tga, tif, exr, psd, hdr, dds).
 fn texture_seed(extension_index: u8, file: &[u8]) -> Vec<u8> {
     let mut v = vec![extension_index];
     v.extend_from_slice(file);
@@ -65,6 +65,25 @@ fn seeds() -> Vec<(PathBuf, Vec<u8>)> {
     )
     .unwrap();
     assert!(foggy.environment.fog.is_some());
+    // The fog scene under a small latitude-longitude sky.
+    let mut sky = foggy.clone();
+    let rgb: Vec<glam::Vec3> = (0..8).map(|i| glam::Vec3::splat(i as f32 * 0.5)).collect();
+    sky.environment.sky = Some(formats::Sky::Textured(formats::TexturedSky {
+        scale: glam::Vec3::splat(0.98),
+        rotation: 45.0,
+        layout: formats::SkyLayout::LatLong {
+            image: formats::SkyImage::from_linear("Assets/Sky.hdr", 4, 2, &rgb),
+            panorama: formats::Panorama::Full,
+        },
+    }));
+    let hdr = {
+        let mut out = Cursor::new(Vec::new());
+        image::DynamicImage::ImageRgba8(img.clone())
+            .into_rgb32f()
+            .write_to(&mut out, ImageFormat::Hdr)
+            .unwrap();
+        out.into_inner()
+    };
     let fuzz = repo().join("fuzz/corpus");
     vec![
         (fuzz.join("soup/seed-4tri.soup"), framed),
@@ -76,7 +95,15 @@ fn seeds() -> Vec<(PathBuf, Vec<u8>)> {
             fuzz.join("soup/seed-fog.soup"),
             foggy.to_bytes(Path::new("seed-fog.soup")).unwrap(),
         ),
+        (
+            fuzz.join("soup/seed-sky.soup"),
+            sky.to_bytes(Path::new("seed-sky.soup")).unwrap(),
+        ),
         (fuzz.join("soup/seed-4tri-payload.bin"), payload),
+        (
+            fuzz.join("unity_texture/seed-hdr.bin"),
+            texture_seed(6, &hdr),
+        ),
         (
             fuzz.join("unity_texture/seed-png.bin"),
             texture_seed(0, &png),
@@ -98,7 +125,7 @@ fn seeds() -> Vec<(PathBuf, Vec<u8>)> {
         // The PNG with a size limit of 1 texel, so the downscale runs.
         (
             fuzz.join("unity_texture/seed-png-max1.bin"),
-            texture_seed(21, &png),
+            texture_seed(24, &png),
         ),
     ]
 }

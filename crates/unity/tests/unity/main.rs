@@ -12,5 +12,6 @@ mod fbx_corpus;
 mod fbx_scene;
 mod fbx_threads;
 mod fuzz_seeds;
+mod skybox;
 mod support;
 mod textures;

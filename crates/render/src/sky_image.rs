@@ -1,0 +1,376 @@
+//! Skies drawn from images, as Unity's Skybox/Panoramic, Skybox/Cubemap and Skybox/6 Sided
+//! shaders draw them: the direction turned by the material's rotation, looked up in a
+//! latitude-longitude image or on a cube's faces, filtered bilinearly in the full-size
+//! image, times the material's tint and exposure.
+
+use crate::sky::SkyAmbient;
+use formats::{Panorama, SkyImage, SkyLayout, TexturedSky};
+use glam::Vec3;
+use std::f32::consts::PI;
+
+/// An image sky with its rotation worked out once.
+#[derive(Clone, Copy, Debug)]
+pub struct ImageSky<'a> {
+    sky: &'a TexturedSky,
+    cos: f32,
+    sin: f32,
+}
+
+impl<'a> ImageSky<'a> {
+    pub fn new(sky: &'a TexturedSky) -> Self {
+        let (sin, cos) = sky.rotation.to_radians().sin_cos();
+        ImageSky { sky, cos, sin }
+    }
+
+    /// Radiance along unit soup direction `dir`.
+    pub fn radiance(&self, dir: Vec3) -> Vec3 {
+        self.unscaled(self.unity_direction(dir)) * self.sky.scale
+    }
+
+    /// The direction the shader samples for soup direction `dir`: X negated into Unity's
+    /// axes, then turned back by the rotation Unity gives the sky mesh.
+    fn unity_direction(&self, dir: Vec3) -> Vec3 {
+        let (x, z) = (-dir.x, dir.z);
+        Vec3::new(
+            self.cos * x + self.sin * z,
+            dir.y,
+            -self.sin * x + self.cos * z,
+        )
+    }
+
+    /// The texels' radiance along Unity direction `d` (not normalised), before the
+    /// material's scale.
+    fn unscaled(&self, d: Vec3) -> Vec3 {
+        match &self.sky.layout {
+            SkyLayout::LatLong { image, panorama } => {
+                let d = d.normalize_or_zero();
+                let [mut u, v] = lat_long(d);
+                match panorama {
+                    Panorama::Full => {}
+                    Panorama::Half if u > 0.5 => return Vec3::ZERO,
+                    // The shader takes u·2 modulo 1: the back half repeats the front.
+                    Panorama::Half | Panorama::HalfMirrored => u = (u * 2.0).fract(),
+                }
+                bilinear(image, u, v, true)
+            }
+            SkyLayout::Cube { faces } => {
+                let (face, u, v) = cube_face(d);
+                bilinear(&faces[face], u, v, false)
+            }
+        }
+    }
+
+    /// Its ambient light, `intensity` times, on nine spherical harmonics: each texel's
+    /// radiance weighted by the solid angle it covers, so a small bright sun in an HDR
+    /// image counts with all of its energy however few texels it has.
+    pub fn ambient(&self, intensity: f32) -> SkyAmbient {
+        SkyAmbient::project(intensity, |add| {
+            let mut texel = |image: &SkyImage, x: u32, y: u32, d: Vec3, area: f32| {
+                let l = image.texel(x, y) * self.sky.scale;
+                // Back from Unity's axes and the mesh's rotation to soup space.
+                let (ux, uz) = (
+                    self.cos * d.x - self.sin * d.z,
+                    self.sin * d.x + self.cos * d.z,
+                );
+                add(Vec3::new(-ux, d.y, uz).normalize(), l * area);
+            };
+            match &self.sky.layout {
+                SkyLayout::LatLong { image, panorama } => {
+                    let (w, h) = (image.width, image.height);
+                    // A half panorama stretches the image over half the turn: each texel
+                    // covers half the azimuth, once or (mirrored) twice.
+                    let copies: &[f32] = match panorama {
+                        Panorama::Full => &[0.0],
+                        Panorama::Half => &[0.0],
+                        Panorama::HalfMirrored => &[0.0, 1.0],
+                    };
+                    let span = match panorama {
+                        Panorama::Full => 1.0,
+                        _ => 0.5,
+                    };
+                    for y in 0..h {
+                        let v = (y as f32 + 0.5) / h as f32;
+                        let theta = PI * (1.0 - v);
+                        let area = (2.0 * PI * span / w as f32) * (PI / h as f32) * theta.sin();
+                        for x in 0..w {
+                            for &c in copies {
+                                let u = ((x as f32 + 0.5) / w as f32 + c) * span;
+                                texel(image, x, y, from_lat_long(u, v), area);
+                            }
+                        }
+                    }
+                }
+                SkyLayout::Cube { faces } => {
+                    for (f, image) in faces.iter().enumerate() {
+                        let (w, h) = (image.width, image.height);
+                        let (du, dv) = (2.0 / w as f32, 2.0 / h as f32);
+                        for y in 0..h {
+                            let b = (y as f32 + 0.5) * dv - 1.0;
+                            for x in 0..w {
+                                let a = (x as f32 + 0.5) * du - 1.0;
+                                let area = du * dv / (1.0 + a * a + b * b).powf(1.5);
+                                texel(image, x, y, from_cube_face(f, a, b), area);
+                            }
+                        }
+                    }
+                }
+            }
+        })
+    }
+}
+
+/// Unit Unity direction → the panoramic shader's (u, v).
+fn lat_long(d: Vec3) -> [f32; 2] {
+    let latitude = d.y.clamp(-1.0, 1.0).acos();
+    let longitude = d.z.atan2(d.x);
+    [0.5 - longitude / (2.0 * PI), 1.0 - latitude / PI]
+}
+
+/// The Unity direction at (u, v) of a latitude-longitude image.
+fn from_lat_long(u: f32, v: f32) -> Vec3 {
+    let latitude = PI * (1.0 - v);
+    let longitude = (0.5 - u) * 2.0 * PI;
+    let ring = latitude.sin();
+    Vec3::new(
+        ring * longitude.cos(),
+        latitude.cos(),
+        ring * longitude.sin(),
+    )
+}
+
+/// Which face (+X, −X, +Y, −Y, +Z, −Z) a Unity direction meets, and where on it (u, v in
+/// [0, 1], v up, as [`SkyLayout::Cube`] orients the faces).
+fn cube_face(d: Vec3) -> (usize, f32, f32) {
+    let a = d.abs();
+    let (face, s, t, m) = if a.x >= a.y && a.x >= a.z {
+        if d.x > 0.0 {
+            (0, -d.z, d.y, a.x)
+        } else {
+            (1, d.z, d.y, a.x)
+        }
+    } else if a.y >= a.z {
+        if d.y > 0.0 {
+            (2, d.x, -d.z, a.y)
+        } else {
+            (3, d.x, d.z, a.y)
+        }
+    } else if d.z > 0.0 {
+        (4, d.x, d.y, a.z)
+    } else {
+        (5, -d.x, d.y, a.z)
+    };
+    if m <= 0.0 {
+        return (4, 0.5, 0.5);
+    }
+    (face, 0.5 * (s / m + 1.0), 0.5 * (t / m + 1.0))
+}
+
+/// The Unity direction through face coordinates (a, b) in [−1, 1] of face `f`.
+fn from_cube_face(f: usize, a: f32, b: f32) -> Vec3 {
+    match f {
+        0 => Vec3::new(1.0, b, -a),
+        1 => Vec3::new(-1.0, b, a),
+        2 => Vec3::new(a, 1.0, -b),
+        3 => Vec3::new(a, -1.0, b),
+        4 => Vec3::new(a, b, 1.0),
+        _ => Vec3::new(-a, b, -1.0),
+    }
+}
+
+/// Bilinear lookup at (u, v), texel centres at half-integers; u wraps around when `wrap`,
+/// else both axes clamp at the edge texels.
+fn bilinear(image: &SkyImage, u: f32, v: f32, wrap: bool) -> Vec3 {
+    let (w, h) = (image.width, image.height);
+    let x = u * w as f32 - 0.5;
+    let y = v * h as f32 - 0.5;
+    let (x0, y0) = (x.floor(), y.floor());
+    let (fx, fy) = (x - x0, y - y0);
+    let column = |i: f32| -> u32 {
+        let i = i as i64;
+        if wrap {
+            i.rem_euclid(w as i64) as u32
+        } else {
+            i.clamp(0, w as i64 - 1) as u32
+        }
+    };
+    let row = |j: f32| -> u32 { (j as i64).clamp(0, h as i64 - 1) as u32 };
+    let (xa, xb, ya, yb) = (column(x0), column(x0 + 1.0), row(y0), row(y0 + 1.0));
+    let bottom = image.texel(xa, ya).lerp(image.texel(xb, ya), fx);
+    let top = image.texel(xa, yb).lerp(image.texel(xb, yb), fx);
+    bottom.lerp(top, fy)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lat_long_and_cube_coordinates_invert() {
+        for &(u, v) in &[(0.1, 0.2), (0.5, 0.5), (0.75, 0.9), (0.99, 0.01)] {
+            let [u2, v2] = lat_long(from_lat_long(u, v));
+            assert!((u - u2).abs() < 1e-5 && (v - v2).abs() < 1e-5, "{u} {v}");
+        }
+        for f in 0..6 {
+            for &(a, b) in &[(0.0, 0.0), (0.5, -0.25), (-0.9, 0.8)] {
+                let (g, u, v) = cube_face(from_cube_face(f, a, b));
+                assert_eq!(g, f);
+                assert!((u - 0.5 * (a + 1.0)).abs() < 1e-6 && (v - 0.5 * (b + 1.0)).abs() < 1e-6);
+            }
+        }
+    }
+
+    #[test]
+    fn the_panoramic_shader_s_landmarks() {
+        // Straight up is the image's top row, Unity's +X its middle column, +Z a quarter
+        // to the left of it, −X its seam.
+        assert_eq!(lat_long(Vec3::Y)[1], 1.0);
+        assert_eq!(lat_long(Vec3::X), [0.5, 0.5]);
+        assert_eq!(lat_long(Vec3::Z), [0.25, 0.5]);
+        assert_eq!(lat_long(-Vec3::Z), [0.75, 0.5]);
+        assert!(lat_long(-Vec3::X)[0].abs() < 1e-6 || lat_long(-Vec3::X)[0] == 1.0);
+    }
+
+    fn sky(layout: SkyLayout, rotation: f32) -> TexturedSky {
+        TexturedSky {
+            scale: Vec3::new(1.0, 0.5, 2.0),
+            rotation,
+            layout,
+        }
+    }
+
+    /// An 8×4 image whose columns (or rows) each hold one power of two.
+    fn stripes(columns: bool) -> SkyImage {
+        let rgb: Vec<Vec3> = (0..32)
+            .map(|i| Vec3::splat(2f32.powi(if columns { i % 8 } else { i / 8 })))
+            .collect();
+        SkyImage::from_linear("stripes", 8, 4, &rgb)
+    }
+
+    #[test]
+    fn a_lat_long_sky_reads_the_texels_the_shader_reads() {
+        let rows = sky(
+            SkyLayout::LatLong {
+                image: stripes(false),
+                panorama: Panorama::Full,
+            },
+            0.0,
+        );
+        let s = ImageSky::new(&rows);
+        // Up is the top row (clamped), the horizon halfway between rows 1 and 2.
+        assert_eq!(s.radiance(Vec3::Y), Vec3::splat(8.0) * rows.scale);
+        assert_eq!(s.radiance(Vec3::Z), Vec3::splat(3.0) * rows.scale);
+        assert_eq!(s.radiance(-Vec3::Y), rows.scale);
+
+        let columns = sky(
+            SkyLayout::LatLong {
+                image: stripes(true),
+                panorama: Panorama::Full,
+            },
+            0.0,
+        );
+        let s = ImageSky::new(&columns);
+        // Unity's +X (the soup's −X) is u = 0.5, between columns 3 and 4; +Z is u = 0.25,
+        // between columns 1 and 2; −X the seam, between columns 7 and 0 (wrapped).
+        let scale = columns.scale;
+        assert_eq!(s.radiance(-Vec3::X), Vec3::splat(12.0) * scale);
+        assert_eq!(s.radiance(Vec3::Z), Vec3::splat(3.0) * scale);
+        assert_eq!(s.radiance(Vec3::X), Vec3::splat(64.5) * scale);
+        // Turned by 90°, Unity's +Z shows what was at +X.
+        let turned = sky(columns.layout.clone(), 90.0);
+        let t = ImageSky::new(&turned);
+        let d = t.radiance(Vec3::Z) - s.radiance(-Vec3::X);
+        assert!(d.abs().max_element() < 1e-4, "{d}");
+    }
+
+    #[test]
+    fn a_half_panorama_is_black_or_mirrored_behind() {
+        let half = |panorama| {
+            sky(
+                SkyLayout::LatLong {
+                    image: stripes(true),
+                    panorama,
+                },
+                0.0,
+            )
+        };
+        let black = half(Panorama::Half);
+        let mirrored = half(Panorama::HalfMirrored);
+        // The front half (Unity's +Z side) stretches the image over 180°: +Z is u = 0.25,
+        // the image's middle (between columns 3 and 4).
+        for s in [&black, &mirrored] {
+            assert_eq!(
+                ImageSky::new(s).radiance(Vec3::Z),
+                Vec3::splat(12.0) * s.scale
+            );
+        }
+        assert_eq!(ImageSky::new(&black).radiance(-Vec3::Z), Vec3::ZERO);
+        assert_eq!(
+            ImageSky::new(&mirrored).radiance(-Vec3::Z),
+            Vec3::splat(12.0) * mirrored.scale
+        );
+    }
+
+    #[test]
+    fn cube_faces_are_met_where_unity_puts_them() {
+        // Face f holds 2^f everywhere.
+        let faces = (0..6)
+            .map(|f| SkyImage::from_linear("f", 2, 2, &[Vec3::splat(2f32.powi(f)); 4]))
+            .collect();
+        let cube = sky(SkyLayout::Cube { faces }, 0.0);
+        let s = ImageSky::new(&cube);
+        // Soup directions: X negated from Unity's.
+        let unity = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
+        for (f, d) in unity.iter().enumerate() {
+            let soup = Vec3::new(-d.x, d.y, d.z);
+            assert_eq!(
+                s.radiance(soup),
+                Vec3::splat(2f32.powi(f as i32)) * cube.scale
+            );
+        }
+    }
+
+    #[test]
+    fn a_uniform_sky_lights_every_normal_with_its_radiance() {
+        let l = Vec3::new(0.25, 0.5, 1.0);
+        let uniform_lat_long = sky(
+            SkyLayout::LatLong {
+                image: SkyImage::from_linear("u", 64, 32, &[l; 64 * 32]),
+                panorama: Panorama::Full,
+            },
+            33.0,
+        );
+        let uniform_cube = sky(
+            SkyLayout::Cube {
+                faces: vec![SkyImage::from_linear("u", 16, 16, &[l; 256]); 6],
+            },
+            0.0,
+        );
+        for s in [&uniform_lat_long, &uniform_cube] {
+            let ambient = ImageSky::new(s).ambient(1.5);
+            for n in [Vec3::Y, -Vec3::Y, Vec3::X, Vec3::new(0.6, 0.0, -0.8)] {
+                let want = l * s.scale * 1.5;
+                let got = ambient.at(n);
+                assert!(
+                    ((got - want) / want).abs().max_element() < 2e-3,
+                    "{n}: {got} against {want}"
+                );
+            }
+        }
+        // Black behind a half panorama: the back (Unity's −Z) gets far less light.
+        let half = sky(
+            SkyLayout::LatLong {
+                image: SkyImage::from_linear("u", 64, 32, &[l; 64 * 32]),
+                panorama: Panorama::Half,
+            },
+            0.0,
+        );
+        let a = ImageSky::new(&half).ambient(1.0);
+        let (front, back) = (a.at(Vec3::Z), a.at(-Vec3::Z));
+        let full = l * half.scale;
+        assert!((a.at(Vec3::X) - full * 0.5).abs().max_element() < 0.01 * full.max_element());
+        assert!(
+            front.x > 0.9 * full.x && back.x < 0.1 * full.x,
+            "{front} {back}"
+        );
+    }
+}
