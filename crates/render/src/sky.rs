@@ -169,6 +169,13 @@ fn basis(d: Vec3) -> [f32; 9] {
     ]
 }
 
+/// Add radiance `l` (times its solid angle) from unit direction `dir` to harmonic sums.
+pub fn add_sample(sums: &mut [Vec3; 9], dir: Vec3, l: Vec3) {
+    for (c, b) in sums.iter_mut().zip(basis(dir)) {
+        *c += l * b;
+    }
+}
+
 /// A sky's ambient light as nine spherical-harmonic coefficients.
 #[derive(Clone, Copy, Debug)]
 pub struct SkyAmbient {
@@ -180,12 +187,13 @@ impl SkyAmbient {
     /// its radiance times the solid angle it stands for, convolved with the cosine lobe
     /// and divided by π (irradiance as the radiance of a white surface), `intensity` times.
     pub fn project(intensity: f32, sample: impl FnOnce(&mut dyn FnMut(Vec3, Vec3))) -> Self {
-        let mut coeffs = [Vec3::ZERO; 9];
-        sample(&mut |dir, l| {
-            for (k, b) in basis(dir).iter().enumerate() {
-                coeffs[k] += l * *b;
-            }
-        });
+        let mut sums = [Vec3::ZERO; 9];
+        sample(&mut |dir, l| add_sample(&mut sums, dir, l));
+        SkyAmbient::from_sums(sums, intensity)
+    }
+
+    /// [`SkyAmbient::project`] of samples already summed by [`add_sample`].
+    pub fn from_sums(mut coeffs: [Vec3; 9], intensity: f32) -> Self {
         const BANDS: [f32; 9] = [
             1.0,
             2.0 / 3.0,

@@ -3,9 +3,10 @@
 //! latitude-longitude image or on a cube's faces, filtered bilinearly in the full-size
 //! image, times the material's tint and exposure.
 
-use crate::sky::SkyAmbient;
+use crate::sky::{add_sample, SkyAmbient};
 use formats::{Panorama, SkyImage, SkyLayout, TexturedSky};
 use glam::Vec3;
+use rayon::prelude::*;
 use std::f32::consts::PI;
 
 /// An image sky with its rotation worked out once.
@@ -62,60 +63,117 @@ impl<'a> ImageSky<'a> {
 
     /// Its ambient light, `intensity` times, on nine spherical harmonics: each texel's
     /// radiance weighted by the solid angle it covers, so a small bright sun in an HDR
-    /// image counts with all of its energy however few texels it has.
+    /// image counts with all of its energy however few texels it has. Rows are summed on
+    /// every core, then added in row order, so the sums are the same on any thread count.
     pub fn ambient(&self, intensity: f32) -> SkyAmbient {
-        SkyAmbient::project(intensity, |add| {
-            let mut texel = |image: &SkyImage, x: u32, y: u32, d: Vec3, area: f32| {
-                let l = image.texel(x, y) * self.sky.scale;
-                // Back from Unity's axes and the mesh's rotation to soup space.
-                let (ux, uz) = (
-                    self.cos * d.x - self.sin * d.z,
-                    self.sin * d.x + self.cos * d.z,
-                );
-                add(Vec3::new(-ux, d.y, uz).normalize(), l * area);
-            };
-            match &self.sky.layout {
-                SkyLayout::LatLong { image, panorama } => {
-                    let (w, h) = (image.width, image.height);
-                    // A half panorama stretches the image over half the turn: each texel
-                    // covers half the azimuth, once or (mirrored) twice.
-                    let copies: &[f32] = match panorama {
-                        Panorama::Full => &[0.0],
-                        Panorama::Half => &[0.0],
-                        Panorama::HalfMirrored => &[0.0, 1.0],
-                    };
-                    let span = match panorama {
-                        Panorama::Full => 1.0,
-                        _ => 0.5,
-                    };
-                    for y in 0..h {
-                        let v = (y as f32 + 0.5) / h as f32;
-                        let theta = PI * (1.0 - v);
-                        let area = (2.0 * PI * span / w as f32) * (PI / h as f32) * theta.sin();
-                        for x in 0..w {
-                            for &c in copies {
-                                let u = ((x as f32 + 0.5) / w as f32 + c) * span;
-                                texel(image, x, y, from_lat_long(u, v), area);
-                            }
-                        }
+        let images: Vec<&SkyImage> = match &self.sky.layout {
+            SkyLayout::LatLong { image, .. } => vec![image],
+            SkyLayout::Cube { faces } => faces.iter().collect(),
+        };
+        let columns = match &self.sky.layout {
+            SkyLayout::LatLong { image, panorama } => Columns::new(image.width, *panorama),
+            SkyLayout::Cube { .. } => Columns::default(),
+        };
+        let rows: Vec<(usize, u32)> = images
+            .iter()
+            .enumerate()
+            .flat_map(|(i, image)| (0..image.height).map(move |y| (i, y)))
+            .collect();
+        let sums: Vec<[Vec3; 9]> = rows
+            .par_iter()
+            .map(|&(i, y)| {
+                let mut sums = [Vec3::ZERO; 9];
+                match &self.sky.layout {
+                    SkyLayout::LatLong { .. } => {
+                        self.lat_long_row(images[i], &columns, y, &mut sums)
                     }
+                    SkyLayout::Cube { .. } => self.face_row(i, images[i], y, &mut sums),
                 }
-                SkyLayout::Cube { faces } => {
-                    for (f, image) in faces.iter().enumerate() {
-                        let (w, h) = (image.width, image.height);
-                        let (du, dv) = (2.0 / w as f32, 2.0 / h as f32);
-                        for y in 0..h {
-                            let b = (y as f32 + 0.5) * dv - 1.0;
-                            for x in 0..w {
-                                let a = (x as f32 + 0.5) * du - 1.0;
-                                let area = du * dv / (1.0 + a * a + b * b).powf(1.5);
-                                texel(image, x, y, from_cube_face(f, a, b), area);
-                            }
-                        }
-                    }
-                }
-            }
-        })
+                sums
+            })
+            .collect();
+        let total = sums.iter().fold([Vec3::ZERO; 9], |mut t, s| {
+            t.iter_mut().zip(s).for_each(|(t, s)| *t += *s);
+            t
+        });
+        SkyAmbient::from_sums(total, intensity)
+    }
+
+    /// Add texel (x, y)'s radiance, as seen along Unity direction `d` over solid angle
+    /// `area`, to harmonic `sums` (whose directions are the soup's).
+    fn add_texel(
+        &self,
+        sums: &mut [Vec3; 9],
+        image: &SkyImage,
+        x: u32,
+        y: u32,
+        d: Vec3,
+        area: f32,
+    ) {
+        let l = image.texel(x, y) * self.sky.scale;
+        // Back from Unity's axes and the mesh's rotation to soup space.
+        let (ux, uz) = (
+            self.cos * d.x - self.sin * d.z,
+            self.sin * d.x + self.cos * d.z,
+        );
+        add_sample(sums, Vec3::new(-ux, d.y, uz).normalize(), l * area);
+    }
+
+    /// One row of a latitude-longitude image, its texels' azimuths from `columns`.
+    fn lat_long_row(&self, image: &SkyImage, columns: &Columns, y: u32, sums: &mut [Vec3; 9]) {
+        let v = (y as f32 + 0.5) / image.height as f32;
+        let (ring, height) = (PI * (1.0 - v)).sin_cos();
+        let area = columns.area * (PI / image.height as f32) * ring;
+        for &(x, cos, sin) in &columns.texels {
+            let d = Vec3::new(ring * cos, height, ring * sin);
+            self.add_texel(sums, image, x, y, d, area);
+        }
+    }
+
+    /// One row of cube face `f`: a texel at face coordinates (a, b) covers
+    /// da·db / (1 + a² + b²)^(3/2) steradians.
+    fn face_row(&self, f: usize, face: &SkyImage, y: u32, sums: &mut [Vec3; 9]) {
+        let (w, h) = (face.width, face.height);
+        let (du, dv) = (2.0 / w as f32, 2.0 / h as f32);
+        let b = (y as f32 + 0.5) * dv - 1.0;
+        for x in 0..w {
+            let a = (x as f32 + 0.5) * du - 1.0;
+            let area = du * dv / (1.0 + a * a + b * b).powf(1.5);
+            self.add_texel(sums, face, x, y, from_cube_face(f, a, b), area);
+        }
+    }
+}
+
+/// A latitude-longitude image's columns as the azimuths they cover: each texel's column
+/// and the cosine and sine of its longitude, and the azimuth one texel spans. A half
+/// panorama stretches the image over half the turn: each texel covers half the azimuth,
+/// once or (mirrored) twice.
+#[derive(Default)]
+struct Columns {
+    texels: Vec<(u32, f32, f32)>,
+    area: f32,
+}
+
+impl Columns {
+    fn new(width: u32, panorama: Panorama) -> Self {
+        let (copies, span): (&[f32], f32) = match panorama {
+            Panorama::Full => (&[0.0], 1.0),
+            Panorama::Half => (&[0.0], 0.5),
+            Panorama::HalfMirrored => (&[0.0, 1.0], 0.5),
+        };
+        let texels = (0..width)
+            .flat_map(|x| {
+                copies.iter().map(move |c| {
+                    let u = ((x as f32 + 0.5) / width as f32 + c) * span;
+                    let (sin, cos) = ((0.5 - u) * 2.0 * PI).sin_cos();
+                    (x, cos, sin)
+                })
+            })
+            .collect();
+        Columns {
+            texels,
+            area: 2.0 * PI * span / width as f32,
+        }
     }
 }
 
@@ -124,18 +182,6 @@ fn lat_long(d: Vec3) -> [f32; 2] {
     let latitude = d.y.clamp(-1.0, 1.0).acos();
     let longitude = d.z.atan2(d.x);
     [0.5 - longitude / (2.0 * PI), 1.0 - latitude / PI]
-}
-
-/// The Unity direction at (u, v) of a latitude-longitude image.
-fn from_lat_long(u: f32, v: f32) -> Vec3 {
-    let latitude = PI * (1.0 - v);
-    let longitude = (0.5 - u) * 2.0 * PI;
-    let ring = latitude.sin();
-    Vec3::new(
-        ring * longitude.cos(),
-        latitude.cos(),
-        ring * longitude.sin(),
-    )
 }
 
 /// Which face (+X, −X, +Y, −Y, +Z, −Z) a Unity direction meets, and where on it (u, v in
@@ -203,6 +249,18 @@ fn bilinear(image: &SkyImage, u: f32, v: f32, wrap: bool) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The Unity direction at (u, v) of a latitude-longitude image.
+    fn from_lat_long(u: f32, v: f32) -> Vec3 {
+        let latitude = PI * (1.0 - v);
+        let longitude = (0.5 - u) * 2.0 * PI;
+        let ring = latitude.sin();
+        Vec3::new(
+            ring * longitude.cos(),
+            latitude.cos(),
+            ring * longitude.sin(),
+        )
+    }
 
     #[test]
     fn lat_long_and_cube_coordinates_invert() {
@@ -372,5 +430,28 @@ mod tests {
             front.x > 0.9 * full.x && back.x < 0.1 * full.x,
             "{front} {back}"
         );
+    }
+
+    #[test]
+    fn the_ambient_sums_do_not_depend_on_the_thread_count() {
+        let rgb: Vec<Vec3> = (0..64 * 32)
+            .map(|i| Vec3::splat((i % 97) as f32 * 0.37))
+            .collect();
+        let s = sky(
+            SkyLayout::LatLong {
+                image: SkyImage::from_linear("r", 64, 32, &rgb),
+                panorama: Panorama::Full,
+            },
+            10.0,
+        );
+        let on = |threads| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| ImageSky::new(&s).ambient(1.0).at(Vec3::new(0.6, 0.0, 0.8)))
+        };
+        assert_eq!(on(1), on(2));
+        assert_eq!(on(1), on(5));
     }
 }
