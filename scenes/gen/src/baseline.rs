@@ -179,6 +179,7 @@ fn build(large: Option<usize>) -> Project {
     let scene = SceneDesc {
         ambient: Ambient::Flat([0.0, 0.0, 0.0]),
         fog: None,
+        skybox: None,
         objects,
     };
     p.add_asset(path, unity::write_scene(key, &scene), meta::scene);

@@ -17,6 +17,7 @@ pub struct Builder {
     mats: BTreeMap<&'static str, String>,
     objects: Vec<Object>,
     fog: Option<FogDesc>,
+    skybox: Option<String>,
 }
 
 impl Builder {
@@ -35,12 +36,20 @@ impl Builder {
             mats,
             objects: Vec::new(),
             fog: None,
+            skybox: None,
         }
     }
 
     /// Turn on RenderSettings fog in the scene written next.
     pub fn fog(&mut self, fog: FogDesc) -> &mut Self {
         self.fog = Some(fog);
+        self
+    }
+
+    /// Add the material file `yaml` at `path` and name it as RenderSettings' skybox.
+    pub fn skybox(&mut self, path: &str, yaml: String) -> &mut Self {
+        let guid = self.project.add_asset(path, yaml, meta::material);
+        self.skybox = Some(guid);
         self
     }
 
@@ -76,6 +85,7 @@ impl Builder {
         let scene = SceneDesc {
             ambient,
             fog: self.fog.take(),
+            skybox: self.skybox.clone(),
             objects: std::mem::take(&mut self.objects),
         };
         self.project
@@ -126,6 +136,7 @@ impl Builder {
         let scene = SceneDesc {
             ambient,
             fog: self.fog.take(),
+            skybox: self.skybox.clone(),
             objects: std::mem::take(&mut self.objects),
         };
         self.project

@@ -183,6 +183,7 @@ pub fn project(models: usize, instances: usize, compress: bool) -> Project {
     let scene = SceneDesc {
         ambient: Ambient::Flat([0.1, 0.1, 0.12]),
         fog: None,
+        skybox: None,
         objects,
     };
     p.add_asset(

@@ -1,6 +1,7 @@
 //! Generator of the Unity projects bundled in `scenes/`: the original Haskell ray tracer's
 //! baseline scene (OBJ models at exact triangle counts), one small project per rendering
-//! effect, and the textured and alpha-blended Quads of `textures`.
+//! effect, the textured and alpha-blended Quads of `textures`, and `skybox`'s sky from an
+//! HDR image.
 //!
 //! Everything is built in memory first ([`project::Project`]), so the same bytes are
 //! written to disk by the binary and compared with the committed files by the tests.
@@ -15,6 +16,7 @@ pub mod mesh;
 pub mod meta;
 pub mod models;
 pub mod project;
+pub mod sky;
 pub mod textures;
 pub mod unity;
 
@@ -23,5 +25,6 @@ pub fn all_projects() -> Vec<project::Project> {
     let mut v = vec![baseline::project()];
     v.extend(effects::all());
     v.push(textures::project());
+    v.push(sky::project());
     v
 }

@@ -101,6 +101,8 @@ pub struct CameraDesc {
     pub orthographic: Option<f32>,
     /// sRGB solid clear colour.
     pub background: [f32; 3],
+    /// Clear to the skybox (`m_ClearFlags: 1`) instead of the solid colour.
+    pub skybox: bool,
 }
 
 impl Default for CameraDesc {
@@ -111,6 +113,7 @@ impl Default for CameraDesc {
             far: 1000.0,
             orthographic: None,
             background: [0.0, 0.0, 0.0],
+            skybox: false,
         }
     }
 }
@@ -140,11 +143,15 @@ pub enum Ambient {
     Flat([f32; 3]),
     /// `m_AmbientMode: 1`, sky / equator / ground colours (sRGB).
     Trilight([f32; 3], [f32; 3], [f32; 3]),
+    /// `m_AmbientMode: 0`, the skybox's light at this `m_AmbientIntensity`.
+    Skybox(f32),
 }
 
 pub struct SceneDesc {
     pub ambient: Ambient,
     pub fog: Option<FogDesc>,
+    /// GUID of the project's skybox material; Unity's Default-Skybox without one.
+    pub skybox: Option<String>,
     pub objects: Vec<Object>,
 }
 
@@ -230,7 +237,7 @@ pub fn write_scene(scene_key: &str, scene: &SceneDesc) -> String {
     docs.sort_by_key(|(id, _)| *id);
     let mut s = String::from("%YAML 1.1\n%TAG !u! tag:unity3d.com,2011:\n");
     s += OCCLUSION_LIGHTMAP_NAVMESH_HEAD;
-    s += &render_settings(&scene.ambient, scene.fog.as_ref());
+    s += &render_settings(&scene.ambient, scene.fog.as_ref(), scene.skybox.as_deref());
     s += LIGHTMAP_NAVMESH;
     for (_, d) in docs {
         s += &d;
@@ -498,7 +505,7 @@ Camera:
 {PREFAB_FIELDS}  m_GameObject: {{fileID: {go}}}
   m_Enabled: 1
   serializedVersion: 2
-  m_ClearFlags: 2
+  m_ClearFlags: {clear}
   m_BackGroundColor: {bg}
   m_projectionMatrixMode: 1
   m_GateFitMode: 2
@@ -541,6 +548,7 @@ Camera:
   m_StereoConvergence: 10
   m_StereoSeparation: 0.022
 ",
+        clear = if c.skybox { 1 } else { 2 },
         bg = rgba(c.background, 1.0),
         near = num(c.near),
         far = num(c.far),
@@ -553,7 +561,7 @@ fn audio_listener(id: i64, go: i64) -> String {
     format!("--- !u!81 &{id}\nAudioListener:\n{PREFAB_FIELDS}  m_GameObject: {{fileID: {go}}}\n  m_Enabled: 1\n")
 }
 
-fn render_settings(ambient: &Ambient, fog: Option<&FogDesc>) -> String {
+fn render_settings(ambient: &Ambient, fog: Option<&FogDesc>, skybox: Option<&str>) -> String {
     let black = [0.0, 0.0, 0.0];
     // Unity's new-scene fog settings, switched off, unless the scene asks for fog.
     let off = FogDesc {
@@ -564,9 +572,14 @@ fn render_settings(ambient: &Ambient, fog: Option<&FogDesc>) -> String {
         end: 300.0,
     };
     let (on, f) = fog.map_or((0, &off), |f| (1, f));
-    let (mode, sky, equator, ground) = match *ambient {
-        Ambient::Flat(c) => (3, c, black, black),
-        Ambient::Trilight(s, e, g) => (1, s, e, g),
+    let (mode, sky, equator, ground, intensity) = match *ambient {
+        Ambient::Flat(c) => (3, c, black, black, 1.0),
+        Ambient::Trilight(s, e, g) => (1, s, e, g, 1.0),
+        Ambient::Skybox(i) => (0, black, black, black, i),
+    };
+    let skybox = match skybox {
+        Some(guid) => format!("{{fileID: 2100000, guid: {guid}, type: 2}}"),
+        None => "{fileID: 10304, guid: 0000000000000000f000000000000000, type: 0}".into(),
     };
     format!(
         "--- !u!104 &2
@@ -582,10 +595,10 @@ RenderSettings:
   m_AmbientSkyColor: {sky}
   m_AmbientEquatorColor: {equator}
   m_AmbientGroundColor: {ground}
-  m_AmbientIntensity: 1
+  m_AmbientIntensity: {intensity}
   m_AmbientMode: {mode}
   m_SubtractiveShadowColor: {{r: 0.42, g: 0.478, b: 0.627, a: 1}}
-  m_SkyboxMaterial: {{fileID: 10304, guid: 0000000000000000f000000000000000, type: 0}}
+  m_SkyboxMaterial: {skybox}
   m_HaloStrength: 0.5
   m_FlareStrength: 1
   m_FlareFadeSpeed: 3
@@ -603,6 +616,7 @@ RenderSettings:
         sky = rgba(sky, 1.0),
         equator = rgba(equator, 1.0),
         ground = rgba(ground, 1.0),
+        intensity = num(intensity),
         fog_colour = rgba(f.colour, 1.0),
         fog_mode = f.mode,
         density = num(f.density),

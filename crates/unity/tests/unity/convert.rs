@@ -4,7 +4,7 @@
 use crate::support::*;
 use formats::{FogMode, LightKind, Shadows};
 use glam::Vec3;
-use std::f32::consts::FRAC_1_SQRT_2;
+use std::f32::consts::{FRAC_1_SQRT_2, PI};
 use std::path::{Path, PathBuf};
 
 const OBJ_GUID: &str = "a1b2c3d4e5f60718293a4b5c6d7e8f90";
@@ -155,6 +155,53 @@ fn render_settings_fog_reaches_the_soup() {
     assert_eq!(fog.colour, Vec3::from_array(grey));
     assert_eq!(soup.environment.background, fog.colour);
     assert!(soup.warnings.is_empty(), "{:?}", soup.warnings);
+}
+
+/// The bundled skybox scene: its panoramic material's HDR image, the sun in it brighter
+/// than 1, where the directional light comes from.
+#[test]
+fn the_bundled_skybox_scene_reads_its_hdr_panorama() {
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes/skybox/Assets/Scenes/Skybox.unity");
+    let soup = convert(&scene);
+    assert!(soup.warnings.is_empty(), "{:?}", soup.warnings);
+    assert_eq!(soup.environment.clear, formats::ClearFlags::Skybox);
+    assert_eq!(soup.environment.ambient.mode, formats::AmbientMode::Skybox);
+    let Some(formats::Sky::Textured(sky)) = &soup.environment.sky else {
+        panic!("{:?}", soup.environment.sky);
+    };
+    let formats::SkyLayout::LatLong { image, panorama } = &sky.layout else {
+        panic!("{:?}", sky.layout);
+    };
+    assert_eq!(*panorama, formats::Panorama::Full);
+    assert_eq!((image.width, image.height), (1024, 512));
+    assert_eq!(image.source, "Assets/Textures/Sky.hdr");
+    // The brightest texel is the sun's 400 (red), within RGBE's rounding, and lies in the
+    // direction opposite the light's (Unity's axes: the soup's with X negated).
+    let (mut best, mut at) = (0.0f32, (0, 0));
+    for y in 0..image.height {
+        for x in 0..image.width {
+            let r = image.texel(x, y).x;
+            if r > best {
+                (best, at) = (r, (x, y));
+            }
+        }
+    }
+    assert!((best - 400.0).abs() <= 400.0 / 256.0, "{best}");
+    let u = (at.0 as f32 + 0.5) / 1024.0;
+    let v = (at.1 as f32 + 0.5) / 512.0;
+    let (polar, azimuth) = (PI * (1.0 - v), (0.5 - u) * 2.0 * PI);
+    let d = Vec3::new(
+        polar.sin() * azimuth.cos(),
+        polar.cos(),
+        polar.sin() * azimuth.sin(),
+    );
+    let light = soup.lights[0].direction;
+    let towards_sun = -Vec3::new(-light.x, light.y, light.z);
+    assert!(
+        d.dot(towards_sun) > 1.5f32.to_radians().cos(),
+        "{d} against {towards_sun}"
+    );
 }
 
 #[test]
