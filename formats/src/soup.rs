@@ -328,7 +328,8 @@ pub enum AmbientMode {
     Flat,
     /// Sky above, equator at the horizon, ground below, by the normal's Y.
     Trilight,
-    /// Unity's skybox ambient, approximated as a trilight from the sky's colours.
+    /// Unity's skybox ambient: the skybox's light on nine spherical harmonics, or the
+    /// trilight of the colours under a skybox the soup does not hold.
     Skybox,
 }
 
@@ -339,7 +340,7 @@ pub struct Ambient {
     pub sky: Vec3,
     pub equator: Vec3,
     pub ground: Vec3,
-    /// `m_AmbientIntensity`: it scales the procedural sky's light in Skybox mode.
+    /// `m_AmbientIntensity`: it scales the skybox's light in Skybox mode.
     pub intensity: f32,
 }
 
