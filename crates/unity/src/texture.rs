@@ -482,11 +482,10 @@ pub fn load_linear(
     })?;
     let (image, float) = decode_image(&bytes, &ext(path), source)?;
     let mut img = image.into_rgb32f();
+    // The sRGB curve itself, not the 8-bit table: 16-bit images keep their precision.
     if !float && import.srgb {
-        img.pixels_mut().for_each(|p| {
-            p.0 =
-                p.0.map(|c| formats::texture::decode_u8((c * 255.0).round() as u8, true))
-        });
+        img.pixels_mut()
+            .for_each(|p| p.0 = p.0.map(crate::material::srgb_to_linear));
     }
     let (w, h) = if resize {
         import.imported_size(img.width(), img.height())
