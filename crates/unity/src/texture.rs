@@ -495,12 +495,17 @@ pub fn load_linear(
     if (w, h) != img.dimensions() {
         img = image::imageops::resize(&img, w, h, image::imageops::FilterType::Triangle);
     }
-    let row = w as usize;
-    let texels: Vec<glam::Vec3> = img.pixels().map(|p| glam::Vec3::from_array(p.0)).collect();
+    // Image files list the top row first; one pass turns them over.
+    let rgb = img
+        .rows()
+        .rev()
+        .flatten()
+        .map(|p| glam::Vec3::from_array(p.0))
+        .collect();
     Ok(LinearImage {
         width: w,
         height: h,
-        rgb: texels.chunks_exact(row).rev().flatten().copied().collect(),
+        rgb,
     })
 }
 
