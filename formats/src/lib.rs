@@ -21,8 +21,8 @@ pub use rays::{Hit, RayRecord};
 pub use sky::{Panorama, ProceduralSky, Sky, SkyImage, SkyLayout, SunDisk, TexturedSky};
 pub use soup::{
     Alpha, Ambient, AmbientMode, Camera, CastShadows, ClearFlags, Cull, Environment, Fog, FogMode,
-    Light, LightKind, Material, NormalMap, Object, Projection, Shadows, Soup, SoupGeometry,
-    SoupKey,
+    Light, LightKind, Material, NormalMap, Object, OcclusionMap, Projection, Shadows, Soup,
+    SoupGeometry, SoupKey,
 };
 pub use texture::{Texture, TextureRef, Tiling};
 

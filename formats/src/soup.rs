@@ -143,6 +143,26 @@ pub struct Material {
     /// The emission map (`_EmissionMap`), multiplied with `emission`, tiled as the albedo
     /// map.
     pub emission_map: Option<TextureRef>,
+    /// The occlusion map (`_OcclusionMap`), darkening the ambient light and the mirror
+    /// reflection, tiled as the albedo map.
+    pub occlusion_map: Option<OcclusionMap>,
+}
+
+/// A material's occlusion map: the green channel g of its texel leaves 1 + (g − 1)·strength
+/// of the light that does not come straight from a light (ambient and reflection), as
+/// Unity's Standard and URP Lit shaders apply it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct OcclusionMap {
+    pub map: TextureRef,
+    /// `_OcclusionStrength`, 0–1.
+    pub strength: f32,
+}
+
+impl OcclusionMap {
+    /// The share of indirect light left where the map's green channel is `g`.
+    pub fn left(&self, g: f32) -> f32 {
+        1.0 + (g - 1.0) * self.strength
+    }
 }
 
 /// A material's normal map: a linear texture whose red and green channels hold the
@@ -176,9 +196,13 @@ impl Material {
         self.alpha != Alpha::Opaque
     }
 
-    /// Whether the material looks anything up by UV (an albedo, normal or emission map).
+    /// Whether the material looks anything up by UV (an albedo, normal, emission or
+    /// occlusion map).
     pub fn reads_uvs(&self) -> bool {
-        self.albedo_map.is_some() || self.normal_map.is_some() || self.emission_map.is_some()
+        self.albedo_map.is_some()
+            || self.normal_map.is_some()
+            || self.emission_map.is_some()
+            || self.occlusion_map.is_some()
     }
 }
 
@@ -199,6 +223,7 @@ impl Material {
             alpha: Alpha::Opaque,
             normal_map: None,
             emission_map: None,
+            occlusion_map: None,
         }
     }
 
@@ -631,10 +656,19 @@ impl Soup {
                     return Err(format!("material {i} has normal map scale {}", n.scale));
                 }
             }
+            if let Some(o) = &m.occlusion_map {
+                if !(0.0..=1.0).contains(&o.strength) {
+                    return Err(format!(
+                        "material {i} has occlusion strength {}",
+                        o.strength
+                    ));
+                }
+            }
             let maps = [
                 m.albedo_map.as_ref(),
                 m.normal_map.as_ref().map(|n| &n.map),
                 m.emission_map.as_ref(),
+                m.occlusion_map.as_ref().map(|o| &o.map),
             ];
             for r in maps.into_iter().flatten() {
                 if r.texture as usize >= self.textures.len() {

@@ -33,6 +33,13 @@ fn sample_soup() -> Soup {
             scale: 0.5,
         }),
         emission: Vec3::new(0.5, 2.0, 0.0),
+        occlusion_map: Some(OcclusionMap {
+            map: TextureRef {
+                texture: 0,
+                tiling: Tiling::default(),
+            },
+            strength: 0.6,
+        }),
         emission_map: Some(TextureRef {
             texture: 0,
             tiling: Tiling {
@@ -920,6 +927,25 @@ fn an_image_sky_with_a_bad_image_or_number_is_corrupt() {
 }
 
 #[test]
+fn an_occlusion_strength_outside_0_to_1_or_a_missing_map_is_corrupt() {
+    fn occlusion(s: &mut Soup) -> &mut OcclusionMap {
+        s.materials[0].occlusion_map.as_mut().unwrap()
+    }
+    refused(
+        &|s| occlusion(s).strength = 1.5,
+        "material 0 has occlusion strength 1.5",
+    );
+    refused(
+        &|s| occlusion(s).strength = f32::NAN,
+        "material 0 has occlusion strength NaN",
+    );
+    refused(
+        &|s| occlusion(s).map.texture = 9,
+        "material 0 names texture 9 of 1",
+    );
+}
+
+#[test]
 fn a_shadow_strength_outside_0_to_1_is_corrupt() {
     refused(
         &|s| s.lights[0].shadow_strength = 1.5,
@@ -990,6 +1016,7 @@ fn bad_texture_references_are_corrupt() {
     s.materials[0].albedo_map = None;
     s.materials[0].normal_map = None;
     s.materials[0].emission_map = None;
+    s.materials[0].occlusion_map = None;
     s.uvs.clear();
     let p = Path::new("tex.soup");
     assert_eq!(Soup::from_bytes(&s.to_bytes(p).unwrap(), p).unwrap(), s);

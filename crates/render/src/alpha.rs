@@ -59,6 +59,7 @@ mod tests {
             opacity,
             normal_map: None,
             emission_map: None,
+            occlusion_map: None,
             albedo_map: map.then_some(TextureRef {
                 texture: 0,
                 tiling: Tiling::default(),

@@ -34,6 +34,8 @@ pub struct RayCounts {
     pub normal_lookups: u64,
     /// Emission-map lookups at shaded points of glowing materials.
     pub emission_lookups: u64,
+    /// Occlusion map texels read.
+    pub occlusion_lookups: u64,
     /// Alpha lookups: cut-out tests inside the traversals and blended surfaces' alpha where
     /// no albedo lookup gave it.
     pub alpha_lookups: u64,
@@ -59,6 +61,7 @@ impl RayCounts {
         self.texture_lookups += o.texture_lookups;
         self.normal_lookups += o.normal_lookups;
         self.emission_lookups += o.emission_lookups;
+        self.occlusion_lookups += o.occlusion_lookups;
         self.alpha_lookups += o.alpha_lookups;
         self.fogged += o.fogged;
         self.sanitized += o.sanitized;
@@ -84,6 +87,7 @@ pub struct SharedCounts {
     texture_lookups: AtomicU64,
     normal_lookups: AtomicU64,
     emission_lookups: AtomicU64,
+    occlusion_lookups: AtomicU64,
     alpha_lookups: AtomicU64,
     fogged: AtomicU64,
     sanitized: AtomicU64,
@@ -106,6 +110,8 @@ impl SharedCounts {
         self.texture_lookups.fetch_add(c.texture_lookups, Relaxed);
         self.normal_lookups.fetch_add(c.normal_lookups, Relaxed);
         self.emission_lookups.fetch_add(c.emission_lookups, Relaxed);
+        self.occlusion_lookups
+            .fetch_add(c.occlusion_lookups, Relaxed);
         self.alpha_lookups.fetch_add(c.alpha_lookups, Relaxed);
         self.fogged.fetch_add(c.fogged, Relaxed);
         self.sanitized.fetch_add(c.sanitized, Relaxed);
@@ -125,6 +131,7 @@ impl SharedCounts {
             texture_lookups: self.texture_lookups.load(Relaxed),
             normal_lookups: self.normal_lookups.load(Relaxed),
             emission_lookups: self.emission_lookups.load(Relaxed),
+            occlusion_lookups: self.occlusion_lookups.load(Relaxed),
             alpha_lookups: self.alpha_lookups.load(Relaxed),
             fogged: self.fogged.load(Relaxed),
             sanitized: self.sanitized.load(Relaxed),

@@ -145,6 +145,8 @@ struct Surfacing {
     normal: Option<(usize, Tiling, f32)>,
     /// The emission map's sampler and tiling, where the plan reads it for a glowing material.
     emission: Option<(usize, Tiling)>,
+    /// The occlusion map's sampler, tiling and strength, where the plan reads it.
+    occlusion: Option<(usize, Tiling, f32)>,
     alpha: AlphaUse,
     opacity: f32,
 }
@@ -347,6 +349,10 @@ impl<'a> Integrator<'a> {
                                 && read[r.texture as usize]
                         })
                         .map(|r| (r.texture as usize, r.tiling)),
+                    occlusion: m
+                        .occlusion_map
+                        .filter(|o| read[o.map.texture as usize])
+                        .map(|o| (o.map.texture as usize, o.map.tiling, o.strength)),
                     alpha: if alpha {
                         alpha_use(m, &plan.alpha.min_alpha)
                     } else {
@@ -913,12 +919,26 @@ impl<'a> Integrator<'a> {
         }
         // A black albedo cannot show any light: no light is asked, no shadow ray traced.
         let lit = albedo.max_element() > 0.0;
+        let mut reflectance = mat.reflectance();
+        // The share of ambient light and reflection the occlusion map leaves (1 without
+        // one: a product with 1 leaves every other pixel's bits as they were).
+        let occlusion = match surfacing.and_then(|s| s.occlusion) {
+            Some((i, tiling, strength))
+                if (lit && self.ambient)
+                    || (self.max_depth > 0 && reflectance.max_element() > 0.0) =>
+            {
+                counts.occlusion_lookups += 1;
+                1.0 + (lookup(&(i, tiling)).y - 1.0) * strength
+            }
+            _ => 1.0,
+        };
+        reflectance *= occlusion;
         if lit && self.ambient {
             let ambient = match &self.sky_ambient {
                 Some(sky) => sky.at(ns),
                 None => environment::ambient(&self.soup.environment, ns),
             };
-            l += ambient * albedo;
+            l += ambient * albedo * occlusion;
         }
         Some(Lit {
             l,
@@ -929,7 +949,7 @@ impl<'a> Integrator<'a> {
             ns,
             layer: obj.layer,
             receives: obj.receive_shadows,
-            reflectance: mat.reflectance(),
+            reflectance,
         })
     }
 
@@ -1537,6 +1557,7 @@ mod tests {
             cull,
             normal_map: None,
             emission_map: None,
+            occlusion_map: None,
             albedo_map: None,
             opacity,
             alpha,

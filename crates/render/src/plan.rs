@@ -264,7 +264,7 @@ impl Plan {
                 "no material has a diffuse albedo".into()
             } else if sky_lit {
                 format!(
-                    "skybox ambient: the procedural sky's light in nine spherical harmonics, \
+                    "skybox ambient: the skybox's light in nine spherical harmonics, \
                      intensity {}",
                     amb.intensity
                 )
@@ -368,9 +368,29 @@ impl Plan {
             },
         };
 
+        // Occlusion maps darken the ambient light on diffuse surfaces and the reflections
+        // of mirrors; elsewhere they change nothing.
+        let occluded: Vec<&Material> = mats
+            .iter()
+            .filter(|m| {
+                m.occlusion_map.is_some()
+                    && ((ambient.enabled && m.albedo().max_element() > 0.0)
+                        || (reflections.enabled
+                            && m.reflectance().max_element() >= opts.cutoff.max(f32::MIN_POSITIVE)))
+            })
+            .copied()
+            .collect();
+        let mut ambient = ambient;
+        if !occluded.is_empty() {
+            ambient.reason += &format!(
+                "; {} materials darken it and their reflections by occlusion maps",
+                occluded.len()
+            );
+        }
+
         let (culling, shadow_casting) = draw_rules(soup, &used, &lights);
-        // Maps read besides the albedo maps: normal maps that show, and the emission maps of
-        // glowing materials.
+        // Maps read besides the albedo maps: normal maps that show, the emission maps of
+        // glowing materials, and occlusion maps where ambient light or a mirror shows them.
         let other_maps: Vec<u32> = normal_mapped
             .iter()
             .filter_map(|m| m.normal_map.map(|n| n.map.texture))
@@ -378,6 +398,11 @@ impl Plan {
                 glowing
                     .iter()
                     .filter_map(|m| m.emission_map.map(|r| r.texture)),
+            )
+            .chain(
+                occluded
+                    .iter()
+                    .filter_map(|m| m.occlusion_map.map(|o| o.map.texture)),
             )
             .collect();
         let (textures, alpha) = texturing(soup, &mats, &other_maps, opts.texture_filter);

@@ -1,4 +1,4 @@
-//! A material's albedo, normal and emission maps in the soup: the textures a `.mat` names,
+//! A material's albedo, normal, emission and occlusion maps in the soup: the textures a `.mat` names,
 //! or the file a model's own material names, found the way Unity's model importer finds
 //! it. Each image is decoded once per import settings and shared by every material that
 //! uses it; a texture that cannot be read leaves the material its tint alone (or without
@@ -6,15 +6,18 @@
 //! material and the file.
 
 use crate::emit::Emitter;
-use crate::texture::{albedo_slot, emission_slot, load, normal_slot, Import, TextureSlot};
+use crate::texture::{
+    albedo_slot, emission_slot, load, normal_slot, occlusion_slot, Import, TextureSlot,
+};
 use crate::yaml::Node;
 use formats::texture::{TextureRef, Tiling};
-use formats::{Material, NormalMap};
+use formats::{Material, NormalMap, OcclusionMap};
 
 /// What a material loses with its albedo map, and with its normal map, as warnings say.
 pub(crate) const TINT_ALONE: &str = "drawn with its tint alone";
 const NO_NORMAL_MAP: &str = "drawn without its normal map";
 const EMISSION_COLOUR_ALONE: &str = "glows with its emission colour alone";
+const NO_OCCLUSION_MAP: &str = "drawn without its occlusion map";
 use rayon::prelude::*;
 use std::path::{Component, Path, PathBuf};
 
@@ -63,6 +66,24 @@ impl Emitter<'_, '_> {
         let path = self.slot_file(&slot, what, EMISSION_COLOUR_ALONE)?;
         let import = Import::read(&path);
         self.texture_ref(&path, import, slot.tiling, what, EMISSION_COLOUR_ALONE)
+    }
+
+    /// The occlusion map of Material `body` where its shader samples one with a strength
+    /// above 0; `what` names the material in warnings.
+    pub(crate) fn mat_occlusion(&mut self, body: &Node, what: &str) -> Option<OcclusionMap> {
+        let (slot, strength) = occlusion_slot(body)?;
+        if strength <= 0.0 {
+            return None;
+        }
+        let path = self.slot_file(&slot, what, NO_OCCLUSION_MAP)?;
+        let map = self.texture_ref(
+            &path,
+            Import::read(&path),
+            slot.tiling,
+            what,
+            NO_OCCLUSION_MAP,
+        )?;
+        Some(OcclusionMap { map, strength })
     }
 
     /// The normal map of Material `body` where its shader samples one; `what` names the
@@ -153,6 +174,9 @@ impl Emitter<'_, '_> {
                 .normal_map
                 .and_then(|n| decoded(n.map).map(|map| NormalMap { map, ..n }));
             m.emission_map = m.emission_map.and_then(decoded);
+            m.occlusion_map = m
+                .occlusion_map
+                .and_then(|o| decoded(o.map).map(|map| OcclusionMap { map, ..o }));
         }
         if !self.soup.materials.iter().any(Material::reads_uvs) {
             self.soup.uvs = Vec::new();

@@ -282,6 +282,7 @@ impl Emitter<'_, '_> {
                 m.albedo_map = self.mat_albedo(&body, &src);
                 m.normal_map = self.mat_normal(&body, &src);
                 m.emission_map = self.mat_emission(&body, m.emission, &src);
+                m.occlusion_map = self.mat_occlusion(&body, &src);
                 (self.add_material(key, || m), format!("override {src}"))
             }
             _ => {
@@ -309,6 +310,7 @@ impl Emitter<'_, '_> {
                 m.albedo_map = self.mat_albedo(&b, &rel);
                 m.normal_map = self.mat_normal(&b, &rel);
                 m.emission_map = self.mat_emission(&b, m.emission, &rel);
+                m.occlusion_map = self.mat_occlusion(&b, &rel);
                 self.add_material(key, || m)
             }
             Ok(None) => self.warn_default(what, format!("{rel} holds no Material")),

@@ -115,6 +115,30 @@ pub fn emission_slot(body: &Node) -> Option<TextureSlot> {
     map_slot(body, "_EmissionMap")
 }
 
+/// The occlusion map of a Material body and its strength (`_OcclusionMap`,
+/// `_OcclusionStrength`, default 1, kept within 0–1), tiled as the albedo map. URP Lit
+/// samples it only with the `_OCCLUSIONMAP` keyword (where the file lists keywords); the
+/// Standard shader whenever the slot holds a texture. HDRP keeps occlusion in its mask
+/// map, which is not read.
+pub fn occlusion_slot(body: &Node) -> Option<(TextureSlot, f32)> {
+    let shader = body.get("m_Shader").and_then(|s| s.str_at("guid"));
+    match shader {
+        Some(HDRP_LIT) => return None,
+        Some(URP_LIT) if crate::material::keyword_on(body, "_OCCLUSIONMAP") == Some(false) => {
+            return None
+        }
+        _ => {}
+    }
+    let found = map_slot(body, "_OcclusionMap")?;
+    let floats = props(body.get("m_SavedProperties")?, "m_Floats");
+    let strength = prop(&floats, "_OcclusionStrength")
+        .and_then(Node::as_f32)
+        .filter(|x| x.is_finite())
+        .unwrap_or(1.0)
+        .clamp(0.0, 1.0);
+    Some((found, strength))
+}
+
 /// The texture in slot `property`, tiled by the albedo property's scale and offset (the
 /// shader's own albedo property, else the first present), as Unity's shaders tile every
 /// map by the main texture's.
@@ -826,6 +850,56 @@ m_SavedProperties:
       m_Texture: {fileID: 0}
 ");
         assert_eq!(normal_slot(&empty), None);
+    }
+
+    #[test]
+    fn occlusion_slot_follows_the_shader_and_keeps_the_strength_within_0_to_1() {
+        let material = |shader: &str, keywords: &str, strength: &str| {
+            mat(&format!(
+                "m_Shader: {{fileID: 4800000, guid: {shader}, type: 3}}
+{keywords}m_SavedProperties:
+  m_TexEnvs:
+  - _OcclusionMap:
+      m_Texture: {{fileID: 2800000, guid: oooo, type: 3}}
+  - _MainTex:
+      m_Texture: {{fileID: 0}}
+      m_Scale: {{x: 2, y: 2}}
+      m_Offset: {{x: 0, y: 0}}
+  m_Floats:
+{strength}"
+            ))
+        };
+        let standard = BUILTIN_SHADERS;
+        let (s, strength) = occlusion_slot(&material(
+            standard,
+            "",
+            "  - _OcclusionStrength: 0.4
+",
+        ))
+        .unwrap();
+        assert_eq!(
+            (s.guid.as_str(), strength, s.tiling.scale),
+            ("oooo", 0.4, [2.0, 2.0])
+        );
+        // The Standard shader needs no keyword; URP Lit does, where keywords are listed.
+        let none = "m_ShaderKeywords: _EMISSION
+";
+        assert!(occlusion_slot(&material(standard, none, "")).is_some());
+        assert_eq!(
+            occlusion_slot(&material(standard, none, "")).unwrap().1,
+            1.0
+        );
+        assert!(occlusion_slot(&material(URP_LIT, none, "")).is_none());
+        let urp = material(
+            URP_LIT,
+            "m_ValidKeywords:
+- _OCCLUSIONMAP
+",
+            "  - _OcclusionStrength: 3
+",
+        );
+        assert_eq!(occlusion_slot(&urp).unwrap().1, 1.0, "kept within 0–1");
+        assert!(occlusion_slot(&material(HDRP_LIT, "", "")).is_none());
     }
 
     #[test]

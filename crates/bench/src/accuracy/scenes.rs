@@ -68,6 +68,7 @@ fn material(name: &str, color: Vec3, metallic: f32, smoothness: f32) -> Material
         cull: Cull::None,
         normal_map: None,
         emission_map: None,
+        occlusion_map: None,
         albedo_map: None,
         opacity: 1.0,
         alpha: Alpha::Opaque,
@@ -246,6 +247,7 @@ pub fn checkerboard() -> Scene {
     soup.materials = vec![Material {
         normal_map: None,
         emission_map: None,
+        occlusion_map: None,
         albedo_map: Some(TextureRef {
             texture: 0,
             tiling: Tiling::default(),

@@ -336,6 +336,7 @@ fn the_texture_filter_is_an_option_and_lookups_are_reported() {
     let m = s.material(formats::Material {
         normal_map: None,
         emission_map: None,
+        occlusion_map: None,
         albedo_map: Some(TextureRef {
             texture: t,
             tiling: Tiling::default(),

@@ -350,6 +350,7 @@ fn shadow_and_mirror_rays_traced_in_blocks_equal_rays_traced_alone() {
                 alpha: formats::Alpha::Cutout { cutoff: 0.5 },
                 normal_map: None,
                 emission_map: None,
+                occlusion_map: None,
                 albedo_map: map,
                 ..diffuse(Vec3::splat(0.6))
             });

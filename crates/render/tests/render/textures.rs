@@ -26,6 +26,7 @@ fn mapped(t: u32, tiling: Tiling) -> Material {
     Material {
         normal_map: None,
         emission_map: None,
+        occlusion_map: None,
         albedo_map: Some(TextureRef { texture: t, tiling }),
         ..diffuse(Vec3::ONE)
     }
@@ -217,6 +218,7 @@ fn quad_over_lit_floor(quad: Material, tex: Option<formats::Texture>) -> SceneBu
             Material {
                 normal_map: None,
                 emission_map: None,
+                occlusion_map: None,
                 albedo_map: Some(TextureRef {
                     texture: t,
                     tiling: Tiling::default(),
@@ -549,5 +551,61 @@ fn emission_maps_multiply_the_glow_and_are_read_only_when_it_shows() {
     assert!(!plan.emission.enabled);
     assert_eq!(plan.textures.textures, 0);
     assert_eq!(out.counts.emission_lookups, 0);
+    assert_eq!(out.frame.pixel(0, 3), Vec3::ZERO);
+}
+
+/// An occlusion map leaves 1 + (g − 1)·strength of the ambient light and of a mirror's
+/// reflection, texel by texel (g the texel's green); with neither to darken it is not read.
+#[test]
+fn occlusion_maps_darken_ambient_light_and_reflections_only() {
+    let scene = |material: Material, ambient: Vec3| {
+        let mut s = SceneBuilder::new();
+        let t = s.texture(four_colours(Wrap::Clamp));
+        let m = s.material(Material {
+            occlusion_map: Some(formats::OcclusionMap {
+                map: TextureRef {
+                    texture: t,
+                    tiling: Tiling::default(),
+                },
+                strength: 0.5,
+            }),
+            ..material
+        });
+        unity_quad(&mut s, 1.0, m, [Vec2::ZERO, Vec2::ONE]);
+        s.soup.environment.ambient.sky = ambient;
+        s.soup.environment.background = Vec3::new(0.25, 0.5, 1.0);
+        s.camera(front_camera(0.5));
+        s.build()
+    };
+    // Red and blue texels have no green: half the light is left; green and white keep it.
+    let half_and_whole = |out: &render::Rendered, full: Vec3| {
+        assert_eq!(out.frame.pixel(0, 3), full * 0.5, "bottom-left, red");
+        assert_eq!(out.frame.pixel(3, 3), full, "bottom-right, green");
+        assert_eq!(out.frame.pixel(0, 0), full * 0.5, "top-left, blue");
+        assert_eq!(out.frame.pixel(3, 0), full, "top-right, white");
+    };
+    let grey = Vec3::splat(0.6);
+    let (soup, kd) = scene(diffuse(Vec3::ONE), grey);
+    let (out, plan) = render(&soup, &kd, &opts(4, 4));
+    assert!(
+        plan.ambient.reason.contains("1 materials darken it"),
+        "{}",
+        plan.ambient.reason
+    );
+    assert_eq!(out.counts.occlusion_lookups, 16);
+    half_and_whole(&out, grey);
+
+    // A mirror facing the camera reflects the background, darkened alike.
+    let (soup, kd) = scene(mirror(1.0), Vec3::ZERO);
+    let out = render_alike_at_tiles(&soup, &kd, &opts(4, 4));
+    half_and_whole(&out, soup.environment.background);
+
+    // No ambient light and no mirror: nothing to darken, no texel read.
+    let (soup, kd) = scene(diffuse(Vec3::ONE), Vec3::ZERO);
+    let (out, plan) = render(&soup, &kd, &opts(4, 4));
+    assert_eq!(
+        (plan.textures.textures, out.counts.occlusion_lookups),
+        (0, 0)
+    );
     assert_eq!(out.frame.pixel(0, 3), Vec3::ZERO);
 }

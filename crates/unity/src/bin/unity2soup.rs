@@ -168,8 +168,11 @@ fn list(report: &unity::Report) {
             .emission_map
             .as_ref()
             .map_or(String::new(), |r| format!(", emission map {}", image(r)));
+        let occlusion = m.occlusion_map.as_ref().map_or(String::new(), |o| {
+            format!(", occlusion map {} strength {}", image(&o.map), o.strength)
+        });
         eprintln!(
-            "material {:?} ({}): {texture}{normal}{glow}, opacity {}, alpha {:?}",
+            "material {:?} ({}): {texture}{normal}{glow}{occlusion}, opacity {}, alpha {:?}",
             m.name, m.source, m.opacity, m.alpha
         );
     }

@@ -585,3 +585,46 @@ fn emission_maps_belong_to_glowing_materials() {
     assert_eq!(soup.materials[0].emission_map, None);
     assert!(soup.textures.is_empty() && soup.uvs.is_empty());
 }
+
+/// An occlusion map reaches the soup with its strength, sharing the decoded image with the
+/// emission map that names the same file and import; a missing one is a warning.
+#[test]
+fn an_occlusion_map_is_read_with_its_strength() {
+    let src = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/textures");
+    let dir = tempfile::tempdir().unwrap();
+    copy_dir(&src, dir.path());
+    let mat = dir.path().join("Assets/Materials/Glow.mat");
+    let text = std::fs::read_to_string(&mat).unwrap();
+    let quadrants = "b9c15245bb706d4c19dc7f7ee351e73a";
+    let with = |guid: &str| {
+        text.replace(
+            "    - _MainTex:\n",
+            &format!(
+                "    - _OcclusionMap:\n        m_Texture: {{fileID: 2800000, guid: {guid}, type: 3}}\n        m_Scale: {{x: 1, y: 1}}\n        m_Offset: {{x: 0, y: 0}}\n    - _MainTex:\n"
+            ),
+        )
+        .replace("    m_Floats:\n", "    m_Floats:\n    - _OcclusionStrength: 0.75\n")
+    };
+    std::fs::write(&mat, with(quadrants)).unwrap();
+    let scene = dir.path().join("Assets/Scenes/EmissionMap.unity");
+    let soup = convert(&scene);
+    assert!(soup.warnings.is_empty(), "{:?}", soup.warnings);
+    let m = &soup.materials[0];
+    let occlusion = m.occlusion_map.expect("an occlusion map");
+    assert_eq!(occlusion.strength, 0.75);
+    assert_eq!(
+        Some(occlusion.map.texture),
+        m.emission_map.map(|r| r.texture)
+    );
+    assert_eq!(soup.textures.len(), 1);
+
+    std::fs::write(&mat, with("0123456789abcdef0123456789abcdef")).unwrap();
+    let soup = convert(&scene);
+    assert_eq!(soup.materials[0].occlusion_map, None);
+    assert_eq!(
+        soup.warnings,
+        vec!["Assets/Materials/Glow.mat: _OcclusionMap: texture GUID 0123456789abcdef0123456789abcdef \
+              is not in the project; drawn without its occlusion map"
+            .to_string()]
+    );
+}
