@@ -97,14 +97,19 @@ pub fn skybox(
     }
     .map_err(|why| format!("skybox {name}: {why}"))?;
     let p = Props::of(&body);
-    // `_Exposure` is a [Gamma] property: a linear-space project takes it decoded.
-    let exposure = gamma_to_linear(p.float("_Exposure").unwrap_or(1.0).max(0.0));
+    // `_Exposure` is a [Gamma] property: a linear-space project takes it decoded. Its
+    // inspector keeps it within the shader's range, 0–8.
+    let exposure = gamma_to_linear(p.float("_Exposure").unwrap_or(1.0).clamp(0.0, 8.0));
     let tint = p
         .colour("_Tint")
         .unwrap_or(linear_rgb(Vec4::splat(0.5)))
         .max(Vec3::ZERO);
+    let scale = tint * COLOUR_SPACE_DOUBLE * exposure;
+    if !scale.is_finite() {
+        return Err(format!("skybox {name}: _Tint {tint} is too bright to draw"));
+    }
     Ok(Some(Sky::Textured(TexturedSky {
-        scale: tint * COLOUR_SPACE_DOUBLE * exposure,
+        scale,
         rotation: p.float("_Rotation").unwrap_or(0.0),
         layout,
     })))

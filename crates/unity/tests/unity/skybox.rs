@@ -249,3 +249,37 @@ fn an_unreadable_image_skybox_is_a_warning() {
         soup.warnings
     );
 }
+
+/// Numbers no inspector writes: an exposure beyond the shader's range 0–8 is kept within
+/// it; a tint too bright for a float is a warning, never a soup its readers refuse.
+#[test]
+fn an_image_skybox_s_numbers_stay_drawable() {
+    let hdr = |root: &Path| {
+        image::Rgb32FImage::from_pixel(4, 2, image::Rgb([1.0, 1.0, 1.0]))
+            .save(root.join("Assets/Sky.hdr"))
+            .unwrap();
+    };
+    let tex_meta = meta("ffff0000ffff0000ffff0000ffff0000", "");
+    let files = [("Assets/Sky.hdr.meta", tex_meta.as_str())];
+    let slot = [("_MainTex", "ffff0000ffff0000ffff0000ffff0000")];
+    let bright = material(108, &slot, "    - _Exposure: 1e30\n", "");
+    let soup = convert_with(&bright, &files, hdr);
+    let tint = unity::material::srgb_to_linear(0.5) * 4.594_794;
+    assert_eq!(textured(&soup).scale, Vec3::splat(tint * 8f32.powf(2.2)));
+    // Linear 1.1e36: finite, but not once times 4.59 and the exposure's 97.
+    let blinding = material(
+        108,
+        &slot,
+        "    - _Exposure: 8\n",
+        "    - _Tint: {r: 1e15, g: 1, b: 1, a: 1}\n",
+    );
+    let soup = convert_with(&blinding, &files, hdr);
+    assert!(soup.environment.sky.is_none());
+    assert!(
+        soup.warnings
+            .iter()
+            .any(|w| w.contains("is too bright to draw; a sky gradient stands in")),
+        "{:?}",
+        soup.warnings
+    );
+}
