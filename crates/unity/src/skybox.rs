@@ -106,7 +106,9 @@ pub fn skybox(
         .max(Vec3::ZERO);
     let scale = tint * COLOUR_SPACE_DOUBLE * exposure;
     if !scale.is_finite() {
-        return Err(format!("skybox {name}: _Tint {tint} is too bright to draw"));
+        return Err(format!(
+            "skybox {name}: _Tint times _Exposure is too bright to draw"
+        ));
     }
     Ok(Some(Sky::Textured(TexturedSky {
         scale,
