@@ -3,6 +3,10 @@
 //! twice along the view ray (O'Neil's single-scattering model, with that shader's
 //! constants), the ground below the horizon, and the sun's disk. Unity evaluates the
 //! scattering at the sky mesh's vertices and interpolates; here each ray gets its own.
+//!
+//! Also what every skybox shares: [`Skybox`], the procedural sky or an image sky
+//! (`sky_image.rs`) behind one lookup, and [`SkyAmbient`], a sky's light on nine spherical
+//! harmonics as Unity's ambient probe holds it.
 
 use crate::sky_image::ImageSky;
 use formats::{ProceduralSky, Sky, SunDisk};
