@@ -212,10 +212,10 @@ impl Plan {
             },
         };
 
-        let reflective = mats
-            .iter()
-            .filter(|m| m.reflectance().max_element() >= opts.cutoff.max(f32::MIN_POSITIVE))
-            .count();
+        // A material whose reflectance reaches the cut-off sends mirror rays.
+        let mirror =
+            |m: &Material| m.reflectance().max_element() >= opts.cutoff.max(f32::MIN_POSITIVE);
+        let reflective = mats.iter().filter(|m| mirror(m)).count();
         let reflections = if opts.depth == 0 {
             ReflectionPlan {
                 enabled: false,
@@ -348,8 +348,7 @@ impl Plan {
                 m.normal_map.is_some()
                     && (opts.aovs.normal
                         || (diffuse_normal && m.albedo().max_element() > 0.0)
-                        || (reflections.enabled
-                            && m.reflectance().max_element() >= opts.cutoff.max(f32::MIN_POSITIVE)))
+                        || (reflections.enabled && mirror(m)))
             })
             .copied()
             .collect();
@@ -375,8 +374,7 @@ impl Plan {
             .filter(|m| {
                 m.occlusion_map.is_some()
                     && ((ambient.enabled && m.albedo().max_element() > 0.0)
-                        || (reflections.enabled
-                            && m.reflectance().max_element() >= opts.cutoff.max(f32::MIN_POSITIVE)))
+                        || (reflections.enabled && mirror(m)))
             })
             .copied()
             .collect();

@@ -39,6 +39,13 @@ impl<'a> ImageSky<'a> {
         )
     }
 
+    /// [`ImageSky::unity_direction`] undone: the soup direction whose lookup is Unity
+    /// direction `d`.
+    fn soup_direction(&self, d: Vec3) -> Vec3 {
+        let x = self.cos * d.x - self.sin * d.z;
+        Vec3::new(-x, d.y, self.sin * d.x + self.cos * d.z)
+    }
+
     /// The texels' radiance along Unity direction `d` (not normalised), before the
     /// material's scale.
     fn unscaled(&self, d: Vec3) -> Vec3 {
@@ -66,13 +73,11 @@ impl<'a> ImageSky<'a> {
     /// image counts with all of its energy however few texels it has. Rows are summed on
     /// every core, then added in row order, so the sums are the same on any thread count.
     pub fn ambient(&self, intensity: f32) -> SkyAmbient {
-        let images: Vec<&SkyImage> = match &self.sky.layout {
-            SkyLayout::LatLong { image, .. } => vec![image],
-            SkyLayout::Cube { faces } => faces.iter().collect(),
-        };
-        let columns = match &self.sky.layout {
-            SkyLayout::LatLong { image, panorama } => Columns::new(image.width, *panorama),
-            SkyLayout::Cube { .. } => Columns::default(),
+        let (images, columns): (Vec<&SkyImage>, Columns) = match &self.sky.layout {
+            SkyLayout::LatLong { image, panorama } => {
+                (vec![image], Columns::new(image.width, *panorama))
+            }
+            SkyLayout::Cube { faces } => (faces.iter().collect(), Columns::default()),
         };
         let rows: Vec<(usize, u32)> = images
             .iter()
@@ -111,12 +116,7 @@ impl<'a> ImageSky<'a> {
         area: f32,
     ) {
         let l = image.texel(x, y) * self.sky.scale;
-        // Back from Unity's axes and the mesh's rotation to soup space.
-        let (ux, uz) = (
-            self.cos * d.x - self.sin * d.z,
-            self.sin * d.x + self.cos * d.z,
-        );
-        add_sample(sums, Vec3::new(-ux, d.y, uz).normalize(), l * area);
+        add_sample(sums, self.soup_direction(d).normalize(), l * area);
     }
 
     /// One row of a latitude-longitude image, its texels' azimuths from `columns`.

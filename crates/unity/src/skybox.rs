@@ -13,6 +13,7 @@ use formats::{
     Light, LightKind, Panorama, ProceduralSky, Sky, SkyImage, SkyLayout, SunDisk, TexturedSky,
 };
 use glam::{Vec3, Vec4};
+use std::path::{Path, PathBuf};
 
 /// Unity's built-in extra resources, where Default-Skybox and the skybox shaders live.
 const BUILTIN_EXTRA: &str = "0000000000000000f000000000000000";
@@ -158,6 +159,40 @@ impl<'a> Props<'a> {
     }
 }
 
+/// The file the texture slot `property` names, and its project-relative name.
+fn texture_file(
+    body: &Node,
+    property: &str,
+    project: &Project,
+) -> Result<(PathBuf, String), String> {
+    let slot = named_slot(body, property).ok_or_else(|| format!("{property} names no texture"))?;
+    let path = project.resolve(&slot.guid).ok_or_else(|| {
+        format!(
+            "{property}: texture GUID {} is not in the project",
+            slot.guid
+        )
+    })?;
+    Ok((path.clone(), project.rel(path)))
+}
+
+/// The image at `path` (slot `property`, named `source`), linear; `resize` as
+/// [`load_linear`].
+fn load(
+    path: &Path,
+    source: &str,
+    property: &str,
+    import: &Import,
+    resize: bool,
+) -> Result<LinearImage, String> {
+    if ext(path) == "cubemap" {
+        return Err(format!(
+            "{property}: {source} is a Unity .cubemap asset, which is not read (import the \
+             cubemap from an image)"
+        ));
+    }
+    load_linear(path, source, import, resize).map_err(|e| e.to_string())
+}
+
 /// The texture `property` names, linear, with its import settings; `resize` as
 /// [`load_linear`].
 fn image(
@@ -166,22 +201,9 @@ fn image(
     project: &Project,
     resize: bool,
 ) -> Result<(LinearImage, Import, String), String> {
-    let slot = named_slot(body, property).ok_or_else(|| format!("{property} names no texture"))?;
-    let path = project.resolve(&slot.guid).ok_or_else(|| {
-        format!(
-            "{property}: texture GUID {} is not in the project",
-            slot.guid
-        )
-    })?;
-    let source = project.rel(path);
-    if ext(path) == "cubemap" {
-        return Err(format!(
-            "{property}: {source} is a Unity .cubemap asset, which is not read (import the \
-             cubemap from an image)"
-        ));
-    }
-    let import = Import::read(path);
-    let img = load_linear(path, &source, &import, resize).map_err(|e| e.to_string())?;
+    let (path, source) = texture_file(body, property, project)?;
+    let import = Import::read(&path);
+    let img = load(&path, &source, property, &import, resize)?;
     Ok((img, import, source))
 }
 
@@ -227,23 +249,21 @@ fn panoramic(body: &Node, project: &Project) -> Result<SkyLayout, String> {
 /// Skybox/Cubemap: `_Tex`, a texture imported as a cubemap from a latitude-longitude
 /// image or six faces in one image (strip or cross).
 fn cubemap(body: &Node, project: &Project) -> Result<SkyLayout, String> {
-    let slot = named_slot(body, "_Tex").ok_or("_Tex names no texture")?;
-    let import = project.resolve(&slot.guid).map(|p| Import::read(p));
-    if let Some(import) = &import {
-        if !import.cube {
-            return Err("_Tex is not imported as a cubemap (Texture Shape: Cube)".into());
-        }
-        match import.cube_mapping {
-            1 => return Err("_Tex is imported as a sphere map, which is not read".into()),
-            2 => {
-                let (img, _, source) = image(body, "_Tex", project, true)?;
-                return Ok(lat_long(&source, &img));
-            }
-            _ => {}
-        }
+    let (path, source) = texture_file(body, "_Tex", project)?;
+    let import = Import::read(&path);
+    if !import.cube {
+        return Err("_Tex is not imported as a cubemap (Texture Shape: Cube)".into());
     }
-    let (img, import, source) = image(body, "_Tex", project, false)?;
-    // Automatic mapping takes a 2:1 image as latitude-longitude; six faces otherwise.
+    if import.cube_mapping == 1 {
+        return Err("_Tex is imported as a sphere map, which is not read".into());
+    }
+    // A cylindrical import is latitude-longitude at the import's size; automatic mapping
+    // takes a 2:1 image so too, and six faces otherwise.
+    let cylindrical = import.cube_mapping == 2;
+    let img = load(&path, &source, "_Tex", &import, cylindrical)?;
+    if cylindrical {
+        return Ok(lat_long(&source, &img));
+    }
     if import.cube_mapping != 5 && img.width == 2 * img.height {
         let (w, h) = import.imported_size(img.width, img.height);
         return Ok(lat_long(&source, &resized(&img, w, h)));
