@@ -40,6 +40,11 @@ impl Found {
 pub(crate) trait Tracer: Sync {
     fn closest(&self, ray: &Ray) -> Found;
     fn occluded(&self, ray: &Ray) -> bool;
+    /// Runs a chunk of this contender's queries in the floating-point mode it asks its
+    /// callers for: the default mode, but for Embree.
+    fn in_mode(&self, run: &mut dyn FnMut()) {
+        run()
+    }
     /// A packet of 4, 8 or 16 rays (neighbouring pixels, or their shadow rays) at once,
     /// answers into `out`, through the contender's widest packet query that fits.
     fn closest_packet(&self, rays: &[Ray], out: &mut [Found]) {
@@ -103,6 +108,10 @@ impl Tracer for crate::embree::EmbreeScene {
     #[inline]
     fn occluded(&self, ray: &Ray) -> bool {
         crate::embree::EmbreeScene::occluded(self, ray)
+    }
+    /// Subnormals flushed, as Embree asks ([`crate::embree::flushing_subnormals`]).
+    fn in_mode(&self, run: &mut dyn FnMut()) {
+        crate::embree::flushing_subnormals(run)
     }
     /// `rtcIntersect4`, `8` or `16`, by the packet's size.
     #[inline]

@@ -59,8 +59,14 @@ pub fn process_cpu_seconds() -> Option<f64> {
 /// large enough that task overhead is noise.
 const CHUNK: usize = 256;
 
-/// Answer every ray with `f` on `pool`'s threads, results in ray order.
-pub fn trace<R, T>(pool: &rayon::ThreadPool, rays: &[R], f: impl Fn(&R) -> T + Sync) -> Vec<T>
+/// Answer every ray with `f` on `pool`'s threads, results in ray order. Each chunk of rays
+/// runs inside `around` (a contender's floating-point mode, see `Tracer::in_mode`).
+pub fn trace<R, T>(
+    pool: &rayon::ThreadPool,
+    rays: &[R],
+    around: impl Fn(&mut dyn FnMut()) + Sync,
+    f: impl Fn(&R) -> T + Sync,
+) -> Vec<T>
 where
     R: Sync,
     T: Send + Copy + Default,
@@ -70,9 +76,11 @@ where
         out.par_chunks_mut(CHUNK)
             .zip(rays.par_chunks(CHUNK))
             .for_each(|(o, r)| {
-                for (slot, ray) in o.iter_mut().zip(r) {
-                    *slot = f(ray);
-                }
+                around(&mut || {
+                    for (slot, ray) in o.iter_mut().zip(r.iter()) {
+                        *slot = f(ray);
+                    }
+                })
             })
     });
     out
@@ -84,6 +92,7 @@ pub fn trace_packets<R, T>(
     pool: &rayon::ThreadPool,
     rays: &[R],
     packet: usize,
+    around: impl Fn(&mut dyn FnMut()) + Sync,
     many: impl Fn(&[R], &mut [T]) + Sync,
 ) -> Vec<T>
 where
@@ -98,9 +107,11 @@ where
         out.par_chunks_mut(chunk)
             .zip(rays.par_chunks(chunk))
             .for_each(|(o, r)| {
-                for (o, r) in o.chunks_mut(packet).zip(r.chunks(packet)) {
-                    many(r, o);
-                }
+                around(&mut || {
+                    for (o, r) in o.chunks_mut(packet).zip(r.chunks(packet)) {
+                        many(r, o);
+                    }
+                })
             })
     });
     out
@@ -120,7 +131,7 @@ mod tests {
     fn trace_keeps_ray_order_on_two_threads() {
         let p = pool(2).unwrap();
         let input: Vec<u32> = (0..10_000).collect();
-        let out = trace(&p, &input, |x| x * 2);
+        let out = trace(&p, &input, |run| run(), |x| x * 2);
         assert!(out.iter().enumerate().all(|(i, &v)| v == 2 * i as u32));
     }
 
@@ -129,14 +140,20 @@ mod tests {
         let p = pool(2).unwrap();
         let input: Vec<u32> = (0..1000).collect();
         for packet in [4, 8, 16] {
-            let out = trace_packets(&p, &input, packet, |r, o| {
-                // Every run but the last has exactly `packet` rays and starts at a multiple.
-                assert!(r.len() == packet || r[0] as usize == 1000 / packet * packet);
-                assert_eq!(r[0] as usize % packet, 0);
-                for (o, x) in o.iter_mut().zip(r) {
-                    *o = x * 3;
-                }
-            });
+            let out = trace_packets(
+                &p,
+                &input,
+                packet,
+                |run| run(),
+                |r, o| {
+                    // Every run but the last has exactly `packet` rays and starts at a multiple.
+                    assert!(r.len() == packet || r[0] as usize == 1000 / packet * packet);
+                    assert_eq!(r[0] as usize % packet, 0);
+                    for (o, x) in o.iter_mut().zip(r) {
+                        *o = x * 3;
+                    }
+                },
+            );
             assert!(out.iter().enumerate().all(|(i, &v)| v == 3 * i as u32));
         }
     }

@@ -40,21 +40,22 @@ impl Bench<'_> {
             for _ in 0..self.cfg.runs.max(1) {
                 for (c, (_, tracer)) in who.iter().enumerate() {
                     let start = Instant::now();
+                    let around = |run: &mut dyn FnMut()| tracer.in_mode(run);
                     let a = match kind {
                         Kind::ShadowPackets(n) | Kind::SoftPackets(n) => {
-                            Answers::Occluded(trace_packets(pool, rays, n, |p, o| {
+                            Answers::Occluded(trace_packets(pool, rays, n, around, |p, o| {
                                 tracer.occluded_packet(p, o)
                             }))
                         }
                         Kind::PrimaryPackets(n) => {
-                            Answers::Closest(trace_packets(pool, rays, n, |p, o| {
+                            Answers::Closest(trace_packets(pool, rays, n, around, |p, o| {
                                 tracer.closest_packet(p, o)
                             }))
                         }
                         _ if kind.any_hit() => {
-                            Answers::Occluded(trace(pool, rays, |r| tracer.occluded(r)))
+                            Answers::Occluded(trace(pool, rays, around, |r| tracer.occluded(r)))
                         }
-                        _ => Answers::Closest(trace(pool, rays, |r| tracer.closest(r))),
+                        _ => Answers::Closest(trace(pool, rays, around, |r| tracer.closest(r))),
                     };
                     times[c].push(start.elapsed().as_secs_f64());
                     answers[c] = Some(a);

@@ -20,7 +20,7 @@
 //! children in different orders: they are traced one by one.
 
 use crate::aabb::Aabb;
-use crate::traverse::{candidate, keep_closer, Tree, STACK};
+use crate::traverse::{candidate, keep_closer, Tree, MIN_POSITIVE_PADDED, STACK};
 use crate::triangle::{self, RayPre4, PAD};
 use crate::Ray;
 use formats::{Hit, KdNode};
@@ -59,6 +59,8 @@ struct Packet {
     tmin: [f32; LANES],
     tmax: [f32; LANES],
     t0: Vec4,
+    /// `down4(t0)`, worked out once (see `traverse::pad_down`).
+    t0_pad: Vec4,
     t1: Vec4,
 }
 
@@ -116,7 +118,8 @@ impl Packet {
             t0 = Vec4::select(parallel, t0, t0.max(near));
             t1 = Vec4::select(parallel, t1, t1.min(far));
         }
-        ok &= down4(t0).cmple(up4(t1));
+        let t0_pad = down4(t0);
+        ok &= t0_pad.cmple(up4(t1));
         let live = ok.bitmask() as u8;
         if live == 0 {
             return Walk::Nowhere;
@@ -154,6 +157,7 @@ impl Packet {
             tmin: tmin.to_array(),
             tmax: tmax.to_array(),
             t0,
+            t0_pad,
             t1,
         })
     }
@@ -172,6 +176,7 @@ fn step4<const FAR_FIRST: bool>(
     node_i: &mut u32,
     mask: &mut u8,
     t0: &mut Vec4,
+    t0_pad: &mut Vec4,
     t1: &mut Vec4,
     stack: &mut [MaybeUninit<Waiting>; STACK],
     sp: &mut usize,
@@ -185,7 +190,7 @@ fn step4<const FAR_FIRST: bool>(
     };
     let tp = (Vec4::splat(node.split()) - p.o[a]) * p.inv[a];
     let only_first = tp.cmpgt(up4(*t1));
-    let only_second = tp.cmplt(down4(*t0)) & !only_first;
+    let only_second = tp.cmplt(*t0_pad) & !only_first;
     let both = !(only_first | only_second);
     let near = (!only_second).bitmask() as u8 & *mask;
     let far = (!only_first).bitmask() as u8 & *mask;
@@ -199,10 +204,10 @@ fn step4<const FAR_FIRST: bool>(
             if near != 0 {
                 push(stack, sp, first, near, *t0, near_t1);
             }
-            (*node_i, *mask, *t0) = (second, far, far_t0);
+            (*node_i, *mask, *t0, *t0_pad) = (second, far, far_t0, down4(far_t0));
         }
     } else if near == 0 {
-        (*node_i, *mask, *t0) = (second, far, far_t0);
+        (*node_i, *mask, *t0, *t0_pad) = (second, far, far_t0, down4(far_t0));
     } else {
         if far != 0 {
             push(stack, sp, second, far, far_t0, *t1);
@@ -241,6 +246,7 @@ impl Tree<'_> {
         node_i: &mut u32,
         mask: &mut u8,
         t0: &mut Vec4,
+        t0_pad: &mut Vec4,
         t1: &mut Vec4,
         stack: &mut [MaybeUninit<Waiting>; STACK],
         sp: &mut usize,
@@ -250,7 +256,7 @@ impl Tree<'_> {
             if node.is_leaf() {
                 return self.leaf(node);
             }
-            step4::<FAR_FIRST>(p, node, node_i, mask, t0, t1, stack, sp);
+            step4::<FAR_FIRST>(p, node, node_i, mask, t0, t0_pad, t1, stack, sp);
         }
     }
 
@@ -291,12 +297,14 @@ impl Tree<'_> {
         let mut stack = [MaybeUninit::<Waiting>::uninit(); STACK];
         let mut sp = 0;
         let (mut node_i, mut mask, mut t0, mut t1) = (0u32, p.live, p.t0, p.t1);
+        let mut t0_pad = p.t0_pad;
         loop {
             let leaf = self.to_leaf::<false>(
                 p,
                 &mut node_i,
                 &mut mask,
                 &mut t0,
+                &mut t0_pad,
                 &mut t1,
                 &mut stack,
                 &mut sp,
@@ -339,9 +347,11 @@ impl Tree<'_> {
                 // SAFETY: entries below `sp` were written by the push that raised `sp`
                 // past them.
                 let w = unsafe { stack[sp].assume_init() };
-                let ahead = Vec4::from_array(best_t).cmpge(down4(w.t0)).bitmask() as u8;
+                let w_pad = down4(w.t0);
+                let ahead = Vec4::from_array(best_t).cmpge(w_pad).bitmask() as u8;
                 if w.lanes & ahead != 0 {
                     (node_i, mask, t0, t1) = (w.node, w.lanes & ahead, w.t0, w.t1);
+                    t0_pad = w_pad;
                     break;
                 }
             }
@@ -386,12 +396,14 @@ impl Tree<'_> {
         let mut stack = [MaybeUninit::<Waiting>::uninit(); STACK];
         let mut sp = 0;
         let (mut node_i, mut mask, mut t0, mut t1) = (0u32, p.live, p.t0, p.t1);
+        let mut t0_pad = p.t0_pad;
         loop {
             let leaf = self.to_leaf::<FAR_FIRST>(
                 p,
                 &mut node_i,
                 &mut mask,
                 &mut t0,
+                &mut t0_pad,
                 &mut t1,
                 &mut stack,
                 &mut sp,
@@ -433,6 +445,7 @@ impl Tree<'_> {
                 let w = unsafe { stack[sp].assume_init() };
                 if w.lanes & !blocked != 0 {
                     (node_i, mask, t0, t1) = (w.node, w.lanes & !blocked, w.t0, w.t1);
+                    t0_pad = down4(t0);
                     break;
                 }
             }
@@ -453,8 +466,12 @@ fn up4(t: Vec4) -> Vec4 {
     t + t.abs() * PAD
 }
 
-/// `traverse::pad_down` on four lanes.
+/// `traverse::pad_down` on four lanes, its subnormal case included: a lane at
+/// `f32::MIN_POSITIVE` takes the constant and pads 1 instead (behind a value the compiler
+/// cannot see through, as there), so that no lane's result is subnormal.
 #[inline(always)]
 fn down4(t: Vec4) -> Vec4 {
-    t - t.abs() * PAD
+    let spawned = t.cmpeq(Vec4::splat(f32::MIN_POSITIVE));
+    let t = std::hint::black_box(Vec4::select(spawned, Vec4::ONE, t));
+    Vec4::select(spawned, Vec4::splat(MIN_POSITIVE_PADDED), t - t.abs() * PAD)
 }

@@ -69,10 +69,31 @@ fn pad_up(t: f32) -> f32 {
     triangle::widen(t)
 }
 
+/// The lower end of a cell's interval, padded the same way down.
+///
+/// A spawned ray's interval starts at `f32::MIN_POSITIVE` (it excludes t = 0 and
+/// subnormal t), whose padding is subnormal, and Intel cores take a microcode assist of
+/// about a hundred cycles for every subnormal result. So each walk pads a lower end once,
+/// when its interval starts, not at every step, and that one value comes from
+/// [`MIN_POSITIVE_PADDED`].
 #[inline(always)]
-fn pad_down(t: f32) -> f32 {
-    t - t.abs() * triangle::PAD
+pub(crate) fn pad_down(t: f32) -> f32 {
+    // The compiler computes both arms and selects, and it would pad `t` itself in both
+    // (the result is the constant either way); the arithmetic pads 1 instead, behind a
+    // value it cannot see through.
+    let spawned = t == f32::MIN_POSITIVE;
+    let x = std::hint::black_box(if spawned { 1.0 } else { t });
+    let padded = x - x.abs() * triangle::PAD;
+    if spawned {
+        MIN_POSITIVE_PADDED
+    } else {
+        padded
+    }
 }
+
+/// `pad_down(f32::MIN_POSITIVE)` as the compiler works it out: IEEE arithmetic, subnormals
+/// included, so the same bits the processor would round to, without the assist.
+pub(crate) const MIN_POSITIVE_PADDED: f32 = f32::MIN_POSITIVE - f32::MIN_POSITIVE * triangle::PAD;
 
 pub(crate) struct Tree<'a> {
     pub tris: &'a [[[f32; 3]; 3]],
@@ -89,6 +110,8 @@ pub(crate) struct Setup {
     pub o: [f32; 3],
     pub inv: [f32; 3],
     pub t0: f32,
+    /// `pad_down(t0)`, worked out once: see [`pad_down`].
+    pub t0_pad: f32,
     pub t1: f32,
 }
 
@@ -121,11 +144,13 @@ pub(crate) fn setup(ray: &Ray, b: &Aabb) -> Option<Setup> {
             t1 = t1.min(far);
         }
     }
-    (pad_down(t0) <= pad_up(t1)).then_some(Setup {
+    let t0_pad = pad_down(t0);
+    (t0_pad <= pad_up(t1)).then_some(Setup {
         pre,
         o,
         inv,
         t0,
+        t0_pad,
         t1,
     })
 }
@@ -180,7 +205,7 @@ fn far_start(t_split: f32, t0: f32) -> f32 {
 /// which no comparison accepts: both children, over the whole interval ([`near_end`],
 /// [`far_start`]).
 #[inline(always)]
-fn step(s: &Setup, i: u32, node: KdNode, t0: f32, t1: f32) -> Step {
+fn step(s: &Setup, i: u32, node: KdNode, t0_pad: f32, t1: f32) -> Step {
     let a = node.axis();
     let below = i + 1;
     let above = node.above_child();
@@ -193,7 +218,7 @@ fn step(s: &Setup, i: u32, node: KdNode, t0: f32, t1: f32) -> Step {
     };
     if tp > pad_up(t1) {
         Step::One(first)
-    } else if tp < pad_down(t0) {
+    } else if tp < t0_pad {
         Step::One(second)
     } else {
         Step::Two {
@@ -238,11 +263,12 @@ fn take_step(
     node: KdNode,
     node_i: &mut u32,
     t0: f32,
+    t0_pad: f32,
     t1: &mut f32,
     stack: &mut Stack,
     sp: &mut usize,
 ) {
-    match step(s, *node_i, node, t0, *t1) {
+    match step(s, *node_i, node, t0_pad, *t1) {
         Step::One(c) => *node_i = c,
         Step::Two {
             first,
@@ -270,6 +296,7 @@ fn take_step_branch_free(
     node: KdNode,
     node_i: &mut u32,
     t0: f32,
+    t0_pad: f32,
     t1: &mut f32,
     stack: &mut Stack,
     sp: &mut usize,
@@ -282,7 +309,7 @@ fn take_step_branch_free(
     let second = below ^ above ^ first;
     prefetch(nodes.as_ptr().wrapping_add(second as usize));
     let only_first = tp > pad_up(*t1);
-    let only_second = !only_first & (tp < pad_down(t0));
+    let only_second = !only_first & (tp < t0_pad);
     let both = !only_first & !only_second;
     stack[*sp] = MaybeUninit::new((second, far_start(tp, t0), *t1));
     *sp += usize::from(both);
@@ -304,12 +331,13 @@ fn take_step_far_first(
     node: KdNode,
     node_i: &mut u32,
     t0: &mut f32,
+    t0_pad: &mut f32,
     t1: f32,
     stack: &mut Stack,
     sp: &mut usize,
 ) {
     // `step` names the children in front-to-back order: `first` is the near one.
-    match step(s, *node_i, node, *t0, t1) {
+    match step(s, *node_i, node, *t0_pad, t1) {
         Step::One(c) => *node_i = c,
         Step::Two {
             first,
@@ -320,6 +348,7 @@ fn take_step_far_first(
             *sp += 1;
             *node_i = second;
             *t0 = far_start(t_split, *t0);
+            *t0_pad = pad_down(*t0);
         }
     }
 }
@@ -424,12 +453,21 @@ impl Tree<'_> {
         let mut best_t = ray.tmax;
         let mut stack = new_stack();
         let mut sp = 0;
-        let (mut node_i, mut t0, mut t1) = (0u32, s.t0, s.t1);
+        let (mut node_i, mut t0, mut t0_pad, mut t1) = (0u32, s.t0, s.t0_pad, s.t1);
         loop {
             let node = self.node(node_i);
             if !node.is_leaf() {
                 count.node();
-                take_step(s, node, &mut node_i, t0, &mut t1, &mut stack, &mut sp);
+                take_step(
+                    s,
+                    node,
+                    &mut node_i,
+                    t0,
+                    t0_pad,
+                    &mut t1,
+                    &mut stack,
+                    &mut sp,
+                );
                 continue;
             }
             let leaf = self.leaf(node);
@@ -446,7 +484,8 @@ impl Tree<'_> {
                 }
                 sp -= 1;
                 (node_i, t0, t1) = pop(&stack, sp);
-                if best_t >= pad_down(t0) {
+                t0_pad = pad_down(t0);
+                if best_t >= t0_pad {
                     break;
                 }
             }
@@ -519,13 +558,22 @@ impl Tree<'_> {
     ) -> bool {
         let mut stack = new_stack();
         let mut sp = 0;
-        let (mut node_i, mut t0, mut t1) = (0u32, s.t0, s.t1);
+        let (mut node_i, mut t0, mut t0_pad, mut t1) = (0u32, s.t0, s.t0_pad, s.t1);
         loop {
             let node = self.node(node_i);
             if !node.is_leaf() {
                 count.node();
                 if FAR_FIRST {
-                    take_step_far_first(s, node, &mut node_i, &mut t0, t1, &mut stack, &mut sp);
+                    take_step_far_first(
+                        s,
+                        node,
+                        &mut node_i,
+                        &mut t0,
+                        &mut t0_pad,
+                        t1,
+                        &mut stack,
+                        &mut sp,
+                    );
                 } else {
                     take_step_branch_free(
                         self.nodes,
@@ -533,6 +581,7 @@ impl Tree<'_> {
                         node,
                         &mut node_i,
                         t0,
+                        t0_pad,
                         &mut t1,
                         &mut stack,
                         &mut sp,
@@ -550,6 +599,7 @@ impl Tree<'_> {
             }
             sp -= 1;
             (node_i, t0, t1) = pop(&stack, sp);
+            t0_pad = pad_down(t0);
         }
     }
 }
@@ -617,5 +667,39 @@ pub(crate) fn candidate(prim: u32, h: RawHit) -> Hit {
         prim,
         u: h.u,
         v: h.v,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::hint::black_box;
+
+    /// The padding the processor rounds to, subnormals included.
+    fn padded_at_run_time(t: f32) -> f32 {
+        let t = black_box(t);
+        t - t.abs() * black_box(triangle::PAD)
+    }
+
+    #[test]
+    fn the_lower_padding_has_the_run_time_bits_and_a_spawned_ray_s_is_subnormal() {
+        for t in [
+            f32::MIN_POSITIVE,
+            f32::MIN_POSITIVE * 2.0,
+            0.0,
+            -0.0,
+            1.0,
+            -3.5,
+            1e-30,
+            f32::INFINITY,
+        ] {
+            assert_eq!(
+                pad_down(t).to_bits(),
+                padded_at_run_time(t).to_bits(),
+                "{t:e}"
+            );
+        }
+        const { assert!(MIN_POSITIVE_PADDED.is_subnormal() && MIN_POSITIVE_PADDED > 0.0) };
+        assert!(pad_down(f32::NAN).is_nan());
     }
 }

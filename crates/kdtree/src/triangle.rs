@@ -170,6 +170,33 @@ const fn gamma(n: i32) -> f32 {
     (n as f32 * u) / (1.0 - n as f32 * u)
 }
 
+/// Below this, a positive tmin is taken as 0 in the scaled early-out `tt ≥ tmin·|det|`.
+/// A spawned ray's tmin is `f32::MIN_POSITIVE`, which excludes t = 0 and subnormal t, and
+/// its product with a determinant below 1 is subnormal: Intel cores take a microcode assist
+/// of about a hundred cycles for each such result, at every triangle test. The final
+/// `t ≥ tmin` still holds each hit to the real bound; the early-out with 0 lets through
+/// only hits within an ulp of a tmin this small, which the near-hit bound in `finish`
+/// refuses unless the triangle lies within about 1e-16 of the origin.
+const TINY_TMIN: f32 = 1.0 / 18_446_744_073_709_551_616.0; // 2⁻⁶⁴
+
+/// The lower bound for the scaled early-out: `tmin`, or 0 for a positive tmin below
+/// [`TINY_TMIN`].
+#[inline(always)]
+fn scaled_tmin(tmin: f32) -> f32 {
+    if tmin > 0.0 && tmin < TINY_TMIN {
+        0.0
+    } else {
+        tmin
+    }
+}
+
+/// [`scaled_tmin`] on four lanes.
+#[inline(always)]
+fn scaled_tmin4(tmin: Vec4) -> Vec4 {
+    let tiny = tmin.cmpgt(Vec4::ZERO) & tmin.cmplt(Vec4::splat(TINY_TMIN));
+    Vec4::select(tiny, Vec4::ZERO, tmin)
+}
+
 /// The part of the test after the edge functions `uvw` agree in sign: the determinant,
 /// the distance from the vertices' `z` (relative to the origin, before the z shear) and
 /// the interval. Shared by the one- and four-triangle tests so they give the same bits.
@@ -196,7 +223,7 @@ fn finish(
     let tt = u * (sz * z[0]) + v * (sz * z[1]) + w * (sz * z[2]);
     // Two-sided: compare against |det|-scaled bounds instead of dividing.
     let (tt, adet) = if det < 0.0 { (-tt, -det) } else { (tt, det) };
-    if !(tt >= tmin * adet && tt <= tmax * adet) {
+    if !(tt >= scaled_tmin(tmin) * adet && tt <= tmax * adet) {
         return None;
     }
     let inv = 1.0 / det;
@@ -350,7 +377,12 @@ pub fn intersect4_along<const KZ: usize>(
         rel(2, ky),
     ];
     let shear = [Vec4::splat(r.sx), Vec4::splat(r.sy), Vec4::splat(r.sz)];
-    lanes4(xy, z, shear, [Vec4::splat(tmin), Vec4::splat(tmax)], |l| {
+    let bounds = [
+        Vec4::splat(scaled_tmin(tmin)),
+        Vec4::splat(tmin),
+        Vec4::splat(tmax),
+    ];
+    lanes4(xy, z, shear, bounds, |l| {
         intersect_along::<KZ>(r, tri[l], tmin, tmax)
     })
 }
@@ -409,7 +441,8 @@ pub fn intersect_rays4_along<const KZ: usize>(
         rel(2, kx),
         rel(2, ky),
     ];
-    let bounds = [Vec4::from_array(tmin), Vec4::from_array(tmax)];
+    let tmin4 = Vec4::from_array(tmin);
+    let bounds = [scaled_tmin4(tmin4), tmin4, Vec4::from_array(tmax)];
     lanes4(xy, z, r.shear, bounds, |l| {
         intersect_along::<KZ>(&r.rays[l], tri, tmin[l], tmax[l])
     })
@@ -417,14 +450,15 @@ pub fn intersect_rays4_along<const KZ: usize>(
 
 /// The four-lane test from the vertices relative to each lane's origin: `xy` holds
 /// a, b and c's x and y (the axes after the dominant one), `z` their dominant-axis
-/// coordinates, `shear` the rays' sx, sy and sz, `bounds` their tmin and tmax. When some
+/// coordinates, `shear` the rays' sx, sy and sz, `bounds` their [`scaled_tmin`], tmin and
+/// tmax. When some
 /// lane's edge function is exactly zero every lane is answered by `exact`, the scalar test.
 #[inline(always)]
 fn lanes4(
     xy: [Vec4; 6],
     z: [Vec4; 3],
     shear: [Vec4; 3],
-    bounds: [Vec4; 2],
+    bounds: [Vec4; 3],
     exact: impl Fn(usize) -> Option<RawHit>,
 ) -> Hits4 {
     let [sxv, syv, sz] = shear;
@@ -474,10 +508,10 @@ fn lanes4(
     let inv = Vec4::ONE / det;
     let max_z = max3_4(zu, zv, zw);
     let near = t.cmplt(max_z * (1.0 / 1024.0));
-    let [tmin4, tmax4] = bounds;
+    let [scaled4, tmin4, tmax4] = bounds;
     let hit = det.cmpne(z)
         & !det.is_nan_mask()
-        & tt.cmpge(tmin4 * adet)
+        & tt.cmpge(scaled4 * adet)
         & tt.cmple(tmax4 * adet)
         & t.cmpge(tmin4)
         & t.cmple(tmax4);
@@ -823,6 +857,49 @@ mod tests {
         let r = RayPre::new(Vec3::new(0.0, 1.0, 0.0), dir).unwrap();
         let h = intersect(&r, &floor, f32::MIN_POSITIVE, f32::INFINITY).unwrap();
         assert!((h.t - 1.0 / -dir.y).abs() < 1e-5, "{}", h.t);
+    }
+
+    /// A tmin below `TINY_TMIN` skips the scaled early-out's product, which would be
+    /// subnormal; the interval still holds, in the scalar test and in every lane.
+    #[test]
+    fn a_tiny_tmin_still_bounds_the_hits() {
+        let floor = tri();
+        let dir = Vec3::new(0.0, 0.0, 1.0);
+        let rays4 = |o: Vec3, tmin: f32| {
+            let r = RayPre::new(o, dir).unwrap();
+            let lanes = RayPre4::from_lanes(
+                r.kz,
+                [o.x, o.y, o.z].map(Vec4::splat),
+                [r.sx, r.sy, r.sz].map(Vec4::splat),
+            );
+            (
+                intersect(&r, &floor, tmin, f32::INFINITY).map(|h| h.t),
+                intersect4_along_any_in(&r, [&floor; 4], tmin).hit,
+                intersect_rays4_along::<2>(&lanes, &floor, [tmin; 4], [f32::INFINITY; 4]).hit,
+            )
+        };
+        // On the triangle: t = 0, outside [MIN_POSITIVE, ∞).
+        let on = Vec3::new(0.25, 0.25, 0.0);
+        assert_eq!(rays4(on, f32::MIN_POSITIVE), (None, [false; 4], [false; 4]));
+        assert_eq!(rays4(on, 0.0).0, Some(0.0));
+        // 1e-30 below it: t = 1e-30, inside [MIN_POSITIVE, ∞) and outside [2e-30, ∞).
+        let below = Vec3::new(0.25, 0.25, -1e-30);
+        assert_eq!(
+            rays4(below, f32::MIN_POSITIVE),
+            (Some(1e-30), [true; 4], [true; 4])
+        );
+        assert_eq!(rays4(below, 2e-30), (None, [false; 4], [false; 4]));
+        assert_eq!(scaled_tmin(f32::MIN_POSITIVE), 0.0);
+        assert_eq!(scaled_tmin(1e-10), 1e-10);
+        assert_eq!(scaled_tmin(-1e-30), -1e-30);
+    }
+
+    fn intersect4_along_any_in(r: &RayPre, tri: [&[[f32; 3]; 3]; 4], tmin: f32) -> Hits4 {
+        match r.kz {
+            0 => intersect4_along::<0>(r, tri, tmin, f32::INFINITY),
+            1 => intersect4_along::<1>(r, tri, tmin, f32::INFINITY),
+            _ => intersect4_along::<2>(r, tri, tmin, f32::INFINITY),
+        }
     }
 
     fn intersect4_along_any(r: &RayPre, tri: [&[[f32; 3]; 3]; 4]) -> Hits4 {
