@@ -250,8 +250,11 @@ pub struct Integrator<'a> {
     fog: Option<FogModel>,
     /// The skybox a Skybox camera shows, when the scene has one.
     sky: Option<Skybox<'a>>,
-    /// The ambient light of the skybox, where the ambient mode is Skybox.
-    sky_ambient: Option<SkyAmbient>,
+    /// The ambient light of the skybox, where the ambient mode is Skybox. Boxed: inline, the
+    /// compiler worked out the harmonics' constant term ahead of the branch on it, from the
+    /// bytes an absent value leaves, and where those read as subnormal numbers Intel cores
+    /// took a microcode assist at every block of pixels (the baseline traced 6–9 % slower).
+    sky_ambient: Option<Box<SkyAmbient>>,
 }
 
 /// [`Integrator::sides`] bits: camera and reflection rays that meet the triangle's front
@@ -411,7 +414,7 @@ impl<'a> Integrator<'a> {
                 .as_ref()
                 .filter(|_| soup.environment.clear == ClearFlags::Skybox)
                 .map(Skybox::new),
-            sky_ambient: sky_ambient(soup, plan),
+            sky_ambient: sky_ambient(soup, plan).map(Box::new),
         }
     }
 
