@@ -451,8 +451,8 @@ pub fn intersect_rays4_along<const KZ: usize>(
 /// The four-lane test from the vertices relative to each lane's origin: `xy` holds
 /// a, b and c's x and y (the axes after the dominant one), `z` their dominant-axis
 /// coordinates, `shear` the rays' sx, sy and sz, `bounds` their [`scaled_tmin`], tmin and
-/// tmax. When some
-/// lane's edge function is exactly zero every lane is answered by `exact`, the scalar test.
+/// tmax. When some lane's edge function is exactly zero every lane is answered by `exact`,
+/// the scalar test.
 #[inline(always)]
 fn lanes4(
     xy: [Vec4; 6],

@@ -134,13 +134,7 @@ fn the_far_clip_plane_is_read_and_one_not_beyond_the_near_plane_is_dropped() {
     assert_eq!(far("55.5").camera.far, 55.5);
     let bad = far("0.2");
     assert_eq!(bad.camera.far, f32::INFINITY);
-    assert!(
-        bad.warnings
-            .iter()
-            .any(|w| w.contains("far clip plane 0.2 is not beyond the near plane 0.3")),
-        "{:?}",
-        bad.warnings
-    );
+    assert_warned(&bad, "far clip plane 0.2 is not beyond the near plane 0.3");
 }
 
 /// The bundled fog scene: its RenderSettings fog arrives in the soup, colour decoded.
@@ -294,13 +288,7 @@ fn the_default_skybox_is_a_procedural_sky_aimed_at_the_sun() {
     ]);
     let hd = convert(&hdrp.join("Assets/s.unity"));
     assert!(hd.environment.sky.is_none());
-    assert!(
-        hd.warnings
-            .iter()
-            .any(|w| w.contains("HDRP ignores RenderSettings' skybox")),
-        "{:?}",
-        hd.warnings
-    );
+    assert_warned(&hd, "HDRP ignores RenderSettings' skybox");
     assert!(
         soup.warnings.iter().any(|w| {
             w.contains(
@@ -537,7 +525,7 @@ fn lights_convert_position_direction_colour_and_shadows() {
         (soup.lights[2].kind, soup.lights[2].shadow_radius),
         (LightKind::Directional, 1.0)
     );
-    assert!(soup.warnings.iter().any(|w| w.contains("area light")));
+    assert_warned(&soup, "area light");
 }
 
 const TWO_GROUPS: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 5 0 0\nv 6 0 0\nv 5 1 0\nmtllib two.mtl\ng A\nusemtl red\nf 1 2 3\ng B\nusemtl green\nf 4 5 6\n";
@@ -704,13 +692,7 @@ fn unresolved_mesh_falls_back_to_the_object_name() {
     let (_d, root) = unresolved_mesh_project();
     let soup = convert(&root.join("Assets/s.unity"));
     assert_eq!(soup.triangles.len(), 3);
-    assert!(
-        soup.warnings
-            .iter()
-            .any(|w| w.contains("found by the object's name")),
-        "{:?}",
-        soup.warnings
-    );
+    assert_warned(&soup, "found by the object's name");
 }
 
 #[test]

@@ -168,6 +168,16 @@ pub fn convert_scene(text: &str) -> formats::Soup {
     convert(&root.join("Assets/s.unity"))
 }
 
+/// Fails, listing the soup's warnings, unless one of them contains `text`.
+#[track_caller]
+pub fn assert_warned(soup: &formats::Soup, text: &str) {
+    assert!(
+        soup.warnings.iter().any(|w| w.contains(text)),
+        "no warning contains {text:?}: {:?}",
+        soup.warnings
+    );
+}
+
 /// The shading normals at each triangle's corners, in soup order.
 pub fn corner_normals(soup: &formats::Soup) -> Vec<[glam::Vec3; 3]> {
     (0..soup.triangle_count())
