@@ -36,6 +36,7 @@ use crate::plan::{colour_mapped, Plan, ShadowMode};
 use crate::sampling::{DiscSpiral, Rng};
 use crate::sky::{SkyAmbient, Skybox};
 use crate::soft::{probe_asked, probe_fits, SoftCone};
+use crate::tangents::Tangents;
 use crate::texture::{cone_footprint, Sampler};
 use crate::RenderOptions;
 use crate::TextureFilter;
@@ -255,6 +256,8 @@ pub struct Integrator<'a> {
     /// bytes an absent value leaves, and where those read as subnormal numbers Intel cores
     /// took a microcode assist at every block of pixels (the baseline traced 6–9 % slower).
     sky_ambient: Option<Box<SkyAmbient>>,
+    /// The MikkTSpace tangents of the triangles whose normal map the plan reads.
+    tangents: Option<Tangents<'a>>,
 }
 
 /// [`Integrator::sides`] bits: camera and reflection rays that meet the triangle's front
@@ -377,6 +380,10 @@ impl<'a> Integrator<'a> {
         };
         let shadow_filter = plan.shadow_casting.enabled || alpha;
         let blend = surfacing.iter().any(|s| s.alpha == AlphaUse::Blend);
+        let normal_mapped: Vec<bool> = surfacing.iter().map(|s| s.normal.is_some()).collect();
+        let tangents = normal_mapped
+            .contains(&true)
+            .then(|| Tangents::new(soup, &normal_mapped));
         Integrator {
             soup,
             accel,
@@ -415,6 +422,7 @@ impl<'a> Integrator<'a> {
                 .filter(|_| soup.environment.clear == ClearFlags::Skybox)
                 .map(Skybox::new),
             sky_ambient: sky_ambient(soup, plan).map(Box::new),
+            tangents,
         }
     }
 
@@ -893,8 +901,15 @@ impl<'a> Integrator<'a> {
         if let Some((i, tiling, scale)) = surfacing.and_then(|s| s.normal) {
             counts.normal_lookups += 1;
             let texel = lookup(&(i, tiling));
-            let uv = self.soup.corner_uvs(prim);
-            ns = normal_map::bend(ns, *tri, uv, texel, scale);
+            let tangent = self
+                .tangents
+                .as_ref()
+                .and_then(|t| t.at(prim, hit.u, hit.v));
+            let tangent = tangent
+                .or_else(|| normal_map::triangle_tangent(ns, *tri, self.soup.corner_uvs(prim)));
+            if let Some(tangent) = tangent {
+                ns = normal_map::bend(ns, tangent, texel, scale);
+            }
         }
         if back {
             ns = -ns;

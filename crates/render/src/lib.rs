@@ -6,6 +6,7 @@
 //! * [`camera`]: pixel → ray (perspective or orthographic, y = 0 at the top row);
 //! * [`cone`]: how wide a pixel's rays are at a hit, for texture filtering;
 //! * [`texture`], [`alpha`]: albedo lookups, cut-out holes and blended surfaces;
+//! * [`normal_map`], [`tangents`]: normal maps, read in each mesh's MikkTSpace tangents;
 //! * [`lights`]: Unity's range falloff and spot cones;
 //! * [`integrator`]: emission, ambient, direct light with hard/soft shadows, mirrors;
 //! * `soft`: a soft shadow's sample rays, four at a time;
@@ -39,6 +40,7 @@ pub mod sampling;
 pub mod sky;
 pub mod sky_image;
 mod soft;
+pub mod tangents;
 pub mod texture;
 
 pub use aov::{Aov, AovSet};

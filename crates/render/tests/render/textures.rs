@@ -519,6 +519,81 @@ fn normal_maps_bend_the_light_and_are_read_only_where_they_show() {
     assert_eq!(out.counts.normal_lookups, 16);
 }
 
+/// A smooth cylinder whose UVs are sheared one way and the other in alternate columns, so
+/// each triangle's own ∂p/∂u leans up or down, under a normal map that tilts every normal
+/// towards increasing u: read in the mesh's MikkTSpace tangents, which the columns share
+/// at their edges, the shading along a row stays smooth (its slope changes by at most 0.0041
+/// from one pixel to the next); read in each triangle's own frame it jumps at every column
+/// edge (by up to 0.37 between neighbouring pixels).
+#[test]
+fn normal_maps_shade_a_curved_mesh_smoothly_across_its_triangles() {
+    let mut s = SceneBuilder::new();
+    let t = s.texture(texture(1, 1, &[[204, 128, 255, 255]], Wrap::Repeat));
+    let m = s.material(Material {
+        normal_map: Some(formats::NormalMap {
+            map: TextureRef {
+                texture: t,
+                tiling: Tiling::default(),
+            },
+            scale: 1.0,
+        }),
+        ..diffuse(Vec3::ONE)
+    });
+    s.soup
+        .objects
+        .push(formats::Object::new("cylinder", "test"));
+    let columns = 24;
+    let vertex = |i: usize, y: f32| {
+        // Starting at the back, so the UV seam (u = 0 and u = 1) is out of sight.
+        let a = std::f32::consts::PI + std::f32::consts::TAU * i as f32 / columns as f32;
+        let n = Vec3::new(a.sin(), 0.0, -a.cos());
+        let shear = if i.is_multiple_of(2) { 0.0 } else { 0.3 };
+        (
+            n + Vec3::Y * y,
+            n,
+            Vec2::new(i as f32 / columns as f32, y + 0.5 + shear),
+        )
+    };
+    for i in 0..columns {
+        let c = [
+            vertex(i, -0.5),
+            vertex(i + 1, -0.5),
+            vertex(i + 1, 0.5),
+            vertex(i, 0.5),
+        ];
+        for tri in [[0, 2, 1], [0, 3, 2]] {
+            s.soup.push_triangle(
+                tri.map(|k| c[k].0),
+                tri.map(|k| c[k].1),
+                Some(tri.map(|k| c[k].2)),
+            );
+            s.soup.tri_material.push(m);
+            s.soup.tri_object.push(0);
+        }
+    }
+    s.light(directional_light(
+        Vec3::new(-0.2, -0.4, 0.9).normalize(),
+        1.0,
+        Shadows::None,
+    ));
+    s.camera(front_camera(0.5));
+    let (soup, kd) = s.build();
+    let (w, h) = (128, 64);
+    let (out, plan) = render(&soup, &kd, &opts(w, h));
+    assert!(plan.normal_maps.enabled, "{}", plan.normal_maps.reason);
+    // The row through the middle, inside the silhouette (|x| < 0.8 m).
+    let row: Vec<f32> = (13..w - 13).map(|x| out.frame.pixel(x, h / 2).x).collect();
+    assert!(row.iter().all(|v| v.is_finite() && *v > 0.0), "{row:?}");
+    // The change of slope from one pixel to the next: the light's falloff across the
+    // cylinder bends slowly, a jump at a column edge does not.
+    let bend = row
+        .windows(3)
+        .map(|p| (p[2] - 2.0 * p[1] + p[0]).abs())
+        .fold(0.0, f32::max);
+    assert!(bend < 0.006, "largest change of slope {bend}: {row:?}");
+    assert!(out.counts.normal_lookups > 0);
+}
+
 /// An emission map multiplies the emission colour texel by texel; a material that does not
 /// glow never reads it.
 #[test]
