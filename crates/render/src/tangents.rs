@@ -111,7 +111,7 @@ impl<'a> Tangents<'a> {
 
     /// The frame of triangle `prim` at barycentrics (u, v) (corner 0 weighs 1 − u − v):
     /// the corners' tangents interpolated, as Unity's shaders interpolate them. None where
-    /// the triangle's object reads no normal map or MikkTSpace gave a corner no tangent. The first
+    /// the triangle's object reads no normal map or MikkTSpace gave a corner no finite tangent. The first
     /// call for an object runs MikkTSpace on its triangles; a thread that asks meanwhile
     /// waits for it.
     pub fn at(&self, prim: usize, u: f32, v: f32) -> Option<Tangent> {
@@ -121,7 +121,8 @@ impl<'a> Tangents<'a> {
         }
         let o = self.soup.tri_object[prim] as usize;
         let c = self.corners[o].get_or_init(|| self.compute(o))[i as usize];
-        if c.iter().any(|c| c.w == 0.0) {
+        // No tangent, or one MikkTSpace's arithmetic overflowed (coordinates near 1e30).
+        if c.iter().any(|c| c.w == 0.0 || !c.is_finite()) {
             return None;
         }
         let t = c[0].truncate() * (1.0 - u - v) + c[1].truncate() * u + c[2].truncate() * v;
@@ -300,5 +301,43 @@ mod tests {
         assert!((f.t - Vec3::X).length() < 1e-6, "{f:?}");
         assert_eq!(tangents.computed(), 1);
         assert_eq!(tangents.at(2, 0.2, 0.2), Some(f));
+    }
+
+    /// Meshes MikkTSpace may choke on: corners drawn from a small pool (so vertices weld,
+    /// triangles repeat, collapse to a line or a point), coordinates from zero and
+    /// subnormal to 1e30, normals zero or not finite, UVs all equal: every lookup returns
+    /// a finite frame or none, and nothing panics.
+    #[test]
+    fn degenerate_meshes_give_finite_frames_or_none() {
+        let mut rng = crate::sampling::Rng::new(7);
+        let mut pick = |n: u32| rng.next_u32() % n;
+        let values = [
+            0.0, -0.0, 1.0, -1.0, 0.5, 1e-30, 1e-40, 1e30, -1e30, 3.0, 7.5e-3,
+        ];
+        let normals = [0.0, 1.0, -1.0, 0.6, f32::NAN, f32::INFINITY];
+        for _ in 0..2_000 {
+            let pool: Vec<(Vec3, Vec3, Vec2)> = (0..1 + pick(6))
+                .map(|_| {
+                    let mut v = || values[pick(values.len() as u32) as usize];
+                    let p = Vec3::new(v(), v(), v());
+                    let uv = Vec2::new(v(), v());
+                    let mut m = || normals[pick(normals.len() as u32) as usize];
+                    (p, Vec3::new(m(), m(), m()), uv)
+                })
+                .collect();
+            let tris: Vec<_> = (0..1 + pick(12))
+                .map(|_| {
+                    let c: [_; 3] = std::array::from_fn(|_| pool[pick(pool.len() as u32) as usize]);
+                    (c.map(|c| c.0), c.map(|c| c.1), c.map(|c| c.2))
+                })
+                .collect();
+            let s = soup_of(&tris);
+            let tangents = Tangents::new(&s, &[true]);
+            for prim in 0..tris.len() {
+                if let Some(f) = tangents.at(prim, 0.25, 0.5) {
+                    assert!(f.t.is_finite() && f.sign.abs() == 1.0, "{f:?} on {tris:?}");
+                }
+            }
+        }
     }
 }
