@@ -27,10 +27,10 @@ pub fn trilight(sky: Vec3, equator: Vec3, ground: Vec3, y: f32) -> Vec3 {
 /// colour, or for Skybox cameras the skybox `sky` where the scene has one, else a
 /// sky gradient by the direction's height (the scene's ambient sky/equator/ground colours,
 /// or [`DEFAULT_SKY`] when those are black).
-pub fn background(env: &Environment, sky: Option<&Skybox>, dir: Vec3) -> Vec3 {
+pub fn background(env: &Environment, sky: Option<&Skybox>, dir: Vec3, spread: f32) -> Vec3 {
     match (env.clear, sky) {
         (ClearFlags::SolidColor, _) => env.background,
-        (ClearFlags::Skybox, Some(sky)) => sky.radiance(dir),
+        (ClearFlags::Skybox, Some(sky)) => sky.radiance(dir, spread),
         (ClearFlags::Skybox, None) => {
             let a = &env.ambient;
             let [s, e, g] = if a.sky.max(a.equator).max(a.ground).max_element() > 0.0 {

@@ -571,7 +571,7 @@ impl<'a> Integrator<'a> {
             for i in (0..LANES).filter(|&i| was[i]) {
                 going[i] = false;
                 let (Some(hit), Some(shaded)) = (first[i], shaded[i]) else {
-                    out[i] = self.beyond(&layers[i], rays[i].dir);
+                    out[i] = self.beyond(&layers[i], rays[i].dir, cones[i].spread);
                     continue;
                 };
                 let shaded = self.fogged(shaded, &rays[i], &hit, bounce, counts);
@@ -628,10 +628,11 @@ impl<'a> Integrator<'a> {
         }
     }
 
-    /// The radiance of a ray that leaves the scene along `dir` behind its blended layers.
+    /// The radiance of a ray that leaves the scene along `dir` behind its blended layers,
+    /// its cone `spread` radians wide.
     #[inline(always)]
-    fn beyond(&self, layers: &Layers, dir: Vec3) -> Vec3 {
-        let bg = environment::background(&self.soup.environment, self.sky.as_ref(), dir);
+    fn beyond(&self, layers: &Layers, dir: Vec3, spread: f32) -> Vec3 {
+        let bg = environment::background(&self.soup.environment, self.sky.as_ref(), dir, spread);
         if layers.through == 1.0 {
             bg
         } else {
@@ -676,7 +677,7 @@ impl<'a> Integrator<'a> {
         let mut layers = Layers::NONE;
         loop {
             let Some(hit) = next else {
-                return self.beyond(&layers, r.dir);
+                return self.beyond(&layers, r.dir, cone.spread);
             };
             let shaded = self.shade(
                 &r,

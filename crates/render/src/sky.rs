@@ -226,7 +226,7 @@ impl SkyAmbient {
 }
 
 /// RenderSettings' skybox, ready to draw.
-#[derive(Clone, Copy, Debug)]
+#[derive(Debug)]
 pub enum Skybox<'a> {
     Procedural(SkyModel),
     Image(ImageSky<'a>),
@@ -240,11 +240,12 @@ impl<'a> Skybox<'a> {
         }
     }
 
-    /// Radiance along unit direction `dir`.
-    pub fn radiance(&self, dir: Vec3) -> Vec3 {
+    /// Radiance along unit direction `dir`, seen by a ray cone `spread` radians wide
+    /// (an image sky filters over it; the procedural sky is smooth).
+    pub fn radiance(&self, dir: Vec3, spread: f32) -> Vec3 {
         match self {
             Skybox::Procedural(p) => p.radiance(dir),
-            Skybox::Image(i) => i.radiance(dir),
+            Skybox::Image(i) => i.radiance_in_cone(dir, spread),
         }
     }
 

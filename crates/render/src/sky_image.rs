@@ -1,31 +1,107 @@
 //! Skies drawn from images, as Unity's Skybox/Panoramic, Skybox/Cubemap and Skybox/6 Sided
 //! shaders draw them: the direction turned by the material's rotation, looked up in a
-//! latitude-longitude image or on a cube's faces, filtered bilinearly in the full-size
-//! image, times the material's tint and exposure.
+//! latitude-longitude image or on a cube's faces, times the material's tint and exposure.
+//!
+//! A lookup is filtered over the ray cone's footprint, as the GPU filters a mip-mapped
+//! texture: bilinearly in the full-size image while a pixel covers at most a texel,
+//! trilinearly between box-filtered halvings of it once the cone spreads over more
+//! (Unity imports sky textures with mip maps). The halvings are built at the first such
+//! lookup, so a sky seen magnified, as most are, costs none.
 
 use crate::sky::{add_sample, SkyAmbient};
 use formats::{Panorama, SkyImage, SkyLayout, TexturedSky};
 use glam::Vec3;
 use rayon::prelude::*;
 use std::f32::consts::PI;
+use std::sync::OnceLock;
 
 /// An image sky with its rotation worked out once.
-#[derive(Clone, Copy, Debug)]
+#[derive(Debug)]
 pub struct ImageSky<'a> {
     sky: &'a TexturedSky,
     cos: f32,
     sin: f32,
+    /// Per image (one, or six faces), its halvings below the full size.
+    mips: Vec<OnceLock<Vec<Level>>>,
+}
+
+/// One box-filtered halving of a sky image, linear RGB, rows bottom up.
+#[derive(Debug)]
+struct Level {
+    width: u32,
+    height: u32,
+    texels: Vec<Vec3>,
+}
+
+impl Level {
+    /// The next halving: each texel the mean of the 2×2 block above it (a last odd row or
+    /// column folds into the block before it), down to one texel.
+    fn halve(width: u32, height: u32, texel: impl Fn(u32, u32) -> Vec3) -> Level {
+        let (w, h) = ((width / 2).max(1), (height / 2).max(1));
+        let span = |i: u32, n: u32, out: u32| {
+            let lo = i * n / out;
+            (lo, ((i + 1) * n / out).max(lo + 1))
+        };
+        let texels = (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .map(|(x, y)| {
+                let ((x0, x1), (y0, y1)) = (span(x, width, w), span(y, height, h));
+                let mut sum = Vec3::ZERO;
+                for j in y0..y1 {
+                    for i in x0..x1 {
+                        sum += texel(i, j);
+                    }
+                }
+                sum / ((x1 - x0) * (y1 - y0)) as f32
+            })
+            .collect();
+        Level {
+            width: w,
+            height: h,
+            texels,
+        }
+    }
+
+    fn texel(&self, x: u32, y: u32) -> Vec3 {
+        self.texels[(y * self.width + x) as usize]
+    }
+}
+
+/// Every halving of `image`, down to one texel.
+fn mip_levels(image: &SkyImage) -> Vec<Level> {
+    let mut levels = vec![Level::halve(image.width, image.height, |x, y| {
+        image.texel(x, y)
+    })];
+    while let Some(l) = levels.last().filter(|l| l.width > 1 || l.height > 1) {
+        let next = Level::halve(l.width, l.height, |x, y| l.texel(x, y));
+        levels.push(next);
+    }
+    levels
 }
 
 impl<'a> ImageSky<'a> {
     pub fn new(sky: &'a TexturedSky) -> Self {
         let (sin, cos) = sky.rotation.to_radians().sin_cos();
-        ImageSky { sky, cos, sin }
+        let images = match &sky.layout {
+            SkyLayout::LatLong { .. } => 1,
+            SkyLayout::Cube { faces } => faces.len(),
+        };
+        ImageSky {
+            sky,
+            cos,
+            sin,
+            mips: (0..images).map(|_| OnceLock::new()).collect(),
+        }
     }
 
-    /// Radiance along unit soup direction `dir`.
+    /// Radiance along unit soup direction `dir`, read in the full-size image.
     pub fn radiance(&self, dir: Vec3) -> Vec3 {
-        self.unscaled(self.unity_direction(dir)) * self.sky.scale
+        self.radiance_in_cone(dir, 0.0)
+    }
+
+    /// Radiance along unit soup direction `dir` seen by a ray cone `spread` radians wide.
+    pub fn radiance_in_cone(&self, dir: Vec3, spread: f32) -> Vec3 {
+        self.unscaled(self.unity_direction(dir), spread) * self.sky.scale
     }
 
     /// The direction the shader samples for soup direction `dir`: X negated into Unity's
@@ -47,25 +123,72 @@ impl<'a> ImageSky<'a> {
     }
 
     /// The texels' radiance along Unity direction `d` (not normalised), before the
-    /// material's scale.
-    fn unscaled(&self, d: Vec3) -> Vec3 {
+    /// material's scale, over a cone `spread` radians wide.
+    fn unscaled(&self, d: Vec3, spread: f32) -> Vec3 {
         match &self.sky.layout {
             SkyLayout::LatLong { image, panorama } => {
                 let d = d.normalize_or_zero();
                 let [mut u, v] = lat_long(d);
+                let mut columns = image.width as f32;
                 match panorama {
                     Panorama::Full => {}
                     Panorama::Half if u > 0.5 => return Vec3::ZERO,
                     // The shader takes u·2 modulo 1: the back half repeats the front.
-                    Panorama::Half | Panorama::HalfMirrored => u = (u * 2.0).fract(),
+                    Panorama::Half | Panorama::HalfMirrored => {
+                        u = (u * 2.0).fract();
+                        columns *= 2.0;
+                    }
                 }
-                bilinear(image, u, v, true)
+                // Texels per radian: along a meridian, and along the parallel, where they
+                // crowd towards the poles; the denser decides, as on the GPU.
+                let ring = (1.0 - d.y * d.y).max(0.0).sqrt().max(1e-3);
+                let density = (image.height as f32 / PI).max(columns / (2.0 * PI) / ring);
+                self.filtered(0, image, u, v, true, spread * density)
             }
             SkyLayout::Cube { faces } => {
                 let (face, u, v) = cube_face(d);
-                bilinear(&faces[face], u, v, false)
+                // Half a face's texels per unit of the face's tangent plane, which a
+                // radian stretches by up to 1 + a² + b² away from the face's centre.
+                let (a, b) = (2.0 * u - 1.0, 2.0 * v - 1.0);
+                let image = &faces[face];
+                let density = image.width.max(image.height) as f32 / 2.0 * (1.0 + a * a + b * b);
+                self.filtered(face, image, u, v, false, spread * density)
             }
         }
+    }
+
+    /// Image `i` at (u, v) over a footprint `texels` wide in the full-size image:
+    /// bilinear there up to one texel, else trilinear between the two halvings whose
+    /// texels are nearest the footprint's size.
+    fn filtered(
+        &self,
+        i: usize,
+        image: &SkyImage,
+        u: f32,
+        v: f32,
+        wrap: bool,
+        texels: f32,
+    ) -> Vec3 {
+        let full = |u, v| {
+            bilinear(image.width, image.height, u, v, wrap, |x, y| {
+                image.texel(x, y)
+            })
+        };
+        // NaN (no cone) reads the full-size image too.
+        if texels.is_nan() || texels <= 1.0 {
+            return full(u, v);
+        }
+        let levels = self.mips[i].get_or_init(|| mip_levels(image));
+        let lod = texels.log2().min(levels.len() as f32);
+        let at = |k: usize| match k {
+            0 => full(u, v),
+            k => {
+                let l = &levels[k.min(levels.len()) - 1];
+                bilinear(l.width, l.height, u, v, wrap, |x, y| l.texel(x, y))
+            }
+        };
+        let k = lod.floor();
+        at(k as usize).lerp(at(k as usize + 1), lod - k)
     }
 
     /// Its ambient light, `intensity` times, on nine spherical harmonics: each texel's
@@ -223,10 +346,9 @@ fn from_cube_face(f: usize, a: f32, b: f32) -> Vec3 {
     }
 }
 
-/// Bilinear lookup at (u, v), texel centres at half-integers; u wraps around when `wrap`,
-/// else both axes clamp at the edge texels.
-fn bilinear(image: &SkyImage, u: f32, v: f32, wrap: bool) -> Vec3 {
-    let (w, h) = (image.width, image.height);
+/// Bilinear lookup at (u, v) in a `w` × `h` image whose texels `texel` reads, texel centres
+/// at half-integers; u wraps around when `wrap`, else both axes clamp at the edge texels.
+fn bilinear(w: u32, h: u32, u: f32, v: f32, wrap: bool, texel: impl Fn(u32, u32) -> Vec3) -> Vec3 {
     let x = u * w as f32 - 0.5;
     let y = v * h as f32 - 0.5;
     let (x0, y0) = (x.floor(), y.floor());
@@ -241,8 +363,8 @@ fn bilinear(image: &SkyImage, u: f32, v: f32, wrap: bool) -> Vec3 {
     };
     let row = |j: f32| -> u32 { (j as i64).clamp(0, h as i64 - 1) as u32 };
     let (xa, xb, ya, yb) = (column(x0), column(x0 + 1.0), row(y0), row(y0 + 1.0));
-    let bottom = image.texel(xa, ya).lerp(image.texel(xb, ya), fx);
-    let top = image.texel(xa, yb).lerp(image.texel(xb, yb), fx);
+    let bottom = texel(xa, ya).lerp(texel(xb, ya), fx);
+    let top = texel(xa, yb).lerp(texel(xb, yb), fx);
     bottom.lerp(top, fy)
 }
 
@@ -453,5 +575,98 @@ mod tests {
         };
         assert_eq!(on(1), on(2));
         assert_eq!(on(1), on(5));
+    }
+
+    #[test]
+    fn halvings_average_their_blocks_down_to_one_texel() {
+        // 5 × 3: odd both ways, so the last column and row fold into the block before.
+        let rgb: Vec<Vec3> = (0..15).map(|i| Vec3::splat(i as f32)).collect();
+        let image = SkyImage::from_linear("ramp", 5, 3, &rgb);
+        let levels = mip_levels(&image);
+        let sizes: Vec<_> = levels.iter().map(|l| (l.width, l.height)).collect();
+        assert_eq!(sizes, [(2, 1), (1, 1)]);
+        // Level 1's left texel: columns 0–1 of all three rows; its right one columns 2–4.
+        let mean = |xs: &[u32]| {
+            let all: Vec<f32> = (0..3)
+                .flat_map(|y| xs.iter().map(move |&x| (y * 5 + x) as f32))
+                .collect();
+            all.iter().sum::<f32>() / all.len() as f32
+        };
+        assert_eq!(levels[0].texel(0, 0).x, mean(&[0, 1]));
+        assert_eq!(levels[0].texel(1, 0).x, mean(&[2, 3, 4]));
+        let top = levels[1].texel(0, 0).x;
+        assert_eq!(top, (mean(&[0, 1]) + mean(&[2, 3, 4])) / 2.0);
+    }
+
+    /// Columns alternating 0 and 2 around a 256 × 128 panorama: a cone narrower than a
+    /// texel reads the column it points at, as before; one spread over several texels
+    /// reads their mean, 1, as a mip-mapped texture on the GPU does, and only then are the
+    /// halvings built.
+    #[test]
+    fn a_wide_cone_reads_the_mean_of_the_texels_it_covers() {
+        let (w, h) = (256u32, 128u32);
+        let rgb: Vec<Vec3> = (0..w * h)
+            .map(|i| Vec3::splat(if i % 2 == 0 { 0.0 } else { 2.0 }))
+            .collect();
+        let striped = TexturedSky {
+            scale: Vec3::ONE,
+            rotation: 0.0,
+            layout: SkyLayout::LatLong {
+                image: SkyImage::from_linear("striped", w, h, &rgb),
+                panorama: Panorama::Full,
+            },
+        };
+        let s = ImageSky::new(&striped);
+        let texel = PI / h as f32;
+        // Along the horizon, a column's centre: x = 100 is u = 100.5 / 256.
+        let u = 100.5 / w as f32;
+        let longitude = (0.5 - u) * 2.0 * PI;
+        let unity = Vec3::new(longitude.cos(), 0.0, longitude.sin());
+        let soup = Vec3::new(-unity.x, unity.y, unity.z);
+        assert_eq!(s.radiance_in_cone(soup, 0.5 * texel), Vec3::ZERO);
+        assert_eq!(s.radiance_in_cone(soup, texel), Vec3::ZERO);
+        assert!(s.mips[0].get().is_none(), "no halving for a magnified sky");
+        for spread in [2.0, 3.0, 8.0, 100.0] {
+            let l = s.radiance_in_cone(soup, spread * texel);
+            assert!((l - Vec3::ONE).abs().max_element() < 1e-6, "{spread}: {l}");
+        }
+        assert_eq!(s.mips[0].get().map(Vec::len), Some(8));
+        // Between one and two texels the two levels blend: partway from 0 towards 1.
+        let l = s.radiance_in_cone(soup, 1.5 * texel).x;
+        assert!(l > 0.0 && l < 1.0, "{l}");
+    }
+
+    /// A uniform sky keeps its radiance at every footprint, on both layouts.
+    #[test]
+    fn filtering_keeps_a_uniform_sky_uniform() {
+        let grey =
+            |w, h| SkyImage::from_linear("grey", w, h, &vec![Vec3::splat(0.25); (w * h) as usize]);
+        for layout in [
+            SkyLayout::LatLong {
+                image: grey(64, 32),
+                panorama: Panorama::Full,
+            },
+            SkyLayout::Cube {
+                faces: (0..6).map(|_| grey(16, 16)).collect(),
+            },
+        ] {
+            let uniform = sky(layout, 30.0);
+            let s = ImageSky::new(&uniform);
+            for d in [
+                Vec3::X,
+                Vec3::new(0.3, 0.9, -0.2),
+                -Vec3::Y,
+                Vec3::new(-1.0, 0.1, 0.4),
+            ] {
+                for spread in [0.0, 0.01, 0.1, 0.5, 3.0] {
+                    let l = s.radiance_in_cone(d.normalize(), spread);
+                    let want = Vec3::splat(0.25) * uniform.scale;
+                    assert!(
+                        (l - want).abs().max_element() < 1e-3 * want.max_element(),
+                        "{d} {spread}: {l}"
+                    );
+                }
+            }
+        }
     }
 }

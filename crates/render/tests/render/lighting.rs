@@ -582,6 +582,49 @@ fn an_image_sky_is_the_background_and_the_skybox_ambient() {
     );
 }
 
+/// A panorama of one-texel columns alternating 0 and 2, seen by a camera whose pixels
+/// each span about 2.7 texels: every background pixel is their mean, 1 (times the tint),
+/// where a lookup in the full-size image along the pixel's ray reads 0 or 2.
+#[test]
+fn an_image_sky_seen_small_is_filtered_not_aliased() {
+    use formats::{Panorama, Sky, SkyImage, SkyLayout, TexturedSky};
+    let (w, h) = (512u32, 256u32);
+    let rgb: Vec<Vec3> = (0..w * h)
+        .map(|i| Vec3::splat(if i % 2 == 0 { 0.0 } else { 2.0 }))
+        .collect();
+    let striped = TexturedSky {
+        scale: Vec3::new(0.98, 0.9, 1.1),
+        rotation: 0.0,
+        layout: SkyLayout::LatLong {
+            image: SkyImage::from_linear("Assets/Stripes.hdr", w, h, &rgb),
+            panorama: Panorama::Full,
+        },
+    };
+    let mut s = SceneBuilder::new();
+    let m = s.diffuse(Vec3::ONE);
+    s.floor(-100.0, 0.0, 0.0, 1.0, m);
+    let (mut soup, kd) = s.build();
+    soup.environment.clear = formats::ClearFlags::Skybox;
+    soup.environment.sky = Some(Sky::Textured(striped.clone()));
+    let out = render_alike_at_tiles(&soup, &kd, &opts(32, 32));
+    let camera = render::CameraModel::new(&soup.camera, 32, 32).unwrap();
+    let full_size = render::sky_image::ImageSky::new(&striped);
+    let mut aliased = 0;
+    for y in 0..32 {
+        for x in 0..32 {
+            let got = out.frame.pixel(x, y);
+            assert_close(got, striped.scale, 1e-5, "a background pixel");
+            let dir = camera.ray(x as f32 + 0.5, y as f32 + 0.5).dir;
+            let l = full_size.radiance(dir);
+            aliased += usize::from((l - striped.scale).abs().max_element() > 0.5);
+        }
+    }
+    assert!(
+        aliased > 500,
+        "unfiltered, {aliased} of 1,024 pixels would be off by half"
+    );
+}
+
 #[test]
 fn an_orthographic_camera_spans_its_half_height() {
     // An emitter filling exactly the upper half of the orthographic view.
