@@ -256,7 +256,8 @@ pub struct Integrator<'a> {
     /// bytes an absent value leaves, and where those read as subnormal numbers Intel cores
     /// took a microcode assist at every block of pixels (the baseline traced 6–9 % slower).
     sky_ambient: Option<Box<SkyAmbient>>,
-    /// The MikkTSpace tangents of the triangles whose normal map the plan reads.
+    /// The MikkTSpace tangents of the objects whose normal map the plan reads, each
+    /// object's computed when a ray first reads its map.
     tangents: Option<Tangents<'a>>,
 }
 

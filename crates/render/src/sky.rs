@@ -226,7 +226,6 @@ impl SkyAmbient {
 }
 
 /// RenderSettings' skybox, ready to draw.
-#[derive(Debug)]
 pub enum Skybox<'a> {
     Procedural(SkyModel),
     Image(ImageSky<'a>),

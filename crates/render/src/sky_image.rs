@@ -16,7 +16,6 @@ use std::f32::consts::PI;
 use std::sync::OnceLock;
 
 /// An image sky with its rotation worked out once.
-#[derive(Debug)]
 pub struct ImageSky<'a> {
     sky: &'a TexturedSky,
     cos: f32,
@@ -26,7 +25,6 @@ pub struct ImageSky<'a> {
 }
 
 /// One box-filtered halving of a sky image, linear RGB, rows bottom up.
-#[derive(Debug)]
 struct Level {
     width: u32,
     height: u32,
