@@ -7,13 +7,13 @@
 //! turns smoothly over a curved mesh; a triangle's own `∂p/∂u` turns from one triangle to
 //! the next and makes a bumpy surface look faceted.
 //!
-//! Unity runs it on each mesh in the mesh's own space; here it runs on each object's
-//! normal-mapped triangles in the soup's world space. A linear map carries `∂p/∂u` along
-//! with the positions, so under rotation, uniform scale and the converter's mirroring the
-//! tangents are Unity's carried into the soup; under non-uniform scale only MikkTSpace's
-//! weighting of the faces around a vertex differs. Only objects with a material that reads
-//! a normal map are processed and stored (48 bytes per triangle, and 4 per triangle of the
-//! scene for the lookup), each only when a ray first reads its map.
+//! Unity runs it on each mesh in the mesh's own space; here it runs on all the triangles
+//! of each object with a normal-mapped material, in the soup's world space. A linear map
+//! carries `∂p/∂u` along with the positions, so under rotation, uniform scale and the
+//! converter's mirroring the tangents are Unity's carried into the soup; under non-uniform
+//! scale only MikkTSpace's weighting of the faces around a vertex differs. Only objects with a material that reads
+//! a normal map are processed and stored (48 bytes per triangle and 4 for its listing, and
+//! 4 per triangle of the scene for the lookup), each only when a ray first reads its map.
 
 use crate::normal_map::Tangent;
 use bevy_mikktspace::{Geometry, TangentSpace};
@@ -111,9 +111,9 @@ impl<'a> Tangents<'a> {
 
     /// The frame of triangle `prim` at barycentrics (u, v) (corner 0 weighs 1 − u − v):
     /// the corners' tangents interpolated, as Unity's shaders interpolate them. None where
-    /// the triangle's object reads no normal map or MikkTSpace gave a corner no finite tangent. The first
-    /// call for an object runs MikkTSpace on its triangles; a thread that asks meanwhile
-    /// waits for it.
+    /// the triangle's object reads no normal map or MikkTSpace gave a corner no finite
+    /// tangent. The first call for an object runs MikkTSpace on its triangles; a thread
+    /// that asks meanwhile waits for it.
     pub fn at(&self, prim: usize, u: f32, v: f32) -> Option<Tangent> {
         let i = *self.slot.get(prim)?;
         if i == NONE {
