@@ -11,9 +11,10 @@
 //! of each object with a normal-mapped material, in the soup's world space. A linear map
 //! carries `∂p/∂u` along with the positions, so under rotation, uniform scale and the
 //! converter's mirroring the tangents are Unity's carried into the soup; under non-uniform
-//! scale only MikkTSpace's weighting of the faces around a vertex differs. Only objects with a material that reads
-//! a normal map are processed and stored (48 bytes per triangle and 4 for its listing, and
-//! 4 per triangle of the scene for the lookup), each only when a ray first reads its map.
+//! scale only MikkTSpace's weighting of the faces around a vertex differs. Only objects
+//! with a material that reads a normal map are processed and stored (48 bytes per triangle
+//! and 4 for its listing, and 4 per triangle of the scene for the lookup), each only when
+//! a ray first reads its map.
 
 use crate::normal_map::Tangent;
 use bevy_mikktspace::{Geometry, TangentSpace};
