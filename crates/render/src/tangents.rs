@@ -144,7 +144,8 @@ impl<'a> Tangents<'a> {
     }
 
     /// Objects whose tangents have been computed.
-    pub fn computed(&self) -> usize {
+    #[cfg(test)]
+    fn computed(&self) -> usize {
         self.corners.iter().filter(|c| c.get().is_some()).count()
     }
 }

@@ -514,6 +514,18 @@ fn skybox_ambient_is_the_procedural_skys_light() {
     );
 }
 
+/// Nothing in view but `sky`, shown by a Skybox camera (a small floor far below keeps the
+/// tree non-empty).
+fn sky_scene(sky: &formats::TexturedSky) -> (formats::Soup, formats::KdFile) {
+    let mut s = SceneBuilder::new();
+    let m = s.diffuse(Vec3::ONE);
+    s.floor(-100.0, 0.0, 0.0, 1.0, m);
+    let (mut soup, kd) = s.build();
+    soup.environment.clear = formats::ClearFlags::Skybox;
+    soup.environment.sky = Some(formats::Sky::Textured(sky.clone()));
+    (soup, kd)
+}
+
 /// A sky from images: each background pixel is the image sky along its camera ray (single
 /// rays and packets alike), the plan names the image, and Skybox ambient under a uniform
 /// image is that image's radiance times the tint, exposure and ambient intensity.
@@ -531,12 +543,7 @@ fn an_image_sky_is_the_background_and_the_skybox_ambient() {
             panorama: Panorama::Full,
         },
     };
-    let mut s = SceneBuilder::new();
-    let m = s.diffuse(Vec3::ONE);
-    s.floor(-100.0, 0.0, 0.0, 1.0, m);
-    let (mut soup, kd) = s.build();
-    soup.environment.clear = formats::ClearFlags::Skybox;
-    soup.environment.sky = Some(Sky::Textured(gradient.clone()));
+    let (soup, kd) = sky_scene(&gradient);
     let out = render_alike_at_tiles(&soup, &kd, &opts(16, 16));
     let camera = render::CameraModel::new(&soup.camera, 16, 16).unwrap();
     let model = render::sky_image::ImageSky::new(&gradient);
@@ -587,7 +594,7 @@ fn an_image_sky_is_the_background_and_the_skybox_ambient() {
 /// where a lookup in the full-size image along the pixel's ray reads 0 or 2.
 #[test]
 fn an_image_sky_seen_small_is_filtered_not_aliased() {
-    use formats::{Panorama, Sky, SkyImage, SkyLayout, TexturedSky};
+    use formats::{Panorama, SkyImage, SkyLayout, TexturedSky};
     let (w, h) = (512u32, 256u32);
     let rgb: Vec<Vec3> = (0..w * h)
         .map(|i| Vec3::splat(if i % 2 == 0 { 0.0 } else { 2.0 }))
@@ -600,12 +607,7 @@ fn an_image_sky_seen_small_is_filtered_not_aliased() {
             panorama: Panorama::Full,
         },
     };
-    let mut s = SceneBuilder::new();
-    let m = s.diffuse(Vec3::ONE);
-    s.floor(-100.0, 0.0, 0.0, 1.0, m);
-    let (mut soup, kd) = s.build();
-    soup.environment.clear = formats::ClearFlags::Skybox;
-    soup.environment.sky = Some(Sky::Textured(striped.clone()));
+    let (soup, kd) = sky_scene(&striped);
     let out = render_alike_at_tiles(&soup, &kd, &opts(32, 32));
     let camera = render::CameraModel::new(&soup.camera, 32, 32).unwrap();
     let full_size = render::sky_image::ImageSky::new(&striped);

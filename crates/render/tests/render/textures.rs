@@ -443,6 +443,22 @@ fn a_mirror_shows_a_texture_where_its_reflection_lands() {
     assert_eq!(out.counts.reflection, 16);
 }
 
+/// A white diffuse material whose one-texel normal map, (204, 128), tilts every normal
+/// by 0.6 towards increasing u and 1/255 towards increasing v at `scale` 1.
+fn tilted_normals(s: &mut SceneBuilder, scale: f32) -> u32 {
+    let t = s.texture(texture(1, 1, &[[204, 128, 255, 255]], Wrap::Repeat));
+    s.material(Material {
+        normal_map: Some(formats::NormalMap {
+            map: TextureRef {
+                texture: t,
+                tiling: Tiling::default(),
+            },
+            scale,
+        }),
+        ..diffuse(Vec3::ONE)
+    })
+}
+
 /// A quad whose normal map tilts every normal by 0.6 towards increasing u (the image's
 /// right) and 1/255 towards increasing v, lit by a sun 30° off its normal from the u side:
 /// each pixel is the cosine between the light and the bent normal. The plan reads the map
@@ -455,17 +471,7 @@ fn normal_maps_bend_the_light_and_are_read_only_where_they_show() {
     let cos30 = 30f32.to_radians().cos();
     let scene = |sun: bool, ambient: formats::AmbientMode, scale: f32| {
         let mut s = SceneBuilder::new();
-        let t = s.texture(texture(1, 1, &[[204, 128, 255, 255]], Wrap::Repeat));
-        let m = s.material(Material {
-            normal_map: Some(formats::NormalMap {
-                map: TextureRef {
-                    texture: t,
-                    tiling: Tiling::default(),
-                },
-                scale,
-            }),
-            ..diffuse(Vec3::ONE)
-        });
+        let m = tilted_normals(&mut s, scale);
         unity_quad(&mut s, 1.0, m, [Vec2::ZERO, Vec2::ONE]);
         if sun {
             // Travelling towards +Z and soup +X: it arrives from soup −X, where u grows.
@@ -528,17 +534,7 @@ fn normal_maps_bend_the_light_and_are_read_only_where_they_show() {
 #[test]
 fn normal_maps_shade_a_curved_mesh_smoothly_across_its_triangles() {
     let mut s = SceneBuilder::new();
-    let t = s.texture(texture(1, 1, &[[204, 128, 255, 255]], Wrap::Repeat));
-    let m = s.material(Material {
-        normal_map: Some(formats::NormalMap {
-            map: TextureRef {
-                texture: t,
-                tiling: Tiling::default(),
-            },
-            scale: 1.0,
-        }),
-        ..diffuse(Vec3::ONE)
-    });
+    let m = tilted_normals(&mut s, 1.0);
     s.soup
         .objects
         .push(formats::Object::new("cylinder", "test"));
