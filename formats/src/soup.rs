@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 pub const MAGIC: &[u8; 8] = b"UTSOUP\0\0";
-pub const VERSION: u32 = 7;
+pub const VERSION: u32 = 8;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Soup {
@@ -266,6 +266,19 @@ pub enum LightKind {
     Directional,
 }
 
+/// How a point or spot light weakens with distance and towards its cone's edge: Unity's
+/// render pipelines each have their own formula (the renderer's `lights` module has both).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Attenuation {
+    /// The built-in pipeline: 1/(1 + 25·x²) for x = distance/range, faded linearly to 0
+    /// over the range's last fifth; a smoothstep across the spot's edge.
+    BuiltIn,
+    /// The Universal Render Pipeline (and the Lightweight one before it): the inverse
+    /// square of the distance times (1 − x⁴)²; the square of a linear ramp across the
+    /// spot's edge.
+    Universal,
+}
+
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Light {
     pub name: String,
@@ -278,6 +291,8 @@ pub struct Light {
     pub intensity: f32,
     /// Distance at which point and spot lights reach zero.
     pub range: f32,
+    /// The pipeline's formula for distance and cone (directional lights have neither).
+    pub attenuation: Attenuation,
     pub shadows: Shadows,
     /// Soft shadows: emitter radius in metres (point, spot) or angular diameter in degrees
     /// (directional).

@@ -80,6 +80,7 @@ fn sample_soup() -> Soup {
         color: Vec3::ONE,
         intensity: 1.5,
         range: 10.0,
+        attenuation: Attenuation::Universal,
         shadows: Shadows::Soft,
         shadow_radius: 0.1,
         shadow_strength: 0.75,
@@ -138,7 +139,7 @@ fn soup_round_trips_through_a_file() {
     assert_eq!(Soup::read(&path).unwrap(), s);
     let bytes = std::fs::read(&path).unwrap();
     assert_eq!(&bytes[..8], b"UTSOUP\0\0");
-    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 7);
+    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 8);
     // Nothing but the artifact is left in the folder (the temp file was renamed).
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
 }
@@ -768,13 +769,13 @@ fn atomic_outputs_get_the_umask_permissions_not_the_temporary_files() {
 }
 
 #[test]
-fn a_version_6_soup_is_refused_with_the_versions_named() {
+fn a_version_7_soup_is_refused_with_the_versions_named() {
     let p = Path::new("old.soup");
     let mut b = sample_soup().to_bytes(p).unwrap();
-    b[8..12].copy_from_slice(&6u32.to_le_bytes());
+    b[8..12].copy_from_slice(&7u32.to_le_bytes());
     let msg = Soup::from_bytes(&b, p).unwrap_err().to_string();
     assert!(
-        msg.contains("soup format version 6, this build reads version 7"),
+        msg.contains("soup format version 7, this build reads version 8"),
         "{msg}"
     );
     assert!(msg.contains("re-run the stage that made it"), "{msg}");
@@ -813,6 +814,24 @@ fn draw_rule_fields_are_encoded_in_unitys_numbering() {
     let cull = m + 12 + 4 + 4 + 1 + 12;
     assert_eq!(&payload[cull..cull + 4], &1u32.to_le_bytes(), "Front is 1");
     assert_eq!(Soup::from_bytes(&b, p).unwrap(), s);
+}
+
+#[test]
+fn a_lights_attenuation_follows_its_range_as_a_variant_number() {
+    let p = Path::new("lights.soup");
+    let mut s = sample_soup();
+    for (attenuation, number) in [(Attenuation::BuiltIn, 0u32), (Attenuation::Universal, 1)] {
+        s.lights[0].attenuation = attenuation;
+        let b = s.to_bytes(p).unwrap();
+        let payload = &b[52..];
+        let name = b"Point Light";
+        let at = payload.windows(name.len()).position(|w| w == name).unwrap() + name.len();
+        // kind (variant and a spot's two angles), position, direction, colour, intensity.
+        let range = at + 12 + 36 + 4;
+        assert_eq!(&payload[range..range + 4], &10.0f32.to_le_bytes());
+        assert_eq!(&payload[range + 4..range + 8], &number.to_le_bytes());
+        assert_eq!(Soup::from_bytes(&b, p).unwrap(), s);
+    }
 }
 
 #[test]

@@ -251,6 +251,7 @@ pub(crate) mod tests {
             color: Vec3::ONE,
             intensity: 1.0,
             range: 10.0,
+            attenuation: formats::Attenuation::BuiltIn,
             shadows: Shadows::Soft,
             shadow_radius,
             shadow_strength: 1.0,

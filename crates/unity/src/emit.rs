@@ -171,7 +171,10 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
         e.soup.environment.ambient = ambient;
     }
     if let Some(rs) = &g.render_settings {
-        match crate::environment::fog(rs, g.project.hdrp) {
+        match crate::environment::fog(
+            rs,
+            g.project.pipeline == crate::project::Pipeline::HighDefinition,
+        ) {
             Ok(fog) => e.soup.environment.fog = fog,
             Err(why) => e
                 .soup

@@ -3,8 +3,9 @@
 
 use crate::emit::{enabled, flip, EmitError, Emitter};
 use crate::material::linear_rgb;
+use crate::project::Pipeline;
 use crate::yaml::Node;
-use formats::{Light, LightKind, Shadows};
+use formats::{Attenuation, Light, LightKind, Shadows};
 use glam::{Mat4, Vec3, Vec4Swizzles};
 
 /// Unity's `m_Type` of a directional light (its shadow softness is an angle).
@@ -33,7 +34,7 @@ pub fn convert(
     b: &Node,
     kind: LightKind,
     world: Mat4,
-    hdrp: bool,
+    pipeline: Pipeline,
     name: String,
 ) -> Option<(Light, Option<String>)> {
     let directional = b.i64_at("m_Type").unwrap_or(2) == DIRECTIONAL;
@@ -71,7 +72,7 @@ pub fn convert(
     // HDRP stores physical units (lux for the sun, lumen for lamps); the renderer's
     // built-in lighting model wants about 1 for a typical light.
     let mut note = None;
-    if hdrp {
+    if pipeline == Pipeline::HighDefinition {
         let div = if directional { 100_000.0 } else { 1_000.0 };
         let mapped = intensity / div;
         note = Some(format!(
@@ -102,6 +103,10 @@ pub fn convert(
         color,
         intensity,
         range,
+        attenuation: match pipeline {
+            Pipeline::Universal => Attenuation::Universal,
+            Pipeline::BuiltIn | Pipeline::HighDefinition => Attenuation::BuiltIn,
+        },
         shadows,
         shadow_radius,
         shadow_strength: shadow_strength.clamp(0.0, 1.0),
@@ -129,8 +134,8 @@ impl Emitter<'_, '_> {
             }
         };
         let world = self.checked_world(go)?;
-        let hdrp = g.project.hdrp;
-        let Some((light, note)) = convert(&o.body, kind, world, hdrp, self.path(go)) else {
+        let Some((light, note)) = convert(&o.body, kind, world, g.project.pipeline, self.path(go))
+        else {
             let detail = "light has a NaN, infinite or degenerate value".into();
             return Err(self.non_finite(go, detail));
         };

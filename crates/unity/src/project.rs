@@ -44,13 +44,41 @@ pub type FileResult = Arc<std::io::Result<Vec<u8>>>;
 /// read error's message.
 pub type MatResult = Arc<Result<Option<Node>, String>>;
 
+/// The render pipeline a project draws with. Its lights, sky and fog follow that
+/// pipeline's rules, so a scene renders as its own editor shows it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pipeline {
+    BuiltIn,
+    /// The Universal Render Pipeline, or the Lightweight one it grew from.
+    Universal,
+    /// The High Definition Render Pipeline: lights in physical units, sky and fog in
+    /// Volumes.
+    HighDefinition,
+}
+
+impl Pipeline {
+    /// The pipeline whose package a `Packages/manifest.json` lists (an installed pipeline
+    /// package is, in practice, the one the project's graphics settings use).
+    pub fn of_manifest(text: &str) -> Pipeline {
+        let lists = |package: &str| text.contains(&format!("\"{package}\""));
+        if lists("com.unity.render-pipelines.high-definition") {
+            Pipeline::HighDefinition
+        } else if lists("com.unity.render-pipelines.universal")
+            || lists("com.unity.render-pipelines.lightweight")
+        {
+            Pipeline::Universal
+        } else {
+            Pipeline::BuiltIn
+        }
+    }
+}
+
 pub struct Project {
     pub root: PathBuf,
     pub assets: PathBuf,
     pub guids: GuidIndex,
-    /// `Packages/manifest.json` names the High Definition Render Pipeline, whose lights
-    /// are in physical units.
-    pub hdrp: bool,
+    /// The render pipeline `Packages/manifest.json` names.
+    pub pipeline: Pipeline,
     /// `ProjectSettings/QualitySettings.asset`'s lodBias at its current quality level; 1
     /// when the file is absent or does not say (see [`crate::lod`]).
     pub lod_bias: f32,
@@ -97,8 +125,8 @@ impl Project {
             )
         };
         let guids = GuidIndex::build(&assets);
-        let hdrp = std::fs::read_to_string(root.join("Packages").join("manifest.json"))
-            .is_ok_and(|m| m.contains("com.unity.render-pipelines.high-definition"));
+        let pipeline = std::fs::read_to_string(root.join("Packages").join("manifest.json"))
+            .map_or(Pipeline::BuiltIn, |m| Pipeline::of_manifest(&m));
         let lod_bias = std::fs::read(root.join("ProjectSettings").join("QualitySettings.asset"))
             .ok()
             .and_then(|b| crate::lod::lod_bias(&String::from_utf8_lossy(&b)))
@@ -109,7 +137,7 @@ impl Project {
             root,
             assets,
             guids,
-            hdrp,
+            pipeline,
             lod_bias,
             files: Mutex::default(),
             models: Mutex::default(),

@@ -5,7 +5,7 @@
 
 use crate::emit::Emitter;
 use crate::material::{keyword_on, linear_rgb, prop, props, srgb_to_linear};
-use crate::project::{ext, Project};
+use crate::project::{ext, Pipeline, Project};
 use crate::reference::fref;
 use crate::texture::{load_linear, named_slot, Import, LinearImage};
 use crate::yaml::Node;
@@ -63,7 +63,7 @@ pub fn skybox(
     if id == 0 {
         return Ok(None);
     }
-    if project.hdrp {
+    if project.pipeline == Pipeline::HighDefinition {
         return Err("HDRP ignores RenderSettings' skybox (its sky is a Volume override)".into());
     }
     if guid == BUILTIN_EXTRA && id == DEFAULT_SKYBOX {
@@ -561,6 +561,7 @@ mod tests {
             color: Vec3::ONE,
             intensity,
             range: 10.0,
+            attenuation: formats::Attenuation::BuiltIn,
             shadows: formats::Shadows::None,
             shadow_radius: 0.0,
             shadow_strength: 1.0,

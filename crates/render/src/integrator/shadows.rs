@@ -341,6 +341,7 @@ mod tests {
             color: Vec3::ONE,
             intensity: 1.0,
             range: 50.0,
+            attenuation: formats::Attenuation::BuiltIn,
             shadows: Shadows::Soft,
             shadow_radius,
             shadow_strength: 1.0,

@@ -48,6 +48,45 @@ fn a_plane_lit_by_one_point_light_matches_the_formula() {
 }
 
 #[test]
+fn a_urp_point_light_follows_the_inverse_square_law_to_its_range() {
+    let mut s = floor_scene();
+    let light_pos = Vec3::new(1.0, 2.0, 0.5);
+    s.light(formats::Light {
+        attenuation: formats::Attenuation::Universal,
+        ..point_light(light_pos, 1.5, 6.0, Shadows::Hard)
+    });
+    let (soup, kd) = s.build();
+    let (w, h) = (40, 40);
+    let (out, _) = render(&soup, &kd, &opts(w, h));
+    let mut lit = 0;
+    for py in 0..h {
+        for px in 0..w {
+            let p = ortho_point(&soup.camera, w, h, px, py, 0.0);
+            let to = light_pos - p;
+            let d2 = to.length_squared();
+            let smooth = (1.0 - (d2 / 36.0).powi(2)).max(0.0).powi(2);
+            let want = ALBEDO * 1.5 * smooth / d2 * (to.y / d2.sqrt());
+            assert_close(
+                out.frame.pixel(px, py),
+                want,
+                0.01,
+                &format!("pixel ({px}, {py})"),
+            );
+            if want.x > 0.0 {
+                lit += 1;
+            }
+        }
+    }
+    assert!(lit > 100 && lit < (w * h) as usize, "{lit} lit pixels");
+    // Below the light the two pipelines differ by more than the tolerance above.
+    let below = out.frame.pixel(24, 22);
+    let p = ortho_point(&soup.camera, w, h, 24, 22, 0.0);
+    let d = (light_pos - p).length();
+    let built_in = ALBEDO * 1.5 * unity_falloff(d, 6.0) * (light_pos.y - p.y) / d;
+    assert!((below.x - built_in.x).abs() > 0.02, "{below} vs {built_in}");
+}
+
+#[test]
 fn a_shadowed_point_is_dark_and_lit_without_shadows() {
     for shadows in [Shadows::Hard, Shadows::None] {
         let mut s = floor_scene();

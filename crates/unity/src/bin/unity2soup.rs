@@ -187,8 +187,8 @@ fn list(report: &unity::Report) {
     }
     for l in &soup.lights {
         eprintln!(
-            "light {:?}: {:?} at {} along {}, colour {}, intensity {}, range {}, shadows {:?}, layers {:#010x}",
-            l.name, l.kind, l.position, l.direction, l.color, l.intensity, l.range, l.shadows, l.culling_mask
+            "light {:?}: {:?} at {} along {}, colour {}, intensity {}, range {}, {:?} attenuation, shadows {:?}, layers {:#010x}",
+            l.name, l.kind, l.position, l.direction, l.color, l.intensity, l.range, l.attenuation, l.shadows, l.culling_mask
         );
     }
     let c = &soup.camera;

@@ -2,7 +2,7 @@
 //! primitives, fileID schemes, prefab instances, visibility, lights and camera.
 
 use crate::support::*;
-use formats::{FogMode, LightKind, Shadows};
+use formats::{Attenuation, FogMode, LightKind, Shadows};
 use glam::Vec3;
 use std::f32::consts::{FRAC_1_SQRT_2, PI};
 use std::path::{Path, PathBuf};
@@ -526,6 +526,59 @@ fn lights_convert_position_direction_colour_and_shadows() {
         (LightKind::Directional, 1.0)
     );
     assert_warned(&soup, "area light");
+}
+
+#[test]
+fn lights_take_the_attenuation_of_the_projects_render_pipeline() {
+    let mut sc = Scene::default();
+    sc.light(&Tf::at(0.0, 5.0, 0.0), 2, [1.0, 1.0, 1.0], 1);
+    sc.light(&Tf::at(1.0, 5.0, 0.0), 0, [1.0, 1.0, 1.0], 0);
+    let manifest = |package: &str| {
+        format!("{{\n  \"dependencies\": {{\n    \"com.unity.ugui\": \"1.0.0\",\n    \"{package}\": \"14.0.9\"\n  }}\n}}\n")
+    };
+    let cases = [
+        (None, Attenuation::BuiltIn, 1.5),
+        (
+            Some("com.unity.render-pipelines.universal"),
+            Attenuation::Universal,
+            1.5,
+        ),
+        (
+            Some("com.unity.render-pipelines.lightweight"),
+            Attenuation::Universal,
+            1.5,
+        ),
+        // HDRP's lamps are in lumen: mapped to the built-in scale (÷1000), as before.
+        (
+            Some("com.unity.render-pipelines.high-definition"),
+            Attenuation::BuiltIn,
+            0.0015,
+        ),
+        // A package whose name only begins like URP's is not URP.
+        (
+            Some("com.unity.render-pipelines.universal-config"),
+            Attenuation::BuiltIn,
+            1.5,
+        ),
+    ];
+    for (package, attenuation, intensity) in cases {
+        let text = package.map(manifest).unwrap_or_default();
+        let mut files = vec![("Assets/s.unity", sc.text.as_str())];
+        if package.is_some() {
+            files.push(("Packages/manifest.json", text.as_str()));
+        }
+        let (_d, root) = project(&files);
+        let soup = convert(&root.join("Assets/s.unity"));
+        assert_eq!(soup.lights.len(), 2);
+        for l in &soup.lights {
+            assert_eq!(
+                (l.attenuation, l.intensity),
+                (attenuation, intensity),
+                "{package:?}: {}",
+                l.name
+            );
+        }
+    }
 }
 
 const TWO_GROUPS: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 5 0 0\nv 6 0 0\nv 5 1 0\nmtllib two.mtl\ng A\nusemtl red\nf 1 2 3\ng B\nusemtl green\nf 4 5 6\n";
