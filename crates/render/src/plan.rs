@@ -5,8 +5,8 @@
 use crate::alpha::{alpha_use, min_alphas, AlphaUse};
 use crate::{RenderOptions, TextureFilter};
 use formats::{
-    AmbientMode, CastShadows, ClearFlags, Cull, Fog, FogMode, LightKind, Material, Panorama,
-    Shadows, Sky, SkyLayout, Soup,
+    AmbientMode, Attenuation, CastShadows, ClearFlags, Cull, Fog, FogMode, LightKind, Material,
+    Panorama, Shadows, Sky, SkyLayout, Soup,
 };
 use glam::Vec3;
 use serde::Serialize;
@@ -748,10 +748,14 @@ fn rim_probe(l: &formats::Light, opts: &RenderOptions) -> String {
 }
 
 fn light_plan(l: &formats::Light, diffuse: bool, opts: &RenderOptions) -> LightPlan {
-    let kind = match l.kind {
-        LightKind::Point => "point",
-        LightKind::Spot { .. } => "spot",
-        LightKind::Directional => "directional",
+    // A point or spot light names the pipeline whose falloff it follows when it is not
+    // the built-in one.
+    let kind = match (l.kind, l.attenuation) {
+        (LightKind::Point, Attenuation::BuiltIn) => "point",
+        (LightKind::Point, Attenuation::Universal) => "point, URP falloff",
+        (LightKind::Spot { .. }, Attenuation::BuiltIn) => "spot",
+        (LightKind::Spot { .. }, Attenuation::Universal) => "spot, URP falloff",
+        (LightKind::Directional, _) => "directional",
     };
     let power = l.color * l.intensity;
     let off = |reason: String| LightPlan {

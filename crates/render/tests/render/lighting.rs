@@ -24,7 +24,8 @@ fn a_plane_lit_by_one_point_light_matches_the_formula() {
     s.light(point_light(light_pos, 1.5, 6.0, Shadows::Hard));
     let (soup, kd) = s.build();
     let (w, h) = (40, 40);
-    let (out, _) = render(&soup, &kd, &opts(w, h));
+    let (out, plan) = render(&soup, &kd, &opts(w, h));
+    assert_eq!(plan.lights[0].kind, "point");
     let mut lit = 0;
     for py in 0..h {
         for px in 0..w {
@@ -57,7 +58,8 @@ fn a_urp_point_light_follows_the_inverse_square_law_to_its_range() {
     });
     let (soup, kd) = s.build();
     let (w, h) = (40, 40);
-    let (out, _) = render(&soup, &kd, &opts(w, h));
+    let (out, plan) = render(&soup, &kd, &opts(w, h));
+    assert_eq!(plan.lights[0].kind, "point, URP falloff");
     let mut lit = 0;
     for py in 0..h {
         for px in 0..w {
