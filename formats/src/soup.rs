@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 pub const MAGIC: &[u8; 8] = b"UTSOUP\0\0";
-pub const VERSION: u32 = 8;
+pub const VERSION: u32 = 9;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Soup {
@@ -146,6 +146,10 @@ pub struct Material {
     /// The occlusion map (`_OcclusionMap`), darkening the ambient light and the mirror
     /// reflection, tiled as the albedo map.
     pub occlusion_map: Option<OcclusionMap>,
+    /// An unlit shader's material (the built-in Unlit and Sprites shaders, URP Unlit): its
+    /// surface shows colour·map as it is, whatever the lights and ambient, mirrors nothing
+    /// and casts no shadow (those shaders have no lighting and no shadow-caster pass).
+    pub unlit: bool,
 }
 
 /// A material's occlusion map: the green channel g of its texel leaves 1 + (g − 1)·strength
@@ -224,18 +228,25 @@ impl Material {
             normal_map: None,
             emission_map: None,
             occlusion_map: None,
+            unlit: false,
         }
     }
 
     /// Lambert albedo: colour·(1 − metallic), because a metal's colour shows in its
-    /// reflection, not in diffuse light.
+    /// reflection, not in diffuse light. An unlit material's is its colour: what it shows.
     pub fn albedo(&self) -> Vec3 {
+        if self.unlit {
+            return self.color;
+        }
         self.color * (1.0 - self.metallic.clamp(0.0, 1.0))
     }
 
     /// Mirror reflectance, tinted by the colour: `_Reflectivity` if set, else
     /// metallic·smoothness, so only smooth metals mirror unless a material says otherwise.
     pub fn reflectance(&self) -> Vec3 {
+        if self.unlit {
+            return Vec3::ZERO;
+        }
         let r = self
             .reflectivity
             .unwrap_or(self.metallic * self.smoothness)

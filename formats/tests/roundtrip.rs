@@ -139,7 +139,7 @@ fn soup_round_trips_through_a_file() {
     assert_eq!(Soup::read(&path).unwrap(), s);
     let bytes = std::fs::read(&path).unwrap();
     assert_eq!(&bytes[..8], b"UTSOUP\0\0");
-    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 8);
+    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 9);
     // Nothing but the artifact is left in the folder (the temp file was renamed).
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
 }
@@ -769,13 +769,13 @@ fn atomic_outputs_get_the_umask_permissions_not_the_temporary_files() {
 }
 
 #[test]
-fn a_version_7_soup_is_refused_with_the_versions_named() {
+fn a_version_8_soup_is_refused_with_the_versions_named() {
     let p = Path::new("old.soup");
     let mut b = sample_soup().to_bytes(p).unwrap();
-    b[8..12].copy_from_slice(&7u32.to_le_bytes());
+    b[8..12].copy_from_slice(&8u32.to_le_bytes());
     let msg = Soup::from_bytes(&b, p).unwrap_err().to_string();
     assert!(
-        msg.contains("soup format version 7, this build reads version 8"),
+        msg.contains("soup format version 8, this build reads version 9"),
         "{msg}"
     );
     assert!(msg.contains("re-run the stage that made it"), "{msg}");
@@ -832,6 +832,28 @@ fn a_lights_attenuation_follows_its_range_as_a_variant_number() {
         assert_eq!(&payload[range + 4..range + 8], &number.to_le_bytes());
         assert_eq!(Soup::from_bytes(&b, p).unwrap(), s);
     }
+}
+
+#[test]
+fn an_unlit_material_shows_its_colour_mirrors_nothing_and_round_trips() {
+    let lit = Material {
+        color: Vec3::new(0.8, 0.4, 0.2),
+        metallic: 0.5,
+        smoothness: 1.0,
+        ..Material::unity_default()
+    };
+    assert_eq!(lit.albedo(), Vec3::new(0.4, 0.2, 0.1));
+    assert_eq!(lit.reflectance(), Vec3::new(0.4, 0.2, 0.1));
+    let unlit = Material {
+        unlit: true,
+        ..lit.clone()
+    };
+    assert_eq!(unlit.albedo(), Vec3::new(0.8, 0.4, 0.2));
+    assert_eq!(unlit.reflectance(), Vec3::ZERO);
+    let p = Path::new("unlit.soup");
+    let mut s = Soup::empty();
+    s.materials = vec![lit, unlit];
+    assert_eq!(Soup::from_bytes(&s.to_bytes(p).unwrap(), p).unwrap(), s);
 }
 
 #[test]

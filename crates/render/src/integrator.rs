@@ -288,7 +288,9 @@ fn sides(soup: &Soup) -> Vec<u8> {
             let cull = soup.materials[m as usize].cull;
             // The shadow pass sees a face from the light, so from the side the shadow ray
             // did not meet.
+            let unlit = soup.materials[m as usize].unlit;
             let casts = |front: bool| match obj.cast_shadows {
+                _ if unlit => false,
                 CastShadows::Off => false,
                 CastShadows::TwoSided => true,
                 CastShadows::On | CastShadows::ShadowsOnly => !cull.skips(!front),

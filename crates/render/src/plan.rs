@@ -77,6 +77,8 @@ pub struct ShadowCastPlan {
     pub non_casting: usize,
     /// Used materials whose culled faces cast no shadow (on objects casting "on").
     pub culled_in_shadow_pass: usize,
+    /// Used unlit materials: their shaders have no shadow-caster pass.
+    pub unlit_materials: usize,
     /// Objects with `m_ReceiveShadows` off: no shadow rays leave them.
     pub not_receiving: usize,
     pub reason: String,
@@ -191,7 +193,9 @@ impl Plan {
             .filter(|(_, &u)| u)
             .map(|(m, _)| m)
             .collect();
-        let diffuse = mats.iter().any(|m| m.albedo().max_element() > 0.0);
+        let diffuse = mats
+            .iter()
+            .any(|m| !m.unlit && m.albedo().max_element() > 0.0);
 
         let lights: Vec<LightPlan> = soup
             .lights
@@ -346,6 +350,7 @@ impl Plan {
             .iter()
             .filter(|m| {
                 m.normal_map.is_some()
+                    && !m.unlit
                     && (opts.aovs.normal
                         || (diffuse_normal && m.albedo().max_element() > 0.0)
                         || (reflections.enabled && mirror(m)))
@@ -373,6 +378,7 @@ impl Plan {
             .iter()
             .filter(|m| {
                 m.occlusion_map.is_some()
+                    && !m.unlit
                     && ((ambient.enabled && m.albedo().max_element() > 0.0)
                         || (reflections.enabled && mirror(m)))
             })
@@ -698,13 +704,15 @@ fn draw_rules(soup: &Soup, used: &[bool], lights: &[LightPlan]) -> (CullPlan, Sh
         .filter(|o| o.cast_shadows == CastShadows::Off)
         .count();
     let culled_in_shadow_pass = shadow_culled.iter().filter(|&&c| c).count();
+    let unlit_materials = used_mats().filter(|m| m.unlit).count();
     let not_receiving = objs().filter(|o| !o.receive_shadows).count();
     let shadows = lights.iter().any(|l| l.enabled && l.shadow_rays > 0);
-    let filter = non_casting + culled_in_shadow_pass > 0;
+    let filter = non_casting + culled_in_shadow_pass + unlit_materials > 0;
     let shadow_casting = ShadowCastPlan {
         enabled: shadows && filter,
         non_casting,
         culled_in_shadow_pass,
+        unlit_materials,
         not_receiving,
         reason: if !shadows {
             "no light traces shadow rays".into()
@@ -713,7 +721,12 @@ fn draw_rules(soup: &Soup, used: &[bool], lights: &[LightPlan]) -> (CullPlan, Sh
         } else {
             format!(
                 "{non_casting} objects cast no shadow, {culled_in_shadow_pass} materials cull \
-                 faces in the shadow pass: shadow rays pass through them inside the traversal"
+                 faces in the shadow pass{}: shadow rays pass through them inside the traversal",
+                if unlit_materials > 0 {
+                    format!(", {unlit_materials} unlit materials cast none")
+                } else {
+                    String::new()
+                }
             )
         } + &if not_receiving > 0 {
             format!("; {not_receiving} objects receive no shadows")

@@ -95,14 +95,23 @@ pub fn convert(body: &Node, source: &str) -> (Material, Vec<String>) {
     let float = |n: &str| prop(&floats, n).and_then(Node::as_f32);
     let color = |n: &str| prop(&colors, n).and_then(Node::color);
 
-    if let Some(c) = color("_BaseColor").or_else(|| color("_Color")) {
-        m.color = linear_rgb(c);
-        // Alpha is stored linear, never sRGB-encoded.
-        if c.w.is_finite() {
-            m.opacity = c.w.clamp(0.0, 1.0);
+    let unlit = unlit_shader(body);
+    // An unlit shader reads only its own colour property, and some read none (white).
+    let tint = match unlit {
+        Some(u) => u.tint.map(|p| (p, color(p))),
+        None => Some(("_Color", color("_BaseColor").or_else(|| color("_Color")))),
+    };
+    match tint {
+        Some((_, Some(c))) => {
+            m.color = linear_rgb(c);
+            // Alpha is stored linear, never sRGB-encoded.
+            if c.w.is_finite() {
+                m.opacity = c.w.clamp(0.0, 1.0);
+            }
         }
-    } else {
-        notes.push("no _Color or _BaseColor; white".to_string());
+        Some((p, None)) if unlit.is_some() => notes.push(format!("no {p}; white")),
+        Some((_, None)) => notes.push("no _Color or _BaseColor; white".to_string()),
+        None => {}
     }
     if let Some(x) = float("_Metallic") {
         m.metallic = x.clamp(0.0, 1.0);
@@ -128,6 +137,17 @@ pub fn convert(body: &Node, source: &str) -> (Material, Vec<String>) {
             m.emission = e;
         }
     }
+    if let Some(u) = unlit {
+        // Unlit shaders show colour·texture as it is: no metal, mirror or glow.
+        m.unlit = true;
+        m.metallic = 0.0;
+        m.smoothness = 0.0;
+        m.reflectivity = None;
+        m.emission = Vec3::ZERO;
+        if u.two_sided {
+            m.cull = Cull::None;
+        }
+    }
     if !(m.color.is_finite()
         && m.emission.is_finite()
         && m.metallic.is_finite()
@@ -148,10 +168,48 @@ const STANDARD_SPECULAR: i64 = 45;
 const UNLIT_TRANSPARENT: i64 = 10750;
 const UNLIT_TRANSPARENT_CUTOUT: i64 = 10751;
 const SPRITES_DEFAULT: i64 = 10753;
+const UNLIT_TEXTURE: i64 = 10752;
+const UNLIT_COLOR: i64 = 10755;
 
 /// Scriptable pipelines' Lit shaders.
 const URP_LIT: &str = "933532a4fcc9baf4fa0491de14d08ed7";
 const HDRP_LIT: &str = "6e4ae4064600d784cac1e41a9e6f2e59";
+/// URP's Unlit shader.
+pub(crate) const URP_UNLIT: &str = "650dd9526735d5b46b79224bc6e94025";
+
+/// What one of Unity's unlit shaders shows: the colour property it multiplies in (none:
+/// white), whether it samples its albedo texture, and whether it draws both faces.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Unlit {
+    pub tint: Option<&'static str>,
+    pub textured: bool,
+    pub two_sided: bool,
+}
+
+/// The material's shader when it is one of Unity's unlit ones: the built-in Unlit/Texture,
+/// Unlit/Color, Unlit/Transparent and Unlit/Transparent Cutout, Sprites/Default, and URP's
+/// Unlit. None of them is lit, and none has a shadow-caster pass.
+pub(crate) fn unlit_shader(body: &Node) -> Option<Unlit> {
+    let shader = body.get("m_Shader");
+    let guid = shader.and_then(|s| s.str_at("guid"));
+    let id = shader.and_then(|s| s.i64_at("fileID"));
+    let (tint, textured, two_sided) = match (guid, id) {
+        (
+            Some(BUILTIN_EXTRA_GUID),
+            Some(UNLIT_TEXTURE | UNLIT_TRANSPARENT | UNLIT_TRANSPARENT_CUTOUT),
+        ) => (None, true, false),
+        (Some(BUILTIN_EXTRA_GUID), Some(UNLIT_COLOR)) => (Some("_Color"), false, false),
+        // Sprites/Default is `Cull Off`.
+        (Some(BUILTIN_EXTRA_GUID), Some(SPRITES_DEFAULT)) => (Some("_Color"), true, true),
+        (Some(URP_UNLIT), _) => (Some("_BaseColor"), true, false),
+        _ => return None,
+    };
+    Some(Unlit {
+        tint,
+        textured,
+        two_sided,
+    })
+}
 
 /// How the material's shader uses alpha, from the properties its inspector writes:
 /// Standard's `_Mode` (0 Opaque, 1 Cutout, 2 Fade, 3 Transparent), URP Lit's `_Surface`
@@ -181,8 +239,8 @@ pub fn alpha_mode(body: &Node, float: &dyn Fn(&str) -> Option<f32>) -> Alpha {
         (Some(BUILTIN_EXTRA_GUID), Some(UNLIT_TRANSPARENT_CUTOUT)) => cutout("_Cutoff"),
         // A transparent surface that also clips is drawn as blended: below the cutoff its
         // alpha lets most light through anyway.
-        (Some(URP_LIT), _) if on("_Surface") => Alpha::Blend,
-        (Some(URP_LIT), _) if on("_AlphaClip") => cutout("_Cutoff"),
+        (Some(URP_LIT | URP_UNLIT), _) if on("_Surface") => Alpha::Blend,
+        (Some(URP_LIT | URP_UNLIT), _) if on("_AlphaClip") => cutout("_Cutoff"),
         (Some(HDRP_LIT), _) if on("_SurfaceType") => Alpha::Blend,
         (Some(HDRP_LIT), _) if on("_AlphaCutoffEnable") => cutout("_AlphaCutoff"),
         _ => Alpha::Opaque,
@@ -280,9 +338,12 @@ impl Emitter<'_, '_> {
                 let body = self.inherit(&body, &src);
                 let (mut m, _notes) = convert(&body, &src);
                 m.albedo_map = self.mat_albedo(&body, &src);
-                m.normal_map = self.mat_normal(&body, &src);
-                m.emission_map = self.mat_emission(&body, m.emission, &src);
-                m.occlusion_map = self.mat_occlusion(&body, &src);
+                // Unlit shaders sample no normal, emission or occlusion map.
+                if !m.unlit {
+                    m.normal_map = self.mat_normal(&body, &src);
+                    m.emission_map = self.mat_emission(&body, m.emission, &src);
+                    m.occlusion_map = self.mat_occlusion(&body, &src);
+                }
                 (self.add_material(key, || m), format!("override {src}"))
             }
             _ => {
@@ -308,9 +369,12 @@ impl Emitter<'_, '_> {
                     self.soup.warnings.push(format!("{rel}: {n}"));
                 }
                 m.albedo_map = self.mat_albedo(&b, &rel);
-                m.normal_map = self.mat_normal(&b, &rel);
-                m.emission_map = self.mat_emission(&b, m.emission, &rel);
-                m.occlusion_map = self.mat_occlusion(&b, &rel);
+                // Unlit shaders sample no normal, emission or occlusion map.
+                if !m.unlit {
+                    m.normal_map = self.mat_normal(&b, &rel);
+                    m.emission_map = self.mat_emission(&b, m.emission, &rel);
+                    m.occlusion_map = self.mat_occlusion(&b, &rel);
+                }
                 self.add_material(key, || m)
             }
             Ok(None) => self.warn_default(what, format!("{rel} holds no Material")),
@@ -677,6 +741,95 @@ mod tests {
         // A custom shader's _Mode means what its author chose.
         let custom = "Material:\n  m_Shader: {fileID: 4800000, guid: 1234, type: 3}\n  m_SavedProperties:\n    m_Floats:\n    - _Mode: 1\n";
         assert_eq!(alpha_of(custom).0, Alpha::Opaque);
+    }
+
+    #[test]
+    fn unlit_shaders_show_their_own_colour_and_texture_and_nothing_else() {
+        // Every file keeps stale lit properties, as Unity leaves them on a shader change.
+        let mat = |shader: &str| {
+            format!("Material:\n  m_Shader: {shader}\n  m_ShaderKeywords: _EMISSION _NORMALMAP\n  m_SavedProperties:\n    m_TexEnvs:\n    - _BaseMap:\n        m_Texture: {{fileID: 2800000, guid: bbbb, type: 3}}\n        m_Scale: {{x: 1, y: 1}}\n        m_Offset: {{x: 0, y: 0}}\n    - _MainTex:\n        m_Texture: {{fileID: 2800000, guid: aaaa, type: 3}}\n        m_Scale: {{x: 2, y: 2}}\n        m_Offset: {{x: 0, y: 0}}\n    - _BumpMap:\n        m_Texture: {{fileID: 2800000, guid: cccc, type: 3}}\n        m_Scale: {{x: 1, y: 1}}\n        m_Offset: {{x: 0, y: 0}}\n    m_Floats:\n    - _Metallic: 1\n    - _Glossiness: 1\n    - _Smoothness: 1\n    - _Surface: 1\n    m_Colors:\n    - _Color: {{r: 0.2, g: 0.2, b: 0.2, a: 0.5}}\n    - _BaseColor: {{r: 1, g: 0.2, b: 0.2, a: 0.25}}\n    - _EmissionColor: {{r: 1, g: 1, b: 1, a: 1}}\n")
+        };
+        let builtin =
+            |id: i64| format!("{{fileID: {id}, guid: 0000000000000000f000000000000000, type: 0}}");
+        let urp = "{fileID: 4800000, guid: 650dd9526735d5b46b79224bc6e94025, type: 3}".to_string();
+        let grey = srgb_to_linear(0.2);
+        let red = Vec3::new(1.0, grey, grey);
+        // shader, colour, opacity, albedo property, alpha, cull
+        let cases = [
+            (
+                builtin(10752),
+                Vec3::ONE,
+                1.0,
+                Some("_MainTex"),
+                Alpha::Opaque,
+                Cull::Back,
+            ),
+            (
+                builtin(10750),
+                Vec3::ONE,
+                1.0,
+                Some("_MainTex"),
+                Alpha::Blend,
+                Cull::Back,
+            ),
+            (
+                builtin(10751),
+                Vec3::ONE,
+                1.0,
+                Some("_MainTex"),
+                Alpha::Cutout { cutoff: 0.5 },
+                Cull::Back,
+            ),
+            (
+                builtin(10755),
+                Vec3::splat(grey),
+                0.5,
+                None,
+                Alpha::Opaque,
+                Cull::Back,
+            ),
+            (
+                builtin(10753),
+                Vec3::splat(grey),
+                0.5,
+                Some("_MainTex"),
+                Alpha::Blend,
+                Cull::None,
+            ),
+            (urp, red, 0.25, Some("_BaseMap"), Alpha::Blend, Cull::Back),
+        ];
+        for (shader, colour, opacity, albedo, alpha, cull) in cases {
+            let text = mat(&shader);
+            let body = parse(&text);
+            let body = body.get("Material").unwrap();
+            let (m, notes) = convert(body, "u.mat");
+            assert!(m.unlit, "{shader}");
+            assert!(
+                (m.color - colour).abs().max_element() < 1e-6,
+                "{shader}: {}",
+                m.color
+            );
+            assert_eq!(
+                (m.opacity, m.alpha, m.cull),
+                (opacity, alpha, cull),
+                "{shader}"
+            );
+            assert_eq!(
+                (m.metallic, m.smoothness, m.emission),
+                (0.0, 0.0, Vec3::ZERO),
+                "{shader}"
+            );
+            assert_eq!(
+                crate::texture::albedo_slot(body).map(|s| s.property),
+                albedo.map(String::from),
+                "{shader}"
+            );
+            assert!(notes.is_empty(), "{shader}: {notes:?}");
+        }
+        // The lit shaders stay lit.
+        let (standard, _) = convert(parse(&mat(&builtin(46))).get("Material").unwrap(), "s.mat");
+        assert!(!standard.unlit);
+        assert_eq!(standard.metallic, 1.0);
     }
 
     #[test]

@@ -55,6 +55,9 @@ pub struct TextureSlot {
 /// The albedo texture slot of a Material body, in either `m_TexEnvs` layout. `None` when
 /// the material's albedo property is empty (`{fileID: 0}`) or absent.
 pub fn albedo_slot(body: &Node) -> Option<TextureSlot> {
+    if crate::material::unlit_shader(body).is_some_and(|u| !u.textured) {
+        return None;
+    }
     let envs = tex_envs(body)?;
     let slot = |name: &str| prop(&envs, name);
     // A known shader reads only its own property: an empty one means untextured even
@@ -72,7 +75,7 @@ pub fn albedo_slot(body: &Node) -> Option<TextureSlot> {
 /// The albedo property of the material's shader, where it is one whose property is known.
 fn own_albedo(body: &Node) -> Option<&'static str> {
     match body.get("m_Shader").and_then(|s| s.str_at("guid")) {
-        Some(URP_LIT) => Some("_BaseMap"),
+        Some(URP_LIT | crate::material::URP_UNLIT) => Some("_BaseMap"),
         Some(HDRP_LIT) => Some("_BaseColorMap"),
         Some(BUILTIN_SHADERS) => Some("_MainTex"),
         _ => None,

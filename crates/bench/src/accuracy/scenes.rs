@@ -69,6 +69,7 @@ fn material(name: &str, color: Vec3, metallic: f32, smoothness: f32) -> Material
         normal_map: None,
         emission_map: None,
         occlusion_map: None,
+        unlit: false,
         albedo_map: None,
         opacity: 1.0,
         alpha: Alpha::Opaque,
@@ -250,6 +251,7 @@ pub fn checkerboard() -> Scene {
         normal_map: None,
         emission_map: None,
         occlusion_map: None,
+        unlit: false,
         albedo_map: Some(TextureRef {
             texture: 0,
             tiling: Tiling::default(),

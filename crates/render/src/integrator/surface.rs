@@ -112,8 +112,12 @@ impl Integrator<'_> {
                 None => l += mat.emission,
             }
         }
-        // A black albedo cannot show any light: no light is asked, no shadow ray traced.
-        let lit = albedo.max_element() > 0.0;
+        // An unlit surface shows its colour as it is; a black albedo cannot show any light:
+        // neither asks a light or traces a shadow ray.
+        if mat.unlit {
+            l += albedo;
+        }
+        let lit = !mat.unlit && albedo.max_element() > 0.0;
         let mut reflectance = mat.reflectance();
         // The share of ambient light and reflection the occlusion map leaves (1 without
         // one: a product with 1 leaves every other pixel's bits as they were).

@@ -129,6 +129,47 @@ fn a_shadowed_point_is_dark_and_lit_without_shadows() {
     }
 }
 
+/// An unlit surface shows its colour as it is, whatever the light, and casts no shadow:
+/// the floor under it is lit as if it were not there.
+#[test]
+fn an_unlit_surface_shows_its_colour_and_casts_no_shadow() {
+    let mut s = floor_scene();
+    let colour = Vec3::new(0.3, 0.5, 0.7);
+    let m = s.material(formats::Material {
+        unlit: true,
+        metallic: 0.5,
+        ..diffuse(colour)
+    });
+    s.quad(
+        "unlit",
+        Vec3::new(1.0, 2.0, -1.0),
+        Vec3::new(0.0, 0.0, 2.0),
+        Vec3::new(1.0, 0.0, 0.0),
+        m,
+    );
+    let light_pos = Vec3::new(3.0, 4.0, 0.0);
+    s.light(point_light(light_pos, 1.0, 20.0, Shadows::Hard));
+    let (soup, kd) = s.build();
+    let (out, plan) = render(&soup, &kd, &opts(40, 40));
+    assert_eq!(plan.shadow_casting.unlit_materials, 1);
+    assert!(plan.shadow_casting.enabled && plan.direct.enabled);
+    // Where the lit quad of the test above throws its shadow, the floor is lit.
+    let p = ortho_point(&soup.camera, 40, 40, 20, 20, 0.0);
+    let to = light_pos - p;
+    let d = to.length();
+    let lit = ALBEDO * unity_falloff(d, 20.0) * (to.y / d);
+    assert_close(
+        out.frame.pixel(20, 20),
+        lit,
+        1e-4,
+        "floor under the unlit quad",
+    );
+    // The quad (x 1–2, so pixel column 13) shows its colour: no light, metal or shading.
+    let q = ortho_point(&soup.camera, 40, 40, 13, 20, 0.0);
+    assert!(q.x > 1.0 && q.x < 2.0, "{q}");
+    assert_eq!(out.frame.pixel(13, 20), colour);
+}
+
 /// A shadow of strength s takes s of the light it blocks away, hard or soft, one ray at a
 /// time or in packets; at strength 0 no shadow ray is traced.
 #[test]
