@@ -171,8 +171,9 @@ fn list(report: &unity::Report) {
         let occlusion = m.occlusion_map.as_ref().map_or(String::new(), |o| {
             format!(", occlusion map {} strength {}", image(&o.map), o.strength)
         });
+        let unlit = if m.unlit { ", unlit" } else { "" };
         eprintln!(
-            "material {:?} ({}): {texture}{normal}{glow}{occlusion}, opacity {}, alpha {:?}",
+            "material {:?} ({}): {texture}{normal}{glow}{occlusion}, opacity {}, alpha {:?}{unlit}",
             m.name, m.source, m.opacity, m.alpha
         );
     }

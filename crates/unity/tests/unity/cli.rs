@@ -156,3 +156,32 @@ fn unity2soup_list_names_each_materials_maps() {
         "{glow}"
     );
 }
+
+#[test]
+fn unity2soup_list_marks_unlit_materials() {
+    let mut sc = Scene::default();
+    let (go, _) = sc.object("Sign", &Tf::at(0.0, 0.0, 0.0), 0, true);
+    sc.mesh(
+        go,
+        CUBE,
+        BUILTIN,
+        &[(2100000, "0123456789abcdef0123456789abcdef")],
+        true,
+    );
+    let flat = "%YAML 1.1\n--- !u!21 &2100000\nMaterial:\n  m_Name: Flat\n  m_Shader: {fileID: 10755, guid: 0000000000000000f000000000000000, type: 0}\n  m_SavedProperties:\n    m_Colors:\n    - _Color: {r: 1, g: 0, b: 0, a: 1}\n";
+    let (_d, root) = project(&[
+        ("Assets/s.unity", sc.text.as_str()),
+        ("Assets/Flat.mat", flat),
+        (
+            "Assets/Flat.mat.meta",
+            "fileFormatVersion: 2\nguid: 0123456789abcdef0123456789abcdef\n",
+        ),
+    ]);
+    let stderr = list(&root.join("Assets/s.unity"));
+    assert!(
+        stderr.contains(
+            "material \"Flat\" (Assets/Flat.mat): no texture, opacity 1, alpha Opaque, unlit"
+        ),
+        "{stderr}"
+    );
+}
