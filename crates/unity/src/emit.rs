@@ -8,6 +8,7 @@
 use crate::docs;
 use crate::graph::{is_transform, Graph, Obj};
 use crate::mesh::Mesh;
+use crate::project::Pipeline;
 use formats::Soup;
 use glam::{Mat4, Vec3};
 use std::collections::HashMap;
@@ -171,10 +172,7 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
         e.soup.environment.ambient = ambient;
     }
     if let Some(rs) = &g.render_settings {
-        match crate::environment::fog(
-            rs,
-            g.project.pipeline == crate::project::Pipeline::HighDefinition,
-        ) {
+        match crate::environment::fog(rs, g.project.pipeline == Pipeline::HighDefinition) {
             Ok(fog) => e.soup.environment.fog = fog,
             Err(why) => e
                 .soup

@@ -98,19 +98,21 @@ pub fn convert(body: &Node, source: &str) -> (Material, Vec<String>) {
     let unlit = unlit_shader(body);
     // An unlit shader reads only its own colour property, and some read none (white).
     let tint = match unlit {
-        Some(u) => u.tint.map(|p| (p, color(p))),
-        None => Some(("_Color", color("_BaseColor").or_else(|| color("_Color")))),
+        Some(u) => u.tint.map(|p| (color(p), p)),
+        None => Some((
+            color("_BaseColor").or_else(|| color("_Color")),
+            "_Color or _BaseColor",
+        )),
     };
     match tint {
-        Some((_, Some(c))) => {
+        Some((Some(c), _)) => {
             m.color = linear_rgb(c);
             // Alpha is stored linear, never sRGB-encoded.
             if c.w.is_finite() {
                 m.opacity = c.w.clamp(0.0, 1.0);
             }
         }
-        Some((p, None)) if unlit.is_some() => notes.push(format!("no {p}; white")),
-        Some((_, None)) => notes.push("no _Color or _BaseColor; white".to_string()),
+        Some((None, names)) => notes.push(format!("no {names}; white")),
         None => {}
     }
     if let Some(x) = float("_Metallic") {
@@ -177,6 +179,15 @@ const HDRP_LIT: &str = "6e4ae4064600d784cac1e41a9e6f2e59";
 /// URP's Unlit shader.
 pub(crate) const URP_UNLIT: &str = "650dd9526735d5b46b79224bc6e94025";
 
+/// The material's shader as `m_Shader` names it: its guid and fileID.
+fn shader_of(body: &Node) -> (Option<&str>, Option<i64>) {
+    let shader = body.get("m_Shader");
+    (
+        shader.and_then(|s| s.str_at("guid")),
+        shader.and_then(|s| s.i64_at("fileID")),
+    )
+}
+
 /// What one of Unity's unlit shaders shows: the colour property it multiplies in (none:
 /// white), whether it samples its albedo texture, and whether it draws both faces.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -190,10 +201,7 @@ pub(crate) struct Unlit {
 /// Unlit/Color, Unlit/Transparent and Unlit/Transparent Cutout, Sprites/Default, and URP's
 /// Unlit. None of them is lit, and none has a shadow-caster pass.
 pub(crate) fn unlit_shader(body: &Node) -> Option<Unlit> {
-    let shader = body.get("m_Shader");
-    let guid = shader.and_then(|s| s.str_at("guid"));
-    let id = shader.and_then(|s| s.i64_at("fileID"));
-    let (tint, textured, two_sided) = match (guid, id) {
+    let (tint, textured, two_sided) = match shader_of(body) {
         (
             Some(BUILTIN_EXTRA_GUID),
             Some(UNLIT_TEXTURE | UNLIT_TRANSPARENT | UNLIT_TRANSPARENT_CUTOUT),
@@ -224,10 +232,7 @@ pub fn alpha_mode(body: &Node, float: &dyn Fn(&str) -> Option<f32>) -> Alpha {
             cutoff: c.clamp(0.0, 1.0),
         }
     };
-    let shader = body.get("m_Shader");
-    let guid = shader.and_then(|s| s.str_at("guid"));
-    let id = shader.and_then(|s| s.i64_at("fileID"));
-    match (guid, id) {
+    match shader_of(body) {
         (Some(BUILTIN_EXTRA_GUID), Some(STANDARD | STANDARD_SPECULAR)) => {
             match float("_Mode").map(|x| x.round() as i64) {
                 Some(1) => cutout("_Cutoff"),

@@ -17,22 +17,30 @@ fn floor_scene() -> SceneBuilder {
     s
 }
 
-#[test]
-fn a_plane_lit_by_one_point_light_matches_the_formula() {
+/// The floor under a point light 2 m up (intensity 1.5, range 6) with `attenuation`,
+/// 40 × 40 pixels, each held to albedo · 1.5 · `falloff(d)` · cos within 0.01; the
+/// plan names the light `kind`. Returns the frame and the camera that took it.
+fn floor_under_a_point_light(
+    attenuation: formats::Attenuation,
+    kind: &str,
+    falloff: impl Fn(f32) -> f32,
+) -> (render::Rendered, Camera) {
     let mut s = floor_scene();
-    let light_pos = Vec3::new(1.0, 2.0, 0.5);
-    s.light(point_light(light_pos, 1.5, 6.0, Shadows::Hard));
+    s.light(formats::Light {
+        attenuation,
+        ..point_light(LAMP, 1.5, 6.0, Shadows::Hard)
+    });
     let (soup, kd) = s.build();
     let (w, h) = (40, 40);
     let (out, plan) = render(&soup, &kd, &opts(w, h));
-    assert_eq!(plan.lights[0].kind, "point");
+    assert_eq!(plan.lights[0].kind, kind);
     let mut lit = 0;
     for py in 0..h {
         for px in 0..w {
             let p = ortho_point(&soup.camera, w, h, px, py, 0.0);
-            let to = light_pos - p;
+            let to = LAMP - p;
             let d = to.length();
-            let want = ALBEDO * 1.5 * unity_falloff(d, 6.0) * (to.y / d);
+            let want = ALBEDO * 1.5 * falloff(d) * (to.y / d);
             assert_close(
                 out.frame.pixel(px, py),
                 want,
@@ -46,45 +54,30 @@ fn a_plane_lit_by_one_point_light_matches_the_formula() {
     }
     // The range (6 m from a light 2 m up) ends inside the view: both cases are checked.
     assert!(lit > 100 && lit < (w * h) as usize, "{lit} lit pixels");
+    (out, soup.camera)
+}
+
+/// Where the point light of [`floor_under_a_point_light`] hangs.
+const LAMP: Vec3 = Vec3::new(1.0, 2.0, 0.5);
+
+#[test]
+fn a_plane_lit_by_one_point_light_matches_the_formula() {
+    floor_under_a_point_light(formats::Attenuation::BuiltIn, "point", |d| {
+        unity_falloff(d, 6.0)
+    });
 }
 
 #[test]
 fn a_urp_point_light_follows_the_inverse_square_law_to_its_range() {
-    let mut s = floor_scene();
-    let light_pos = Vec3::new(1.0, 2.0, 0.5);
-    s.light(formats::Light {
-        attenuation: formats::Attenuation::Universal,
-        ..point_light(light_pos, 1.5, 6.0, Shadows::Hard)
-    });
-    let (soup, kd) = s.build();
-    let (w, h) = (40, 40);
-    let (out, plan) = render(&soup, &kd, &opts(w, h));
-    assert_eq!(plan.lights[0].kind, "point, URP falloff");
-    let mut lit = 0;
-    for py in 0..h {
-        for px in 0..w {
-            let p = ortho_point(&soup.camera, w, h, px, py, 0.0);
-            let to = light_pos - p;
-            let d2 = to.length_squared();
-            let smooth = (1.0 - (d2 / 36.0).powi(2)).max(0.0).powi(2);
-            let want = ALBEDO * 1.5 * smooth / d2 * (to.y / d2.sqrt());
-            assert_close(
-                out.frame.pixel(px, py),
-                want,
-                0.01,
-                &format!("pixel ({px}, {py})"),
-            );
-            if want.x > 0.0 {
-                lit += 1;
-            }
-        }
-    }
-    assert!(lit > 100 && lit < (w * h) as usize, "{lit} lit pixels");
+    let (out, camera) =
+        floor_under_a_point_light(formats::Attenuation::Universal, "point, URP falloff", |d| {
+            (1.0 - (d * d / 36.0).powi(2)).max(0.0).powi(2) / (d * d)
+        });
     // Below the light the two pipelines differ by more than the tolerance above.
     let below = out.frame.pixel(24, 22);
-    let p = ortho_point(&soup.camera, w, h, 24, 22, 0.0);
-    let d = (light_pos - p).length();
-    let built_in = ALBEDO * 1.5 * unity_falloff(d, 6.0) * (light_pos.y - p.y) / d;
+    let p = ortho_point(&camera, 40, 40, 24, 22, 0.0);
+    let d = (LAMP - p).length();
+    let built_in = ALBEDO * 1.5 * unity_falloff(d, 6.0) * (LAMP.y - p.y) / d;
     assert!((below.x - built_in.x).abs() > 0.02, "{below} vs {built_in}");
 }
 
