@@ -297,7 +297,8 @@ pub struct Light {
     pub position: Vec3,
     /// Unit vector the light shines along (Unity's local +Z, converted).
     pub direction: Vec3,
-    /// Linear RGB.
+    /// Linear RGB; times `intensity`, the light's final colour as the project combines
+    /// colour, intensity and colour temperature.
     pub color: Vec3,
     pub intensity: f32,
     /// Distance at which point and spot lights reach zero.

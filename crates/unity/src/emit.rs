@@ -164,6 +164,23 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
     }
     e.decode_textures();
     e.soup.warnings.extend(camera_warnings);
+    // Only an intensity other than 1 lights differently in the two conventions.
+    if g.project.light_units_assumed && e.soup.lights.iter().any(|l| l.intensity != 1.0) {
+        e.soup.warnings.push(
+            "ProjectSettings/GraphicsSettings.asset is missing: lights take the built-in \
+             pipeline's default, gamma colour × intensity decoded (intensity 0.5 lights as \
+             0.21, 2 as 4.6); a project set to Lights Use Linear Intensity looks different"
+                .into(),
+        );
+    }
+    if g.project.gamma_color_space {
+        e.soup.warnings.push(
+            "ProjectSettings/ProjectSettings.asset: the project draws in the Gamma colour space; \
+             unitrace renders in linear space, as Unity's Linear setting does, so lit surfaces, \
+             falloff and blending look brighter and softer than in its editor"
+                .into(),
+        );
+    }
     if let Some(ambient) = g
         .render_settings
         .as_ref()

@@ -29,6 +29,16 @@ pub fn srgb_to_linear(c: f32) -> f32 {
     }
 }
 
+/// Unity's gamma-to-linear conversion of a value that may exceed 1 (a `[Gamma]` float, a
+/// light's colour times its intensity): the sRGB curve up to 1, x^2.2 above.
+pub fn gamma_to_linear(x: f32) -> f32 {
+    if x <= 1.0 {
+        srgb_to_linear(x)
+    } else {
+        x.powf(2.2)
+    }
+}
+
 pub fn linear_rgb(c: Vec4) -> Vec3 {
     Vec3::new(
         srgb_to_linear(c.x),

@@ -5,6 +5,7 @@
 
 use crate::docs;
 use crate::fbx;
+use crate::light::LightUnits;
 use crate::meta::{GuidIndex, ModelMeta};
 use crate::model::Model;
 use crate::obj;
@@ -73,12 +74,29 @@ impl Pipeline {
     }
 }
 
+/// Whether a `ProjectSettings.asset` text sets the Gamma colour space (`m_ActiveColorSpace`
+/// 0; 1 is Linear).
+pub fn gamma_color_space(text: &str) -> bool {
+    docs::split(text)
+        .into_iter()
+        .find(|d| d.class == docs::PLAYER_SETTINGS)
+        .is_some_and(|d| d.parse().i64_at("m_ActiveColorSpace") == Some(0))
+}
+
 pub struct Project {
     pub root: PathBuf,
     pub assets: PathBuf,
     pub guids: GuidIndex,
     /// The render pipeline `Packages/manifest.json` names.
     pub pipeline: Pipeline,
+    /// How lights' colours and intensities combine, from the pipeline and
+    /// `ProjectSettings/GraphicsSettings.asset`.
+    pub light_units: LightUnits,
+    /// A built-in project without `ProjectSettings/GraphicsSettings.asset`, whose lights take
+    /// Unity's default units.
+    pub light_units_assumed: bool,
+    /// `ProjectSettings/ProjectSettings.asset` sets the Gamma colour space (absent: linear).
+    pub gamma_color_space: bool,
     /// `ProjectSettings/QualitySettings.asset`'s lodBias at its current quality level; 1
     /// when the file is absent or does not say (see [`crate::lod`]).
     pub lod_bias: f32,
@@ -127,10 +145,19 @@ impl Project {
         let guids = GuidIndex::build(&assets);
         let pipeline = std::fs::read_to_string(root.join("Packages").join("manifest.json"))
             .map_or(Pipeline::BuiltIn, |m| Pipeline::of_manifest(&m));
-        let lod_bias = std::fs::read(root.join("ProjectSettings").join("QualitySettings.asset"))
-            .ok()
-            .and_then(|b| crate::lod::lod_bias(&String::from_utf8_lossy(&b)))
+        let settings = |name: &str| {
+            std::fs::read(root.join("ProjectSettings").join(name))
+                .ok()
+                .map(|b| String::from_utf8_lossy(&b).into_owned())
+        };
+        let lod_bias = settings("QualitySettings.asset")
+            .and_then(|text| crate::lod::lod_bias(&text))
             .unwrap_or(1.0);
+        let graphics = settings("GraphicsSettings.asset");
+        let light_units_assumed = pipeline == Pipeline::BuiltIn && graphics.is_none();
+        let light_units = LightUnits::of(pipeline, graphics.as_deref());
+        let gamma_color_space =
+            settings("ProjectSettings.asset").is_some_and(|text| gamma_color_space(&text));
         let canonical_root = root.canonicalize().unwrap_or_else(|_| root.clone());
         Project {
             canonical_root,
@@ -138,6 +165,9 @@ impl Project {
             assets,
             guids,
             pipeline,
+            light_units,
+            light_units_assumed,
+            gamma_color_space,
             lod_bias,
             files: Mutex::default(),
             models: Mutex::default(),

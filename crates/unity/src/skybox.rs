@@ -4,7 +4,7 @@
 //! Sided).
 
 use crate::emit::Emitter;
-use crate::material::{keyword_on, linear_rgb, prop, props, srgb_to_linear};
+use crate::material::{gamma_to_linear, keyword_on, linear_rgb, prop, props};
 use crate::project::{ext, Pipeline, Project};
 use crate::reference::fref;
 use crate::texture::{load_linear, named_slot, Import, LinearImage};
@@ -116,16 +116,6 @@ pub fn skybox(
         rotation: p.float("_Rotation").unwrap_or(0.0),
         layout,
     })))
-}
-
-/// Unity's gamma-to-linear conversion of a [Gamma] float: the sRGB curve up to 1, x^2.2
-/// above.
-fn gamma_to_linear(x: f32) -> f32 {
-    if x <= 1.0 {
-        srgb_to_linear(x)
-    } else {
-        x.powf(2.2)
-    }
 }
 
 /// A material's finite float and colour properties (colours linear). A number Unity

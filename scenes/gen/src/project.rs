@@ -10,6 +10,10 @@ use std::path::Path;
 const PROJECT_VERSION: &str =
     "m_EditorVersion: 2022.3.20f1\nm_EditorVersionWithRevision: 2022.3.20f1 (61c2feb0970d)\n";
 
+/// The bundled projects' lights are authored in linear units: intensity times the linear
+/// colour, with colour temperature available (Unity fills in every other setting).
+const GRAPHICS_SETTINGS: &str = "%YAML 1.1\n%TAG !u! tag:unity3d.com,2011:\n--- !u!30 &1\nGraphicsSettings:\n  m_ObjectHideFlags: 0\n  m_LightsUseLinearIntensity: 1\n  m_LightsUseColorTemperature: 1\n";
+
 pub struct Project {
     /// Folder name under `scenes/`.
     pub name: String,
@@ -24,6 +28,7 @@ impl Project {
             files: BTreeMap::new(),
         };
         p.add("ProjectSettings/ProjectVersion.txt", PROJECT_VERSION);
+        p.add("ProjectSettings/GraphicsSettings.asset", GRAPHICS_SETTINGS);
         p
     }
 

@@ -10,7 +10,11 @@ fn scene() -> (tempfile::TempDir, std::path::PathBuf) {
     sc.light(&Tf::at(0.0, 3.0, 0.0), 2, [1.0, 1.0, 1.0], 1);
     sc.primitive("Floor", &Tf::at(0.0, 0.0, 0.0), 0, PLANE);
     sc.primitive("Box A", &Tf::at(2.0, 0.5, 0.0), 0, CUBE);
-    let (d, root) = project(&[("Assets/Scenes/s.unity", &sc.text)]);
+    let linear = graphics_settings(1, 1);
+    let (d, root) = project(&[
+        ("Assets/Scenes/s.unity", &sc.text),
+        (GRAPHICS_SETTINGS, &linear),
+    ]);
     (d, root.join("Assets/Scenes/s.unity"))
 }
 

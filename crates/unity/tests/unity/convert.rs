@@ -512,10 +512,21 @@ fn lights_convert_position_direction_colour_and_shadows() {
         "{}",
         spot.direction
     );
-    assert!(close(spot.color, Vec3::new(1.0, 0.21404114, 0.0), 1e-6));
+    // A built-in project without graphics settings: Unity decodes the gamma colour times
+    // the intensity, (1.5, 0.75, 0) → (1.5^2.2, sRGB⁻¹(0.75), 0).
+    assert!(close(
+        spot.color * spot.intensity,
+        Vec3::new(2.4400615, 0.52252156, 0.0),
+        1e-5
+    ));
+    assert!(
+        (spot.intensity - 2.4400615).abs() < 1e-5,
+        "{}",
+        spot.intensity
+    );
     assert_eq!(
-        (spot.intensity, spot.range, spot.shadows, spot.shadow_radius),
-        (1.5, 12.0, Shadows::Soft, 0.1)
+        (spot.range, spot.shadows, spot.shadow_radius),
+        (12.0, Shadows::Soft, 0.1)
     );
     assert_eq!(
         (soup.lights[1].kind, soup.lights[1].shadows),
@@ -536,8 +547,10 @@ fn lights_take_the_attenuation_of_the_projects_render_pipeline() {
     let manifest = |package: &str| {
         format!("{{\n  \"dependencies\": {{\n    \"com.unity.ugui\": \"1.0.0\",\n    \"{package}\": \"14.0.9\"\n  }}\n}}\n")
     };
+    // The built-in pipeline decodes a gamma intensity (1.5^2.2); the scriptable ones do not.
+    let gamma = 1.5f32.powf(2.2);
     let cases = [
-        (None, Attenuation::BuiltIn, 1.5),
+        (None, Attenuation::BuiltIn, gamma),
         (
             Some("com.unity.render-pipelines.universal"),
             Attenuation::Universal,
@@ -558,7 +571,7 @@ fn lights_take_the_attenuation_of_the_projects_render_pipeline() {
         (
             Some("com.unity.render-pipelines.universal-config"),
             Attenuation::BuiltIn,
-            1.5,
+            gamma,
         ),
     ];
     for (package, attenuation, intensity) in cases {
@@ -578,6 +591,102 @@ fn lights_take_the_attenuation_of_the_projects_render_pipeline() {
                 l.name
             );
         }
+    }
+}
+
+#[test]
+fn lights_combine_colour_and_intensity_as_the_projects_graphics_settings_say() {
+    let mut sc = Scene::default();
+    sc.light(&Tf::at(0.0, 5.0, 0.0), 2, [1.0, 0.5, 0.25], 1);
+    sc.raw("  m_ColorTemperature: 5000\n  m_UseColorTemperature: 1\n");
+    let urp = "{\"dependencies\": {\"com.unity.render-pipelines.universal\": \"14.0.9\"}}";
+    let linear = Vec3::new(1.0, 0.21404114, 0.05087609) * 1.5;
+    // Unity's fit at 5,000 K.
+    let warm = Vec3::new(1.0, 0.77996, 0.61952);
+    let cases: [(&str, Option<String>, Option<&str>, Vec3); 5] = [
+        // Unity's defaults: gamma intensity, no temperature.
+        (
+            "default",
+            None,
+            None,
+            Vec3::new(2.4400615, 0.52252156, 0.11601613),
+        ),
+        ("linear", Some(graphics_settings(1, 0)), None, linear),
+        (
+            "linear, temperature",
+            Some(graphics_settings(1, 1)),
+            None,
+            linear * warm,
+        ),
+        // Temperature needs linear intensity.
+        (
+            "gamma, temperature",
+            Some(graphics_settings(0, 1)),
+            None,
+            Vec3::new(2.4400615, 0.52252156, 0.11601613),
+        ),
+        // URP switches both on whatever the file says.
+        (
+            "URP",
+            Some(graphics_settings(0, 0)),
+            Some(urp),
+            linear * warm,
+        ),
+    ];
+    for (what, settings, manifest, want) in cases {
+        let mut files = vec![("Assets/s.unity", sc.text.as_str())];
+        if let Some(text) = &settings {
+            files.push((GRAPHICS_SETTINGS, text));
+        }
+        if let Some(text) = manifest {
+            files.push(("Packages/manifest.json", text));
+        }
+        let (_d, root) = project(&files);
+        let soup = convert(&root.join("Assets/s.unity"));
+        let l = &soup.lights[0];
+        let got = l.color * l.intensity;
+        assert!(close(got, want, 2e-5), "{what}: {got} against {want}");
+        let assumed = soup
+            .warnings
+            .iter()
+            .any(|w| w.contains("GraphicsSettings.asset is missing"));
+        assert_eq!(assumed, what == "default", "{what}: {:?}", soup.warnings);
+    }
+    // Where every intensity is 1 the two conventions agree, and nothing is said.
+    let one = sc.text.replace("m_Intensity: 1.5", "m_Intensity: 1");
+    let (_d, root) = project(&[("Assets/s.unity", one.as_str())]);
+    let soup = convert(&root.join("Assets/s.unity"));
+    assert_eq!(soup.lights[0].intensity, 1.0);
+    assert!(
+        !soup.warnings.iter().any(|w| w.contains("GraphicsSettings")),
+        "{:?}",
+        soup.warnings
+    );
+}
+
+#[test]
+fn a_gamma_colour_space_project_is_warned_about() {
+    let mut sc = Scene::default();
+    sc.light(&Tf::at(0.0, 5.0, 0.0), 2, [1.0, 1.0, 1.0], 1);
+    let player = |space: i32| {
+        format!("{HEADER}--- !u!129 &1\nPlayerSettings:\n  m_ObjectHideFlags: 0\n  serializedVersion: 26\n  productName: p\n  m_ActiveColorSpace: {space}\n")
+    };
+    for (space, warned) in [(0, true), (1, false)] {
+        let text = player(space);
+        let (_d, root) = project(&[
+            ("Assets/s.unity", sc.text.as_str()),
+            ("ProjectSettings/ProjectSettings.asset", &text),
+        ]);
+        let soup = convert(&root.join("Assets/s.unity"));
+        let said = soup
+            .warnings
+            .iter()
+            .any(|w| w.contains("Gamma colour space"));
+        assert_eq!(
+            said, warned,
+            "m_ActiveColorSpace {space}: {:?}",
+            soup.warnings
+        );
     }
 }
 

@@ -86,7 +86,8 @@ fn a_camera_culling_mask_hides_a_layer_and_the_report_names_it() {
     quad(&mut sc, 20, "Hidden", 8, "");
     sc.light(&Tf::at(0.0, 3.0, 0.0), 2, [1.0, 1.0, 1.0], 1);
     sc.raw("  m_CullingMask:\n    serializedVersion: 2\n    m_Bits: 255\n");
-    let (_d, root) = project(&[("Assets/s.unity", &sc.text)]);
+    let linear = graphics_settings(1, 1);
+    let (_d, root) = project(&[("Assets/s.unity", &sc.text), (GRAPHICS_SETTINGS, &linear)]);
     let r =
         unity::convert_report(&root.join("Assets/s.unity"), &unity::Options::default()).unwrap();
     assert!(object(&r.soup, "Seen").is_some());

@@ -145,6 +145,15 @@ impl Scene {
     }
 }
 
+/// Where a project keeps its graphics settings.
+pub const GRAPHICS_SETTINGS: &str = "ProjectSettings/GraphicsSettings.asset";
+
+/// A `GraphicsSettings.asset` with Lights Use Linear Intensity and Lights Use Color
+/// Temperature on (1) or off (0).
+pub fn graphics_settings(linear: i32, temperature: i32) -> String {
+    format!("{HEADER}--- !u!30 &1\nGraphicsSettings:\n  m_ObjectHideFlags: 0\n  serializedVersion: 13\n  m_LightsUseLinearIntensity: {linear}\n  m_LightsUseColorTemperature: {temperature}\n")
+}
+
 /// A project folder with `Assets/` and the given files (paths relative to the root).
 pub fn project(files: &[(&str, &str)]) -> (tempfile::TempDir, PathBuf) {
     let dir = tempfile::tempdir().unwrap();
