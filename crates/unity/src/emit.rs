@@ -9,6 +9,7 @@ use crate::docs;
 use crate::graph::{is_transform, Graph, Obj};
 use crate::mesh::Mesh;
 use crate::project::Pipeline;
+use crate::quality::ShadowQuality;
 use formats::Soup;
 use glam::{Mat4, Vec3};
 use std::collections::HashMap;
@@ -172,6 +173,18 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
              0.21, 2 as 4.6); a project set to Lights Use Linear Intensity looks different"
                 .into(),
         );
+    }
+    let quality_says = match g.project.shadow_quality {
+        ShadowQuality::Disable => Some("disables shadows: no light casts one"),
+        ShadowQuality::HardOnly => {
+            Some("allows hard shadows only: soft-shadow lights cast hard ones")
+        }
+        ShadowQuality::All => None,
+    };
+    if let Some(says) = quality_says.filter(|_| !e.soup.lights.is_empty()) {
+        e.soup.warnings.push(format!(
+            "ProjectSettings/QualitySettings.asset: the current quality level {says}, as in Unity"
+        ));
     }
     if g.project.gamma_color_space {
         e.soup.warnings.push(

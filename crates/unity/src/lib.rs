@@ -30,6 +30,7 @@ pub mod objexport;
 pub mod prefab;
 pub mod primitives;
 pub mod project;
+pub mod quality;
 pub mod reference;
 pub mod renderer;
 pub mod skinned_renderer;

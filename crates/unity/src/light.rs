@@ -4,7 +4,8 @@
 use crate::docs;
 use crate::emit::{enabled, flip, EmitError, Emitter};
 use crate::material::{gamma_to_linear, srgb_to_linear};
-use crate::project::Pipeline;
+use crate::project::{Pipeline, Project};
+use crate::quality::ShadowQuality;
 use crate::yaml::Node;
 use formats::{Attenuation, Light, LightKind, Shadows};
 use glam::{Mat4, Vec3, Vec4Swizzles};
@@ -119,10 +120,10 @@ pub fn convert(
     b: &Node,
     kind: LightKind,
     world: Mat4,
-    pipeline: Pipeline,
-    units: LightUnits,
+    project: &Project,
     name: String,
 ) -> Option<(Light, Option<String>)> {
+    let pipeline = project.pipeline;
     let directional = b.i64_at("m_Type").unwrap_or(2) == DIRECTIONAL;
     let angle = b.f32_at("m_SpotAngle").unwrap_or(30.0);
     let gamma = b
@@ -141,6 +142,11 @@ pub fn convert(
         1 => Shadows::Hard,
         2 => Shadows::Soft,
         _ => Shadows::None,
+    };
+    let shadows = match (project.shadow_quality, shadows) {
+        (ShadowQuality::Disable, _) => Shadows::None,
+        (ShadowQuality::HardOnly, Shadows::Soft) => Shadows::Hard,
+        (_, asked) => asked,
     };
     // Unity's inspector keeps the strength within 0–1.
     let shadow_strength = b
@@ -167,7 +173,7 @@ pub fn convert(
         ));
         intensity = mapped;
     }
-    let (color, intensity) = units.light(gamma, intensity, temperature);
+    let (color, intensity) = project.light_units.light(gamma, intensity, temperature);
     let position = flip(world.w_axis.xyz());
     let direction = flip(world.transform_vector3(Vec3::Z)).normalize_or_zero();
     let all = [
@@ -222,16 +228,7 @@ impl Emitter<'_, '_> {
             }
         };
         let world = self.checked_world(go)?;
-        let project = &g.project;
-        let name = self.path(go);
-        let Some((light, note)) = convert(
-            &o.body,
-            kind,
-            world,
-            project.pipeline,
-            project.light_units,
-            name,
-        ) else {
+        let Some((light, note)) = convert(&o.body, kind, world, g.project, self.path(go)) else {
             let detail = "light has a NaN, infinite or degenerate value".into();
             return Err(self.non_finite(go, detail));
         };

@@ -24,21 +24,6 @@ use formats::Projection;
 use glam::Vec3;
 use std::collections::{HashMap, HashSet};
 
-/// lodBias of the current quality level of a `QualitySettings.asset`'s text: the
-/// `m_CurrentQuality`-th entry of `m_QualitySettings`. `None` when the text does not
-/// say, or says something other than a positive finite number.
-pub fn lod_bias(text: &str) -> Option<f32> {
-    let body = docs::split(text)
-        .into_iter()
-        .find(|d| d.class == docs::QUALITY_SETTINGS)?
-        .parse();
-    let current = usize::try_from(body.i64_at("m_CurrentQuality")?).ok()?;
-    let level = body.get("m_QualitySettings")?.as_seq().get(current)?;
-    level
-        .f32_at("lodBias")
-        .filter(|b| b.is_finite() && *b > 0.0)
-}
-
 /// Relative screen height of a group of world size `size` whose reference point is
 /// `distance` from a camera with `projection`, under `lod_bias`.
 pub fn relative_height(size: f32, distance: f32, projection: Projection, lod_bias: f32) -> f32 {
@@ -171,54 +156,6 @@ impl Emitter<'_, '_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    const QUALITY: &str = "%YAML 1.1\n%TAG !u! tag:unity3d.com,2011:\n--- !u!47 &1\nQualitySettings:\n  m_ObjectHideFlags: 0\n  serializedVersion: 5\n  m_CurrentQuality: 1\n  m_QualitySettings:\n  - serializedVersion: 2\n    name: Low\n    lodBias: 0.4\n    maximumLODLevel: 0\n  - serializedVersion: 2\n    name: High\n    shadowCascade4Split: {x: 0.06666667, y: 0.2, z: 0.46666667}\n    lodBias: 2\n    maximumLODLevel: 0\n  m_PerPlatformDefaultQuality:\n    Standalone: 0\n";
-
-    #[test]
-    fn lod_bias_is_the_current_quality_levels() {
-        assert_eq!(lod_bias(QUALITY), Some(2.0));
-        let first = QUALITY.replace("m_CurrentQuality: 1", "m_CurrentQuality: 0");
-        assert_eq!(lod_bias(&first), Some(0.4));
-    }
-
-    #[test]
-    fn odd_quality_settings_say_nothing() {
-        for (from, to) in [
-            ("m_CurrentQuality: 1", "m_CurrentQuality: 2"),
-            ("m_CurrentQuality: 1", "m_CurrentQuality: -1"),
-            ("m_CurrentQuality: 1", "m_CurrentQuality: x"),
-            (
-                "m_CurrentQuality: 1",
-                "m_CurrentQuality: 99999999999999999999",
-            ),
-            ("m_CurrentQuality: 1\n", ""),
-            ("lodBias: 2", "lodBias: 0"),
-            ("lodBias: 2", "lodBias: -1"),
-            ("lodBias: 2", "lodBias: NaN"),
-            ("lodBias: 2", "lodBias: Infinity"),
-            ("lodBias: 2", "lodBias: {x: 1}"),
-            ("lodBias: 2", "lodBias:"),
-            ("--- !u!47 &1", "--- !u!48 &1"),
-            ("  m_QualitySettings:\n", "  m_QualitySettings: 3\n"),
-        ] {
-            let text = QUALITY.replace(from, to);
-            assert_eq!(lod_bias(&text), None, "{to}");
-        }
-        for junk in [
-            "",
-            "\0\u{fffd}",
-            "QualitySettings:\n  m_CurrentQuality: 0\n",
-            "--- !u!47 &1\n",
-        ] {
-            assert_eq!(lod_bias(junk), None, "{junk:?}");
-        }
-        // Cut anywhere, the file still reads without a panic.
-        for end in 0..QUALITY.len() {
-            if QUALITY.is_char_boundary(end) {
-                let _ = lod_bias(&QUALITY[..end]);
-            }
-        }
-    }
 
     #[test]
     fn relative_height_matches_unitys_rule() {

@@ -9,6 +9,7 @@ use crate::light::LightUnits;
 use crate::meta::{GuidIndex, ModelMeta};
 use crate::model::Model;
 use crate::obj;
+use crate::quality::ShadowQuality;
 use crate::yaml::Node;
 use rayon::prelude::*;
 use std::collections::{HashMap, HashSet};
@@ -97,6 +98,9 @@ pub struct Project {
     pub light_units_assumed: bool,
     /// `ProjectSettings/ProjectSettings.asset` sets the Gamma colour space (absent: linear).
     pub gamma_color_space: bool,
+    /// The realtime shadows the current quality level allows a built-in project (`All` for
+    /// URP and HDRP, whose pipeline assets decide, and where the file does not say).
+    pub shadow_quality: ShadowQuality,
     /// `ProjectSettings/QualitySettings.asset`'s lodBias at its current quality level; 1
     /// when the file is absent or does not say (see [`crate::lod`]).
     pub lod_bias: f32,
@@ -150,9 +154,16 @@ impl Project {
                 .ok()
                 .map(|b| String::from_utf8_lossy(&b).into_owned())
         };
-        let lod_bias = settings("QualitySettings.asset")
-            .and_then(|text| crate::lod::lod_bias(&text))
+        let quality = settings("QualitySettings.asset");
+        let lod_bias = quality
+            .as_deref()
+            .and_then(crate::quality::lod_bias)
             .unwrap_or(1.0);
+        let shadow_quality = quality
+            .as_deref()
+            .filter(|_| pipeline == Pipeline::BuiltIn)
+            .and_then(crate::quality::shadows)
+            .unwrap_or(ShadowQuality::All);
         let graphics = settings("GraphicsSettings.asset");
         let light_units_assumed = pipeline == Pipeline::BuiltIn && graphics.is_none();
         let light_units = LightUnits::of(pipeline, graphics.as_deref());
@@ -168,6 +179,7 @@ impl Project {
             light_units,
             light_units_assumed,
             gamma_color_space,
+            shadow_quality,
             lod_bias,
             files: Mutex::default(),
             models: Mutex::default(),

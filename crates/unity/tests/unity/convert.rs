@@ -665,6 +665,41 @@ fn lights_combine_colour_and_intensity_as_the_projects_graphics_settings_say() {
 }
 
 #[test]
+fn the_current_quality_level_limits_a_built_in_projects_shadows() {
+    let mut sc = Scene::default();
+    sc.light(&Tf::at(0.0, 5.0, 0.0), 2, [1.0, 1.0, 1.0], 2);
+    sc.light(&Tf::at(1.0, 5.0, 0.0), 2, [1.0, 1.0, 1.0], 1);
+    let quality = |shadows: i32| {
+        format!("{HEADER}--- !u!47 &1\nQualitySettings:\n  m_ObjectHideFlags: 0\n  serializedVersion: 5\n  m_CurrentQuality: 1\n  m_QualitySettings:\n  - serializedVersion: 2\n    name: Low\n    shadows: 0\n  - serializedVersion: 2\n    name: High\n    shadows: {shadows}\n    lodBias: 1\n")
+    };
+    let urp = "{\"dependencies\": {\"com.unity.render-pipelines.universal\": \"14.0.9\"}}";
+    let cases = [
+        (2, None, [Shadows::Soft, Shadows::Hard], false),
+        (1, None, [Shadows::Hard, Shadows::Hard], true),
+        (0, None, [Shadows::None, Shadows::None], true),
+        // URP's shadows are its pipeline asset's: the quality level's are not read.
+        (0, Some(urp), [Shadows::Soft, Shadows::Hard], false),
+    ];
+    for (level, manifest, want, said) in cases {
+        let text = quality(level);
+        let mut files = vec![
+            ("Assets/s.unity", sc.text.as_str()),
+            ("ProjectSettings/QualitySettings.asset", text.as_str()),
+        ];
+        files.extend(manifest.map(|m| ("Packages/manifest.json", m)));
+        let (_d, root) = project(&files);
+        let soup = convert(&root.join("Assets/s.unity"));
+        let got: Vec<Shadows> = soup.lights.iter().map(|l| l.shadows).collect();
+        assert_eq!(got, want, "shadows {level}, {manifest:?}");
+        let told = soup
+            .warnings
+            .iter()
+            .any(|w| w.contains("QualitySettings.asset"));
+        assert_eq!(told, said, "shadows {level}: {:?}", soup.warnings);
+    }
+}
+
+#[test]
 fn a_gamma_colour_space_project_is_warned_about() {
     let mut sc = Scene::default();
     sc.light(&Tf::at(0.0, 5.0, 0.0), 2, [1.0, 1.0, 1.0], 1);
