@@ -174,6 +174,14 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
                 .into(),
         );
     }
+    if let Some(listed) = g.project.unassigned_pipeline {
+        e.soup.warnings.push(format!(
+            "Packages/manifest.json lists {}, but neither ProjectSettings/GraphicsSettings.asset \
+             nor the current quality level assigns a render pipeline asset: Unity draws the \
+             project with the built-in pipeline, and so does unitrace",
+            listed.name()
+        ));
+    }
     let quality_says = match g.project.shadow_quality {
         ShadowQuality::Disable => Some("disables shadows: no light casts one"),
         ShadowQuality::HardOnly => {

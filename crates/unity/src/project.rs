@@ -59,6 +59,15 @@ pub enum Pipeline {
 }
 
 impl Pipeline {
+    /// The pipeline's name in messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            Pipeline::BuiltIn => "the built-in render pipeline",
+            Pipeline::Universal => "URP",
+            Pipeline::HighDefinition => "HDRP",
+        }
+    }
+
     /// The pipeline whose package a `Packages/manifest.json` lists (an installed pipeline
     /// package is, in practice, the one the project's graphics settings use).
     pub fn of_manifest(text: &str) -> Pipeline {
@@ -75,6 +84,23 @@ impl Pipeline {
     }
 }
 
+/// Whether a project assigns a render pipeline asset: the current quality level's, else
+/// `GraphicsSettings.asset`'s default one (`m_CustomRenderPipeline`). `None` when the
+/// graphics settings do not say (absent or unreadable): then only the manifest tells. A
+/// pipeline package without an assigned asset leaves Unity drawing with the built-in
+/// pipeline.
+pub fn assigned_render_pipeline(graphics: Option<&str>, quality: Option<&str>) -> Option<bool> {
+    if quality.and_then(crate::quality::assigns_render_pipeline) == Some(true) {
+        return Some(true);
+    }
+    let body = docs::split(graphics?)
+        .into_iter()
+        .find(|d| d.class == docs::GRAPHICS_SETTINGS)?
+        .parse();
+    let default = body.get("m_CustomRenderPipeline")?;
+    Some(crate::reference::fref(Some(default)).0 != 0)
+}
+
 /// Whether a `ProjectSettings.asset` text sets the Gamma colour space (`m_ActiveColorSpace`
 /// 0; 1 is Linear).
 pub fn gamma_color_space(text: &str) -> bool {
@@ -88,8 +114,11 @@ pub struct Project {
     pub root: PathBuf,
     pub assets: PathBuf,
     pub guids: GuidIndex,
-    /// The render pipeline `Packages/manifest.json` names.
+    /// The render pipeline `Packages/manifest.json` names, unless the graphics settings
+    /// assign no pipeline asset (then the built-in one).
     pub pipeline: Pipeline,
+    /// The pipeline the manifest lists where no asset assigns it, for a warning.
+    pub unassigned_pipeline: Option<Pipeline>,
     /// How lights' colours and intensities combine, from the pipeline and
     /// `ProjectSettings/GraphicsSettings.asset`.
     pub light_units: LightUnits,
@@ -147,14 +176,20 @@ impl Project {
             )
         };
         let guids = GuidIndex::build(&assets);
-        let pipeline = std::fs::read_to_string(root.join("Packages").join("manifest.json"))
-            .map_or(Pipeline::BuiltIn, |m| Pipeline::of_manifest(&m));
         let settings = |name: &str| {
             std::fs::read(root.join("ProjectSettings").join(name))
                 .ok()
                 .map(|b| String::from_utf8_lossy(&b).into_owned())
         };
         let quality = settings("QualitySettings.asset");
+        let graphics = settings("GraphicsSettings.asset");
+        let listed = std::fs::read_to_string(root.join("Packages").join("manifest.json"))
+            .map_or(Pipeline::BuiltIn, |m| Pipeline::of_manifest(&m));
+        let pipeline = match assigned_render_pipeline(graphics.as_deref(), quality.as_deref()) {
+            Some(false) => Pipeline::BuiltIn,
+            _ => listed,
+        };
+        let unassigned_pipeline = (pipeline != listed).then_some(listed);
         let lod_bias = quality
             .as_deref()
             .and_then(crate::quality::lod_bias)
@@ -164,7 +199,6 @@ impl Project {
             .filter(|_| pipeline == Pipeline::BuiltIn)
             .and_then(crate::quality::shadows)
             .unwrap_or(ShadowQuality::All);
-        let graphics = settings("GraphicsSettings.asset");
         let light_units_assumed = pipeline == Pipeline::BuiltIn && graphics.is_none();
         let light_units = LightUnits::of(pipeline, graphics.as_deref());
         let gamma_color_space =
@@ -176,6 +210,7 @@ impl Project {
             assets,
             guids,
             pipeline,
+            unassigned_pipeline,
             light_units,
             light_units_assumed,
             gamma_color_space,

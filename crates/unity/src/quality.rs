@@ -4,6 +4,7 @@
 //! pipeline (URP and HDRP take theirs from their pipeline assets, which are not read).
 
 use crate::docs;
+use crate::reference::fref;
 use crate::yaml::Node;
 
 /// The realtime shadows a built-in quality level allows (its `shadows`, Unity's
@@ -47,6 +48,15 @@ pub fn shadows(text: &str) -> Option<ShadowQuality> {
         1 => Some(ShadowQuality::HardOnly),
         2 => Some(ShadowQuality::All),
         _ => None,
+    })
+}
+
+/// Whether the current quality level overrides the render pipeline with an asset of its
+/// own (`customRenderPipeline`); `None` when the text does not say.
+pub fn assigns_render_pipeline(text: &str) -> Option<bool> {
+    current_level(text, |level| {
+        let field = level.get("customRenderPipeline")?;
+        Some(fref(Some(field)).0 != 0)
     })
 }
 
@@ -100,6 +110,24 @@ mod tests {
                 let _ = lod_bias(&QUALITY[..end]);
             }
         }
+    }
+
+    #[test]
+    fn a_level_may_assign_its_own_render_pipeline() {
+        assert_eq!(assigns_render_pipeline(QUALITY), None);
+        let none = QUALITY.replace(
+            "    lodBias: 2\n",
+            "    lodBias: 2\n    customRenderPipeline: {fileID: 0}\n",
+        );
+        assert_eq!(assigns_render_pipeline(&none), Some(false));
+        let urp = none.replace(
+            "{fileID: 0}",
+            "{fileID: 11400000, guid: 19ba41d7c0026c3459d37c2fe90c55a0, type: 2}",
+        );
+        assert_eq!(assigns_render_pipeline(&urp), Some(true));
+        // The other level's asset is not the current one's.
+        let low = urp.replace("m_CurrentQuality: 1", "m_CurrentQuality: 0");
+        assert_eq!(assigns_render_pipeline(&low), None);
     }
 
     #[test]

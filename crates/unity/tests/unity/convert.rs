@@ -665,6 +665,61 @@ fn lights_combine_colour_and_intensity_as_the_projects_graphics_settings_say() {
 }
 
 #[test]
+fn a_pipeline_package_without_an_assigned_asset_draws_built_in() {
+    let mut sc = Scene::default();
+    sc.light(&Tf::at(0.0, 5.0, 0.0), 2, [1.0, 1.0, 1.0], 1);
+    let urp = "{\"dependencies\": {\"com.unity.render-pipelines.universal\": \"14.0.9\"}}";
+    let asset = "{fileID: 11400000, guid: 19ba41d7c0026c3459d37c2fe90c55a0, type: 2}";
+    let graphics = |default: &str| {
+        format!("{HEADER}--- !u!30 &1\nGraphicsSettings:\n  m_ObjectHideFlags: 0\n  m_CustomRenderPipeline: {default}\n  m_LightsUseLinearIntensity: 0\n")
+    };
+    let quality = |level: &str| {
+        format!("{HEADER}--- !u!47 &1\nQualitySettings:\n  m_CurrentQuality: 0\n  m_QualitySettings:\n  - serializedVersion: 2\n    name: High\n    customRenderPipeline: {level}\n")
+    };
+    let none = "{fileID: 0}";
+    let cases = [
+        // Without graphics settings only the manifest tells.
+        (None, None, Attenuation::Universal),
+        (Some(graphics(asset)), None, Attenuation::Universal),
+        (Some(graphics(none)), None, Attenuation::BuiltIn),
+        (
+            Some(graphics(none)),
+            Some(quality(none)),
+            Attenuation::BuiltIn,
+        ),
+        // The current quality level's own asset is enough.
+        (
+            Some(graphics(none)),
+            Some(quality(asset)),
+            Attenuation::Universal,
+        ),
+    ];
+    for (graphics, quality, attenuation) in cases {
+        let mut files = vec![
+            ("Assets/s.unity", sc.text.as_str()),
+            ("Packages/manifest.json", urp),
+        ];
+        files.extend(graphics.as_deref().map(|t| (GRAPHICS_SETTINGS, t)));
+        files.extend(
+            quality
+                .as_deref()
+                .map(|t| ("ProjectSettings/QualitySettings.asset", t)),
+        );
+        let (_d, root) = project(&files);
+        let soup = convert(&root.join("Assets/s.unity"));
+        let what = format!("{graphics:?} {quality:?}");
+        let l = &soup.lights[0];
+        assert_eq!(l.attenuation, attenuation, "{what}");
+        let built_in = attenuation == Attenuation::BuiltIn;
+        // Built-in: the gamma intensity 1.5^2.2 of the graphics settings' default.
+        let want = if built_in { 1.5f32.powf(2.2) } else { 1.5 };
+        assert!((l.intensity - want).abs() < 1e-5, "{what}: {}", l.intensity);
+        let warned = soup.warnings.iter().any(|w| w.contains("lists URP, but"));
+        assert_eq!(warned, built_in, "{what}: {:?}", soup.warnings);
+    }
+}
+
+#[test]
 fn the_current_quality_level_limits_a_built_in_projects_shadows() {
     let mut sc = Scene::default();
     sc.light(&Tf::at(0.0, 5.0, 0.0), 2, [1.0, 1.0, 1.0], 2);
