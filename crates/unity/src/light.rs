@@ -6,6 +6,7 @@ use crate::emit::{enabled, flip, EmitError, Emitter};
 use crate::material::{gamma_to_linear, srgb_to_linear};
 use crate::project::{Pipeline, Project};
 use crate::quality::ShadowQuality;
+use crate::reference::fref;
 use crate::yaml::Node;
 use formats::{Attenuation, Light, LightKind, Shadows};
 use glam::{Mat4, Vec3, Vec4Swizzles};
@@ -70,6 +71,78 @@ impl LightUnits {
         };
         (gamma.map(srgb_to_linear) * tint, intensity)
     }
+}
+
+/// The shadows a URP pipeline asset supports (`UniversalRenderPipelineAsset`'s fields;
+/// where a field is missing, the default the asset's class gives it).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct UniversalShadows {
+    /// `m_MainLightShadowsSupported` (default on).
+    pub main: bool,
+    /// `m_AdditionalLightShadowsSupported`: point and spot lights (default off).
+    pub additional: bool,
+    /// `m_SoftShadowsSupported` (default off: soft shadows are drawn hard).
+    pub soft: bool,
+}
+
+impl UniversalShadows {
+    /// The settings of a pipeline asset's text; `None` when it holds no URP asset.
+    pub fn of_asset(text: &str) -> Option<UniversalShadows> {
+        let body = docs::split(text)
+            .into_iter()
+            .filter(|d| d.class == docs::MONO_BEHAVIOUR)
+            .map(|d| d.parse())
+            .find(|b| b.get("m_MainLightShadowsSupported").is_some())?;
+        let flag = |key: &str, default: bool| body.i64_at(key).map_or(default, |v| v != 0);
+        Some(UniversalShadows {
+            main: flag("m_MainLightShadowsSupported", true),
+            additional: flag("m_AdditionalLightShadowsSupported", false),
+            soft: flag("m_SoftShadowsSupported", false),
+        })
+    }
+}
+
+/// Applies URP's shadow rules to a URP scene's `lights`: of the directional lights only
+/// the main light casts shadows (the light RenderSettings names, `sun`, when it is
+/// directional, else the first of the brightest by intensity), and where the pipeline
+/// asset is known (`asset`), its switches for the main light, point and spot lights and
+/// soft shadows. Returns how many lights' shadows changed.
+pub fn universal_shadows(
+    lights: &mut [Light],
+    sun: Option<usize>,
+    asset: Option<UniversalShadows>,
+) -> usize {
+    let directional = |l: &Light| matches!(l.kind, LightKind::Directional);
+    let main = sun
+        .filter(|&i| lights.get(i).is_some_and(directional))
+        .or_else(|| {
+            let mut best: Option<(usize, f32)> = None;
+            for (i, l) in lights.iter().enumerate().filter(|(_, l)| directional(l)) {
+                if l.intensity > best.map_or(0.0, |b| b.1) {
+                    best = Some((i, l.intensity));
+                }
+            }
+            best.map(|b| b.0)
+        });
+    let mut changed = 0;
+    for (i, l) in lights.iter_mut().enumerate() {
+        let casts = match (directional(l), asset) {
+            (true, _) if Some(i) != main => false,
+            (true, Some(a)) => a.main,
+            (false, Some(a)) => a.additional,
+            (_, None) => true,
+        };
+        let shadows = match l.shadows {
+            _ if !casts => Shadows::None,
+            Shadows::Soft if asset.is_some_and(|a| !a.soft) => Shadows::Hard,
+            asked => asked,
+        };
+        if shadows != l.shadows {
+            l.shadows = shadows;
+            changed += 1;
+        }
+    }
+    changed
 }
 
 /// Unity's linear RGB of a black body at `kelvin` (clamped to 1,000–40,000 K), white near
@@ -210,6 +283,38 @@ pub fn convert(
 }
 
 impl Emitter<'_, '_> {
+    /// The index among the soup's lights of the light RenderSettings `rs` names as the
+    /// sun (`m_Sun`, a light of the top scene's file).
+    pub(crate) fn sun(&self, rs: &Node) -> Option<usize> {
+        let sun = fref(rs.get("m_Sun")).0;
+        self.light_ids
+            .iter()
+            .position(|&(file, id)| sun != 0 && file == 0 && id == sun)
+    }
+
+    /// URP's shadow rules on the converted lights, said once where they change any.
+    pub(crate) fn universal_shadow_rules(&mut self) {
+        let g = self.g;
+        if g.project.pipeline != Pipeline::Universal {
+            return;
+        }
+        let sun = g.render_settings.as_ref().and_then(|rs| self.sun(rs));
+        let asset = g.project.universal_shadows;
+        let changed = universal_shadows(&mut self.soup.lights, sun, asset);
+        if changed > 0 {
+            let rules = if asset.is_some() {
+                "its main light alone among directional lights, and as its pipeline asset \
+                 supports main-light, additional-light and soft shadows"
+            } else {
+                "its main light alone among directional lights"
+            };
+            self.soup.warnings.push(format!(
+                "{}: URP draws shadows for {rules}: {changed} light(s) traced so",
+                self.scene_rel
+            ));
+        }
+    }
+
     /// Light component `c` of GameObject `go`.
     pub(crate) fn light(&mut self, go: usize, c: usize) -> Result<(), EmitError> {
         let g = self.g;
@@ -300,6 +405,92 @@ mod tests {
         assert_eq!(GAMMA.light(Vec3::ONE, 1.0, Some(2000.0)).0, Vec3::ONE);
         let (c, _) = LINEAR.light(Vec3::ONE, 1.0, Some(2000.0));
         assert_eq!(c, temperature_rgb(2000.0));
+    }
+
+    fn light(kind: LightKind, intensity: f32, shadows: Shadows) -> Light {
+        Light {
+            name: String::new(),
+            kind,
+            position: Vec3::ZERO,
+            direction: Vec3::NEG_Y,
+            color: Vec3::ONE,
+            intensity,
+            range: 10.0,
+            attenuation: Attenuation::Universal,
+            shadows,
+            shadow_radius: 0.1,
+            shadow_strength: 1.0,
+            culling_mask: u32::MAX,
+        }
+    }
+
+    #[test]
+    fn urp_casts_directional_shadows_from_its_main_light_alone() {
+        let sun = |i| light(LightKind::Directional, i, Shadows::Soft);
+        let lamp = light(LightKind::Point, 1.0, Shadows::Soft);
+        let shadows = |ls: &[Light]| ls.iter().map(|l| l.shadows).collect::<Vec<_>>();
+        // The brightest directional light is the main one; the first of equals wins.
+        let mut ls = vec![sun(1.0), sun(2.0), sun(2.0), lamp.clone()];
+        assert_eq!(universal_shadows(&mut ls, None, None), 2);
+        let (s, n) = (Shadows::Soft, Shadows::None);
+        assert_eq!(shadows(&ls), [n, s, n, s]);
+        // RenderSettings' sun wins over brightness, unless it is not directional.
+        let mut ls = vec![sun(1.0), sun(2.0), lamp.clone()];
+        universal_shadows(&mut ls, Some(0), None);
+        assert_eq!(shadows(&ls), [s, n, s]);
+        let mut ls = vec![sun(1.0), sun(2.0), lamp.clone()];
+        universal_shadows(&mut ls, Some(2), None);
+        assert_eq!(shadows(&ls), [n, s, s]);
+        // A directional light of intensity 0 is never the main light.
+        let mut ls = vec![sun(0.0)];
+        universal_shadows(&mut ls, None, None);
+        assert_eq!(shadows(&ls), [n]);
+        // The asset's switches.
+        let asset = |main, additional, soft| {
+            Some(UniversalShadows {
+                main,
+                additional,
+                soft,
+            })
+        };
+        let h = Shadows::Hard;
+        for (a, want) in [
+            (asset(true, true, true), [s, n, s]),
+            (asset(true, true, false), [h, n, h]),
+            (asset(true, false, false), [h, n, n]),
+            (asset(false, true, true), [n, n, s]),
+        ] {
+            let mut ls = vec![sun(2.0), sun(1.0), lamp.clone()];
+            universal_shadows(&mut ls, None, a);
+            assert_eq!(shadows(&ls), want, "{a:?}");
+        }
+    }
+
+    #[test]
+    fn a_urp_asset_says_which_shadows_it_supports() {
+        let text = "%YAML 1.1\n--- !u!114 &11400000\nMonoBehaviour:\n  m_Name: UniversalRP-HighQuality\n  m_MainLightShadowsSupported: 1\n  m_AdditionalLightShadowsSupported: 1\n  m_SoftShadowsSupported: 0\n";
+        let got = UniversalShadows::of_asset(text);
+        let want = UniversalShadows {
+            main: true,
+            additional: true,
+            soft: false,
+        };
+        assert_eq!(got, Some(want));
+        // Fields an older asset lacks take the class's defaults.
+        let old = "--- !u!114 &1\nMonoBehaviour:\n  m_MainLightShadowsSupported: 0\n";
+        let want = UniversalShadows {
+            main: false,
+            additional: false,
+            soft: false,
+        };
+        assert_eq!(UniversalShadows::of_asset(old), Some(want));
+        for other in [
+            "",
+            "--- !u!114 &1\nMonoBehaviour:\n  m_Name: x\n",
+            "\0\u{fffd}",
+        ] {
+            assert_eq!(UniversalShadows::of_asset(other), None, "{other:?}");
+        }
     }
 
     #[test]

@@ -5,7 +5,7 @@
 
 use crate::docs;
 use crate::fbx;
-use crate::light::LightUnits;
+use crate::light::{LightUnits, UniversalShadows};
 use crate::meta::{GuidIndex, ModelMeta};
 use crate::model::Model;
 use crate::obj;
@@ -84,21 +84,41 @@ impl Pipeline {
     }
 }
 
-/// Whether a project assigns a render pipeline asset: the current quality level's, else
-/// `GraphicsSettings.asset`'s default one (`m_CustomRenderPipeline`). `None` when the
-/// graphics settings do not say (absent or unreadable): then only the manifest tells. A
-/// pipeline package without an assigned asset leaves Unity drawing with the built-in
-/// pipeline.
-pub fn assigned_render_pipeline(graphics: Option<&str>, quality: Option<&str>) -> Option<bool> {
-    if quality.and_then(crate::quality::assigns_render_pipeline) == Some(true) {
-        return Some(true);
+/// The render pipeline asset a project's settings assign.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum PipelineAsset {
+    /// The graphics settings are absent or do not say: only the manifest tells.
+    Unknown,
+    /// Neither the current quality level nor `GraphicsSettings.asset` assigns one: a
+    /// pipeline package alone leaves Unity drawing with the built-in pipeline.
+    Unassigned,
+    /// The current quality level's asset, else `GraphicsSettings.asset`'s default
+    /// (`m_CustomRenderPipeline`), by GUID.
+    Assigned(Option<String>),
+}
+
+impl PipelineAsset {
+    pub fn of(graphics: Option<&str>, quality: Option<&str>) -> PipelineAsset {
+        if let Some((id, guid)) = quality.and_then(crate::quality::render_pipeline_asset) {
+            if id != 0 {
+                return PipelineAsset::Assigned(guid);
+            }
+        }
+        let default = graphics.and_then(|text| {
+            let body = docs::split(text)
+                .into_iter()
+                .find(|d| d.class == docs::GRAPHICS_SETTINGS)?
+                .parse();
+            Some(crate::reference::fref(Some(
+                body.get("m_CustomRenderPipeline")?,
+            )))
+        });
+        match default {
+            None => PipelineAsset::Unknown,
+            Some((0, _)) => PipelineAsset::Unassigned,
+            Some((_, guid)) => PipelineAsset::Assigned(guid),
+        }
     }
-    let body = docs::split(graphics?)
-        .into_iter()
-        .find(|d| d.class == docs::GRAPHICS_SETTINGS)?
-        .parse();
-    let default = body.get("m_CustomRenderPipeline")?;
-    Some(crate::reference::fref(Some(default)).0 != 0)
 }
 
 /// Whether a `ProjectSettings.asset` text sets the Gamma colour space (`m_ActiveColorSpace`
@@ -119,6 +139,8 @@ pub struct Project {
     pub pipeline: Pipeline,
     /// The pipeline the manifest lists where no asset assigns it, for a warning.
     pub unassigned_pipeline: Option<Pipeline>,
+    /// The shadows a URP project's assigned pipeline asset supports, where it is found.
+    pub universal_shadows: Option<UniversalShadows>,
     /// How lights' colours and intensities combine, from the pipeline and
     /// `ProjectSettings/GraphicsSettings.asset`.
     pub light_units: LightUnits,
@@ -185,9 +207,17 @@ impl Project {
         let graphics = settings("GraphicsSettings.asset");
         let listed = std::fs::read_to_string(root.join("Packages").join("manifest.json"))
             .map_or(Pipeline::BuiltIn, |m| Pipeline::of_manifest(&m));
-        let pipeline = match assigned_render_pipeline(graphics.as_deref(), quality.as_deref()) {
-            Some(false) => Pipeline::BuiltIn,
+        let asset = PipelineAsset::of(graphics.as_deref(), quality.as_deref());
+        let pipeline = match asset {
+            PipelineAsset::Unassigned => Pipeline::BuiltIn,
             _ => listed,
+        };
+        let universal_shadows = match &asset {
+            PipelineAsset::Assigned(Some(guid)) if pipeline == Pipeline::Universal => guids
+                .get(guid)
+                .and_then(|path| std::fs::read(path).ok())
+                .and_then(|b| UniversalShadows::of_asset(&String::from_utf8_lossy(&b))),
+            _ => None,
         };
         let unassigned_pipeline = (pipeline != listed).then_some(listed);
         let lod_bias = quality
@@ -211,6 +241,7 @@ impl Project {
             guids,
             pipeline,
             unassigned_pipeline,
+            universal_shadows,
             light_units,
             light_units_assumed,
             gamma_color_space,

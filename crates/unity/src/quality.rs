@@ -51,12 +51,12 @@ pub fn shadows(text: &str) -> Option<ShadowQuality> {
     })
 }
 
-/// Whether the current quality level overrides the render pipeline with an asset of its
-/// own (`customRenderPipeline`); `None` when the text does not say.
-pub fn assigns_render_pipeline(text: &str) -> Option<bool> {
+/// The render pipeline asset the current quality level overrides the default with
+/// (`customRenderPipeline`: its fileID, 0 for none, and GUID); `None` when the text does
+/// not say.
+pub fn render_pipeline_asset(text: &str) -> Option<(i64, Option<String>)> {
     current_level(text, |level| {
-        let field = level.get("customRenderPipeline")?;
-        Some(fref(Some(field)).0 != 0)
+        Some(fref(Some(level.get("customRenderPipeline")?)))
     })
 }
 
@@ -114,20 +114,21 @@ mod tests {
 
     #[test]
     fn a_level_may_assign_its_own_render_pipeline() {
-        assert_eq!(assigns_render_pipeline(QUALITY), None);
+        let assigns = |text: &str| render_pipeline_asset(text).map(|(id, _)| id != 0);
+        assert_eq!(assigns(QUALITY), None);
         let none = QUALITY.replace(
             "    lodBias: 2\n",
             "    lodBias: 2\n    customRenderPipeline: {fileID: 0}\n",
         );
-        assert_eq!(assigns_render_pipeline(&none), Some(false));
+        assert_eq!(assigns(&none), Some(false));
         let urp = none.replace(
             "{fileID: 0}",
             "{fileID: 11400000, guid: 19ba41d7c0026c3459d37c2fe90c55a0, type: 2}",
         );
-        assert_eq!(assigns_render_pipeline(&urp), Some(true));
+        assert_eq!(assigns(&urp), Some(true));
         // The other level's asset is not the current one's.
         let low = urp.replace("m_CurrentQuality: 1", "m_CurrentQuality: 0");
-        assert_eq!(assigns_render_pipeline(&low), None);
+        assert_eq!(assigns(&low), None);
     }
 
     #[test]

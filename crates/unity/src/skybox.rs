@@ -450,11 +450,7 @@ impl Emitter<'_, '_> {
         }
         match sky {
             Ok(Some(Sky::Procedural(mut sky))) => {
-                let sun = fref(rs.get("m_Sun")).0;
-                let named = self
-                    .light_ids
-                    .iter()
-                    .position(|&(file, id)| sun != 0 && file == 0 && id == sun);
+                let named = self.sun(rs);
                 aim(&mut sky, &self.soup.lights, named);
                 self.soup.environment.sky = Some(Sky::Procedural(sky));
             }

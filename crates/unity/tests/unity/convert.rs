@@ -720,6 +720,45 @@ fn a_pipeline_package_without_an_assigned_asset_draws_built_in() {
 }
 
 #[test]
+fn a_urp_projects_pipeline_asset_decides_which_lights_cast_shadows() {
+    let mut sc = Scene::default();
+    sc.light(&Tf::at(0.0, 5.0, 0.0), 1, [1.0, 1.0, 1.0], 2);
+    sc.light(&Tf::at(0.0, 6.0, 0.0), 1, [0.5, 0.5, 0.5], 2);
+    sc.light(&Tf::at(1.0, 5.0, 0.0), 2, [1.0, 1.0, 1.0], 2);
+    let urp = "{\"dependencies\": {\"com.unity.render-pipelines.universal\": \"14.0.9\"}}";
+    let guid = "19ba41d7c0026c3459d37c2fe90c55a0";
+    let graphics = format!("{HEADER}--- !u!30 &1\nGraphicsSettings:\n  m_CustomRenderPipeline: {{fileID: 11400000, guid: {guid}, type: 2}}\n");
+    let meta = format!("fileFormatVersion: 2\nguid: {guid}\n");
+    let asset = |additional: i32, soft: i32| {
+        format!("{HEADER}--- !u!114 &11400000\nMonoBehaviour:\n  m_Name: URP\n  m_MainLightShadowsSupported: 1\n  m_AdditionalLightShadowsSupported: {additional}\n  m_SoftShadowsSupported: {soft}\n")
+    };
+    let (s, h, n) = (Shadows::Soft, Shadows::Hard, Shadows::None);
+    let cases = [
+        // Without the asset only the main light rule holds: the second sun (equal
+        // intensity, later) casts none.
+        (None, [s, n, s]),
+        (Some(asset(1, 1)), [s, n, s]),
+        (Some(asset(0, 0)), [h, n, n]),
+    ];
+    for (asset, want) in cases {
+        let mut files = vec![
+            ("Assets/s.unity", sc.text.as_str()),
+            ("Packages/manifest.json", urp),
+            (GRAPHICS_SETTINGS, graphics.as_str()),
+        ];
+        if let Some(text) = &asset {
+            files.push(("Assets/Settings/URP.asset", text));
+            files.push(("Assets/Settings/URP.asset.meta", &meta));
+        }
+        let (_d, root) = project(&files);
+        let soup = convert(&root.join("Assets/s.unity"));
+        let got: Vec<Shadows> = soup.lights.iter().map(|l| l.shadows).collect();
+        assert_eq!(got, want, "{asset:?}");
+        assert_warned(&soup, "URP draws shadows for its main light alone");
+    }
+}
+
+#[test]
 fn the_current_quality_level_limits_a_built_in_projects_shadows() {
     let mut sc = Scene::default();
     sc.light(&Tf::at(0.0, 5.0, 0.0), 2, [1.0, 1.0, 1.0], 2);
