@@ -84,6 +84,23 @@ impl Pipeline {
     }
 }
 
+/// Settings files are a few kilobytes; a larger one (a GUID that names some other
+/// asset, a damaged file) is not read whole, and its settings count as unknown.
+const SETTINGS_BYTES: u64 = 16 << 20;
+
+/// A settings file's text (invalid UTF-8 replaced), or `None` when it is missing,
+/// unreadable or larger than [`SETTINGS_BYTES`].
+fn settings_text(path: &Path) -> Option<String> {
+    use std::io::Read;
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)
+        .ok()?
+        .take(SETTINGS_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .ok()?;
+    (bytes.len() as u64 <= SETTINGS_BYTES).then(|| String::from_utf8_lossy(&bytes).into_owned())
+}
+
 /// The render pipeline asset a project's settings assign.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum PipelineAsset {
@@ -198,11 +215,7 @@ impl Project {
             )
         };
         let guids = GuidIndex::build(&assets);
-        let settings = |name: &str| {
-            std::fs::read(root.join("ProjectSettings").join(name))
-                .ok()
-                .map(|b| String::from_utf8_lossy(&b).into_owned())
-        };
+        let settings = |name: &str| settings_text(&root.join("ProjectSettings").join(name));
         let quality = settings("QualitySettings.asset");
         let graphics = settings("GraphicsSettings.asset");
         let listed = std::fs::read_to_string(root.join("Packages").join("manifest.json"))
@@ -215,8 +228,8 @@ impl Project {
         let universal_shadows = match &asset {
             PipelineAsset::Assigned(Some(guid)) if pipeline == Pipeline::Universal => guids
                 .get(guid)
-                .and_then(|path| std::fs::read(path).ok())
-                .and_then(|b| UniversalShadows::of_asset(&String::from_utf8_lossy(&b))),
+                .and_then(|path| settings_text(path))
+                .and_then(|text| UniversalShadows::of_asset(&text)),
             _ => None,
         };
         let unassigned_pipeline = (pipeline != listed).then_some(listed);
@@ -454,4 +467,29 @@ fn guids_in(text: &str) -> impl Iterator<Item = &str> {
             .unwrap_or(rest.len());
         (end == 32).then(|| &rest[..end])
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn settings_files_are_read_up_to_a_bound() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("QualitySettings.asset");
+        std::fs::write(&path, "m_CurrentQuality: 0\n").unwrap();
+        assert_eq!(
+            settings_text(&path).as_deref(),
+            Some("m_CurrentQuality: 0\n")
+        );
+        let f = std::fs::File::create(&path).unwrap();
+        f.set_len(SETTINGS_BYTES).unwrap();
+        assert_eq!(
+            settings_text(&path).map(|t| t.len()),
+            Some(SETTINGS_BYTES as usize)
+        );
+        f.set_len(SETTINGS_BYTES + 1).unwrap();
+        assert_eq!(settings_text(&path), None);
+        assert_eq!(settings_text(&dir.path().join("absent")), None);
+    }
 }
