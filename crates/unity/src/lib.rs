@@ -73,6 +73,8 @@ pub struct Report {
     /// Renderers Unity does not draw by design (outside the camera's culling mask, in a
     /// LOD level the camera does not show), one line each.
     pub skipped: Vec<String>,
+    /// What was read of the project's settings ([`project::Project::settings`]).
+    pub settings: String,
 }
 
 /// Convert a scene into a sealed soup.
@@ -140,5 +142,6 @@ pub fn convert_report(scene: &Path, opts: &Options) -> Result<Report, ConvertErr
         cameras,
         material_origins,
         skipped,
+        settings: project.settings(),
     })
 }

@@ -156,6 +156,8 @@ pub struct Project {
     pub pipeline: Pipeline,
     /// The pipeline the manifest lists where no asset assigns it, for a warning.
     pub unassigned_pipeline: Option<Pipeline>,
+    /// The assigned render pipeline asset's file, where the project holds it.
+    pub pipeline_asset: Option<PathBuf>,
     /// The shadows a URP project's assigned pipeline asset supports, where it is found.
     pub universal_shadows: Option<UniversalShadows>,
     /// How lights' colours and intensities combine, from the pipeline and
@@ -225,13 +227,15 @@ impl Project {
             PipelineAsset::Unassigned => Pipeline::BuiltIn,
             _ => listed,
         };
-        let universal_shadows = match &asset {
-            PipelineAsset::Assigned(Some(guid)) if pipeline == Pipeline::Universal => guids
-                .get(guid)
-                .and_then(|path| settings_text(path))
-                .and_then(|text| UniversalShadows::of_asset(&text)),
+        let pipeline_asset = match &asset {
+            PipelineAsset::Assigned(Some(guid)) => guids.get(guid).cloned(),
             _ => None,
         };
+        let universal_shadows = pipeline_asset
+            .as_deref()
+            .filter(|_| pipeline == Pipeline::Universal)
+            .and_then(settings_text)
+            .and_then(|text| UniversalShadows::of_asset(&text));
         let unassigned_pipeline = (pipeline != listed).then_some(listed);
         let lod_bias = quality
             .as_deref()
@@ -254,6 +258,7 @@ impl Project {
             guids,
             pipeline,
             unassigned_pipeline,
+            pipeline_asset,
             universal_shadows,
             light_units,
             light_units_assumed,
@@ -265,6 +270,49 @@ impl Project {
             mats: Mutex::default(),
             by_name: OnceLock::new(),
         }
+    }
+
+    /// What the converter read of the project's settings, in one line (for `--list`).
+    pub fn settings(&self) -> String {
+        let on = |b: bool| if b { "on" } else { "off" };
+        let mut pipeline = self.pipeline.name().to_string();
+        if let Some(path) = &self.pipeline_asset {
+            pipeline += &format!(" (asset {}", self.rel(path));
+            if let Some(u) = self.universal_shadows {
+                pipeline += &format!(
+                    ": main-light shadows {}, additional-light shadows {}, soft shadows {}",
+                    on(u.main),
+                    on(u.additional),
+                    on(u.soft)
+                );
+            }
+            pipeline += ")";
+        }
+        let units = self.light_units;
+        let intensity = if units.linear_intensity {
+            "linear"
+        } else {
+            "gamma"
+        };
+        let assumed = if self.light_units_assumed {
+            ", no GraphicsSettings.asset: Unity's default"
+        } else {
+            ""
+        };
+        let space = if self.gamma_color_space {
+            "Gamma (rendered linear)"
+        } else {
+            "linear"
+        };
+        let shadows = match self.pipeline {
+            Pipeline::BuiltIn => format!("; quality-level shadows {:?}", self.shadow_quality),
+            _ => String::new(),
+        };
+        format!(
+            "{pipeline}; light intensity {intensity}, colour temperature {}{assumed}; colour space {space}{shadows}; LOD bias {}",
+            on(units.linear_intensity && units.color_temperature),
+            self.lod_bias
+        )
     }
 
     /// A path relative to the project root, with forward slashes (for names and

@@ -26,7 +26,8 @@ struct Args {
     /// Treat every warning as an error.
     #[arg(long)]
     strict: bool,
-    /// List every converted object (triangles, source, materials, layer, shadows), every
+    /// List the project settings read (render pipeline, light units, colour space,
+    /// quality level), every converted object (triangles, source, materials, layer, shadows), every
     /// material (texture, tiling, opacity, alpha mode), every renderer Unity's draw rules
     /// skip (camera culling mask, LOD levels the camera does not show), light and warning
     /// on stderr.
@@ -102,8 +103,10 @@ fn run(args: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// One line per object, skipped renderer and light, for checking a conversion by eye.
+/// The project's settings, then one line per object, material, skipped renderer and
+/// light, for checking a conversion by eye.
 fn list(report: &unity::Report) {
+    eprintln!("project: {}", report.settings);
     let soup = &report.soup;
     let mut tris = vec![0usize; soup.objects.len()];
     let mut mats: Vec<Vec<u32>> = vec![Vec::new(); soup.objects.len()];

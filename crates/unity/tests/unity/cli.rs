@@ -122,6 +122,10 @@ fn unity2soup_list_says_where_each_material_came_from() {
     let (_d, scene) = scene();
     let stderr = list(&scene);
     assert!(
+        stderr.starts_with("project: the built-in render pipeline; light intensity linear, colour temperature on; colour space linear; quality-level shadows All; LOD bias 1\n"),
+        "{stderr}"
+    );
+    assert!(
         stderr.contains("object \"Box A\": 12 triangles from builtin:Cube [Default-Material rgb(1.000,1.000,1.000) cull Back from default], layer 0, shadows On"),
         "{stderr}"
     );

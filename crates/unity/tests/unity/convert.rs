@@ -751,10 +751,17 @@ fn a_urp_projects_pipeline_asset_decides_which_lights_cast_shadows() {
             files.push(("Assets/Settings/URP.asset.meta", &meta));
         }
         let (_d, root) = project(&files);
-        let soup = convert(&root.join("Assets/s.unity"));
-        let got: Vec<Shadows> = soup.lights.iter().map(|l| l.shadows).collect();
+        let opts = unity::Options::default();
+        let r = unity::convert_report(&root.join("Assets/s.unity"), &opts).unwrap();
+        let got: Vec<Shadows> = r.soup.lights.iter().map(|l| l.shadows).collect();
         assert_eq!(got, want, "{asset:?}");
-        assert_warned(&soup, "URP draws shadows for its main light alone");
+        assert_warned(&r.soup, "URP draws shadows for its main light alone");
+        // `--list`'s summary names the asset and what it supports.
+        let read = match &asset {
+            None => "URP; ".to_string(),
+            Some(_) => format!("URP (asset Assets/Settings/URP.asset: main-light shadows on, additional-light shadows {0}, soft shadows {0}); ", if want[2] == s { "on" } else { "off" }),
+        };
+        assert!(r.settings.starts_with(&read), "{}", r.settings);
     }
 }
 
