@@ -20,9 +20,9 @@ pub use kd::{BuildParams, KdFile, KdHeader, KdNode, TreeStats};
 pub use rays::{Hit, RayRecord};
 pub use sky::{Panorama, ProceduralSky, Sky, SkyImage, SkyLayout, SunDisk, TexturedSky};
 pub use soup::{
-    Alpha, Ambient, AmbientMode, Attenuation, Camera, CastShadows, ClearFlags, Cull, Environment,
-    Fog, FogMode, Light, LightKind, Material, NormalMap, Object, OcclusionMap, Projection, Shadows,
-    Soup, SoupGeometry, SoupKey,
+    Alpha, Ambient, AmbientMode, Attenuation, Camera, CastShadows, ClearFlags, ColorSpace, Cull,
+    Environment, Fog, FogMode, Light, LightKind, Material, NormalMap, Object, OcclusionMap,
+    Projection, Shadows, Soup, SoupGeometry, SoupKey,
 };
 pub use texture::{Texture, TextureRef, Tiling};
 

@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 pub const MAGIC: &[u8; 8] = b"UTSOUP\0\0";
-pub const VERSION: u32 = 9;
+pub const VERSION: u32 = 10;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Soup {
@@ -455,6 +455,23 @@ pub struct Environment {
     pub fog: Option<Fog>,
     /// RenderSettings' skybox, when it is one the renderer draws.
     pub sky: Option<Sky>,
+    /// The colour space the project's shaders compute in.
+    pub color_space: ColorSpace,
+}
+
+/// The colour space a Unity project renders in (Player settings' Color Space).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ColorSpace {
+    /// Colours, textures and lights are decoded to linear values, shaded, and the frame is
+    /// linear: every colour in the soup is linear RGB.
+    #[default]
+    Linear,
+    /// Shaders compute on the stored, gamma-encoded values and the frame holds what the
+    /// display shows: the soup's colours, light colours and texels are as Unity stores
+    /// them (textures' `srgb` is false), the renderer shades them as they are and decodes
+    /// each pixel from sRGB at the end; a procedural sky's light is the square root of its
+    /// linear value, as Unity's gamma-space skybox shader outputs it.
+    Gamma,
 }
 
 impl Default for Environment {
@@ -471,6 +488,7 @@ impl Default for Environment {
             },
             fog: None,
             sky: None,
+            color_space: ColorSpace::Linear,
         }
     }
 }

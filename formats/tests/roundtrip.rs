@@ -139,9 +139,15 @@ fn soup_round_trips_through_a_file() {
     assert_eq!(Soup::read(&path).unwrap(), s);
     let bytes = std::fs::read(&path).unwrap();
     assert_eq!(&bytes[..8], b"UTSOUP\0\0");
-    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 9);
+    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 10);
     // Nothing but the artifact is left in the folder (the temp file was renamed).
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    // A gamma-space project's soup says so.
+    let mut g = sample_soup();
+    g.environment.color_space = formats::ColorSpace::Gamma;
+    g.write(&path).unwrap();
+    assert_eq!(Soup::read(&path).unwrap(), g);
+    assert_ne!(g, s);
 }
 
 /// A killed writer's temporary is removed by the next write into its folder once it is
@@ -769,13 +775,13 @@ fn atomic_outputs_get_the_umask_permissions_not_the_temporary_files() {
 }
 
 #[test]
-fn a_version_8_soup_is_refused_with_the_versions_named() {
+fn a_version_9_soup_is_refused_with_the_versions_named() {
     let p = Path::new("old.soup");
     let mut b = sample_soup().to_bytes(p).unwrap();
-    b[8..12].copy_from_slice(&8u32.to_le_bytes());
+    b[8..12].copy_from_slice(&9u32.to_le_bytes());
     let msg = Soup::from_bytes(&b, p).unwrap_err().to_string();
     assert!(
-        msg.contains("soup format version 8, this build reads version 9"),
+        msg.contains("soup format version 9, this build reads version 10"),
         "{msg}"
     );
     assert!(msg.contains("re-run the stage that made it"), "{msg}");

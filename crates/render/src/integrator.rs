@@ -317,7 +317,7 @@ fn sky_ambient(soup: &Soup, plan: &Plan) -> Option<SkyAmbient> {
         .filter(|_| env.ambient.mode == AmbientMode::Skybox)?;
     plan.ambient
         .enabled
-        .then(|| Skybox::new(sky).ambient(env.ambient.intensity))
+        .then(|| Skybox::new(sky, env.color_space).ambient(env.ambient.intensity))
 }
 
 /// Replace NaN and ±Inf channels by 0; true when something was replaced.
@@ -433,7 +433,7 @@ impl<'a> Integrator<'a> {
                 .sky
                 .as_ref()
                 .filter(|_| soup.environment.clear == ClearFlags::Skybox)
-                .map(Skybox::new),
+                .map(|sky| Skybox::new(sky, soup.environment.color_space)),
             sky_ambient: sky_ambient(soup, plan).map(Box::new),
             tangents,
         }

@@ -5,7 +5,7 @@ use crate::counters::{RayCounts, SharedCounts};
 use crate::integrator::{Integrator, Primary};
 use crate::sampling::{pixel_samples, Rng};
 use crate::{CameraModel, Frame, Plan, RenderError, RenderOptions, Window};
-use formats::{KdFile, Soup};
+use formats::{ColorSpace, KdFile, Soup};
 use glam::Vec3;
 use kdtree::{Accel, LANES};
 use rayon::prelude::*;
@@ -77,7 +77,8 @@ pub fn render(
         let integrator = Integrator::new(soup, accel, plan, opts);
         let setup_seconds = setup.elapsed().as_secs_f64();
         let start = Instant::now();
-        let (frame, counts) = render_tiles(&camera, &integrator, opts, window, progress);
+        let gamma = soup.environment.color_space == ColorSpace::Gamma;
+        let (frame, counts) = render_tiles(&camera, &integrator, opts, window, gamma, progress);
         Rendered {
             frame,
             counts,
@@ -103,6 +104,7 @@ fn render_tiles(
     integrator: &Integrator,
     opts: &RenderOptions,
     window: Window,
+    gamma: bool,
     progress: Option<&(dyn Fn(u64, u64) + Sync)>,
 ) -> (Frame, RayCounts) {
     // One pixel's cone shared by its samples, the same for every pixel.
@@ -131,11 +133,39 @@ fn render_tiles(
             for x in tile.x0..tile.x1 {
                 let (c, p) = it.next().expect("one result per tile pixel");
                 let i = frame.index(x, y).expect("tiles lie inside the window");
-                frame.set(i, *c, p);
+                if gamma {
+                    frame.set(
+                        i,
+                        decode(*c),
+                        &Primary {
+                            albedo: decode(p.albedo),
+                            ..*p
+                        },
+                    );
+                } else {
+                    frame.set(i, *c, p);
+                }
             }
         }
     }
     (frame, shared.load())
+}
+
+/// A gamma-space project's pixel as the display shows it, in linear RGB: its frame holds
+/// sRGB-encoded values (Unity's gamma-to-linear conversion: the sRGB curve to 1, x^2.2
+/// above; negative values, which no colour has, as 0).
+fn decode(c: Vec3) -> Vec3 {
+    c.map(|v| {
+        if v <= 0.0 {
+            0.0
+        } else if v <= 0.04045 {
+            v / 12.92
+        } else if v <= 1.0 {
+            ((v + 0.055) / 1.055).powf(2.4)
+        } else {
+            v.powf(2.2)
+        }
+    })
 }
 
 /// A tile's pixels, row by row. The pixels of each 2×2 block are traced together, sample by

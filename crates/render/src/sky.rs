@@ -9,7 +9,7 @@
 //! harmonics as Unity's ambient probe holds it.
 
 use crate::sky_image::ImageSky;
-use formats::{ProceduralSky, Sky, SunDisk};
+use formats::{ColorSpace, ProceduralSky, Sky, SunDisk};
 use glam::Vec3;
 use std::f32::consts::PI;
 
@@ -42,6 +42,8 @@ pub struct SkyModel {
     kr_4pi: f32,
     /// The sun light's colour, normalised so that a dim sun still draws a bright disk.
     sun_light: Vec3,
+    /// A gamma-space project's sky: Unity's shader outputs the square root of its light.
+    gamma: bool,
 }
 
 /// The optical depth scale along a ray at angle `cos` to the vertical (O'Neil's fit).
@@ -65,6 +67,24 @@ impl SkyModel {
             kr_esun: rayleigh * SUN_BRIGHTNESS,
             kr_4pi: rayleigh * 4.0 * PI,
             sun_light: sky.sun_colour / brightness,
+            gamma: false,
+        }
+    }
+
+    /// The sky as a project in colour space `space` draws it.
+    pub fn in_space(self, space: ColorSpace) -> Self {
+        SkyModel {
+            gamma: space == ColorSpace::Gamma,
+            ..self
+        }
+    }
+
+    /// What the shader writes for light `l`.
+    fn output(&self, l: Vec3) -> Vec3 {
+        if self.gamma {
+            l.max(Vec3::ZERO).map(f32::sqrt)
+        } else {
+            l
         }
     }
 
@@ -73,14 +93,15 @@ impl SkyModel {
         (-(scatter.clamp(0.0, MAX_SCATTER)) * k).exp()
     }
 
-    /// The sky's radiance along unit direction `eye` (linear RGB).
+    /// The sky's radiance along unit direction `eye` (linear RGB; in a gamma-space project
+    /// the value its shader writes).
     pub fn radiance(&self, eye: Vec3) -> Vec3 {
         let (col, c_out) = self.scattered(eye);
-        if eye.y > 0.0 {
+        self.output(if eye.y > 0.0 {
             col + self.sun(c_out, self.sky.sun_direction, eye)
         } else {
             col
-        }
+        })
     }
 
     /// The light the sky sends down unit direction `eye` without the sun's disk, and the
@@ -151,7 +172,7 @@ impl SkyModel {
                 for c in 0..COLUMNS {
                     let phi = 2.0 * PI * (c as f32 + 0.5) / COLUMNS as f32;
                     let dir = Vec3::new(ring * phi.cos(), y, ring * phi.sin());
-                    add(dir, self.scattered(dir).0 * area);
+                    add(dir, self.output(self.scattered(dir).0) * area);
                 }
             }
         })
@@ -232,9 +253,11 @@ pub enum Skybox<'a> {
 }
 
 impl<'a> Skybox<'a> {
-    pub fn new(sky: &'a Sky) -> Self {
+    /// The sky as a project in colour space `space` draws it (an image sky's texels and
+    /// scale are already that space's).
+    pub fn new(sky: &'a Sky, space: ColorSpace) -> Self {
         match sky {
-            Sky::Procedural(p) => Skybox::Procedural(SkyModel::new(*p)),
+            Sky::Procedural(p) => Skybox::Procedural(SkyModel::new(*p).in_space(space)),
             Sky::Textured(t) => Skybox::Image(ImageSky::new(t)),
         }
     }

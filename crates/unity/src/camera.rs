@@ -2,7 +2,7 @@
 //! background: the Game view's camera among the scene's enabled ones.
 
 use crate::emit::{flip, EmitError, Emitter};
-use crate::material::linear_rgb;
+use crate::material::shaded_rgb;
 use crate::reference::fref;
 use crate::yaml::Node;
 use formats::{Camera, ClearFlags, Projection};
@@ -94,7 +94,7 @@ impl Emitter<'_, '_> {
         self.camera_mask = crate::layer::culling_mask(b);
         self.soup.environment.clear = clear_flags(b);
         if let Some(bg) = b.get("m_BackGroundColor").and_then(Node::color) {
-            self.soup.environment.background = linear_rgb(bg);
+            self.soup.environment.background = shaded_rgb(bg, g.project.color_space);
         }
         Ok(())
     }

@@ -7,10 +7,11 @@
 
 use crate::docs;
 use crate::graph::{is_transform, Graph, Obj};
+use crate::material::linear_to_srgb;
 use crate::mesh::Mesh;
 use crate::project::Pipeline;
 use crate::quality::ShadowQuality;
-use formats::Soup;
+use formats::{ColorSpace, Soup};
 use glam::{Mat4, Vec3};
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -195,23 +196,16 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
             "ProjectSettings/QualitySettings.asset: the current quality level {says}, as in Unity"
         ));
     }
-    if g.project.gamma_color_space {
-        e.soup.warnings.push(
-            "ProjectSettings/ProjectSettings.asset: the project draws in the Gamma colour space; \
-             unitrace renders in linear space, as Unity's Linear setting does, so lit surfaces, \
-             falloff and blending look brighter and softer than in its editor"
-                .into(),
-        );
-    }
     if let Some(ambient) = g
         .render_settings
         .as_ref()
-        .and_then(crate::environment::ambient)
+        .and_then(|rs| crate::environment::ambient(rs, g.project.color_space))
     {
         e.soup.environment.ambient = ambient;
     }
     if let Some(rs) = &g.render_settings {
-        match crate::environment::fog(rs, g.project.pipeline == Pipeline::HighDefinition) {
+        let hdrp = g.project.pipeline == Pipeline::HighDefinition;
+        match crate::environment::fog(rs, hdrp, g.project.color_space) {
             Ok(fog) => e.soup.environment.fog = fog,
             Err(why) => e
                 .soup
@@ -228,6 +222,9 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
     }
     let placements = std::mem::take(&mut e.placements);
     placements.fill(&mut e.soup, &mut e.material_origins);
+    if g.project.color_space == ColorSpace::Gamma {
+        keep_gamma(&mut e.soup);
+    }
     e.soup.seal();
     Ok(Emitted {
         soup: e.soup,
@@ -256,5 +253,20 @@ impl Emitter<'_, '_> {
             return false;
         }
         self.camera_draws(go)
+    }
+}
+
+/// A gamma-space project's materials as its shaders take them. Materials are converted
+/// (from `.mat` files, FBX and OBJ models alike) with their colours decoded as a linear
+/// project decodes them; here those colours are encoded back to the values Unity stores,
+/// and texels are read as stored (`srgb` off), which is what a gamma-space shader samples.
+fn keep_gamma(soup: &mut Soup) {
+    soup.environment.color_space = ColorSpace::Gamma;
+    for m in &mut soup.materials {
+        m.color = m.color.map(linear_to_srgb);
+        m.emission = m.emission.map(linear_to_srgb);
+    }
+    for t in &mut soup.textures {
+        t.srgb = false;
     }
 }

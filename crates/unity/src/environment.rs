@@ -1,18 +1,18 @@
 //! RenderSettings (class 104): the ambient light and the fog of the scene.
 
-use crate::material::linear_rgb;
+use crate::material::shaded_rgb;
 use crate::yaml::Node;
-use formats::{Ambient, AmbientMode, Fog, FogMode};
+use formats::{Ambient, AmbientMode, ColorSpace, Fog, FogMode};
 use glam::{Vec3, Vec4};
 
 /// The ambient light a RenderSettings body sets; `None` when a colour is not finite
 /// (the soup keeps its default).
-pub fn ambient(rs: &Node) -> Option<Ambient> {
+pub fn ambient(rs: &Node, space: ColorSpace) -> Option<Ambient> {
     let intensity = rs.f32_at("m_AmbientIntensity").unwrap_or(1.0);
     let col = |k: &str| {
         rs.get(k)
             .and_then(Node::color)
-            .map(linear_rgb)
+            .map(|c| shaded_rgb(c, space))
             .unwrap_or(Vec3::ZERO)
             * intensity
     };
@@ -38,7 +38,7 @@ pub fn ambient(rs: &Node) -> Option<Ambient> {
 /// The fog a RenderSettings body turns on (`m_Fog: 1`), with Unity's defaults for what it
 /// does not say; `Err` with the reason when it cannot be drawn. HDRP draws its fog from a
 /// Volume override and ignores these settings.
-pub fn fog(rs: &Node, hdrp: bool) -> Result<Option<Fog>, String> {
+pub fn fog(rs: &Node, hdrp: bool, space: ColorSpace) -> Result<Option<Fog>, String> {
     if rs.i64_at("m_Fog") != Some(1) {
         return Ok(None);
     }
@@ -64,10 +64,11 @@ pub fn fog(rs: &Node, hdrp: bool) -> Result<Option<Fog>, String> {
             ))
         }
     };
-    let colour = linear_rgb(
+    let colour = shaded_rgb(
         rs.get("m_FogColor")
             .and_then(Node::color)
             .unwrap_or(Vec4::new(0.5, 0.5, 0.5, 1.0)),
+        space,
     );
     if !mode.is_finite() || !colour.is_finite() {
         return Err(format!(
@@ -88,7 +89,7 @@ mod tests {
 
     fn fog_of(fields: &str, hdrp: bool) -> Result<Option<Fog>, String> {
         let rs = parse(&format!("RenderSettings:\n  m_Fog: 1\n{fields}"));
-        fog(rs.get("RenderSettings").unwrap(), hdrp)
+        fog(rs.get("RenderSettings").unwrap(), hdrp, ColorSpace::Linear)
     }
 
     #[test]
@@ -117,12 +118,17 @@ mod tests {
         let default = fog_of("", false).unwrap().unwrap();
         assert_eq!(default.mode, FogMode::ExponentialSquared { density: 0.01 });
         assert_eq!(default.colour, Vec3::splat(srgb_to_linear(0.5)));
+        // A gamma-space project's shaders take the stored colour.
+        let rs = parse(&format!("RenderSettings:\n  m_Fog: 1\n{colour}"));
+        let gamma = fog(rs.get("RenderSettings").unwrap(), false, ColorSpace::Gamma);
+        assert_eq!(gamma.unwrap().unwrap().colour, Vec3::new(0.5, 0.25, 1.0));
     }
 
     #[test]
     fn fog_that_is_off_unknown_hdrp_or_not_finite_is_not_drawn() {
         let off = parse("RenderSettings:\n  m_Fog: 0\n  m_FogMode: 2\n");
-        assert_eq!(fog(off.get("RenderSettings").unwrap(), false), Ok(None));
+        let off = off.get("RenderSettings").unwrap();
+        assert_eq!(fog(off, false, ColorSpace::Linear), Ok(None));
         let hdrp = fog_of("  m_FogMode: 2\n", true).unwrap_err();
         assert!(hdrp.contains("HDRP ignores RenderSettings fog"), "{hdrp}");
         let mode = fog_of("  m_FogMode: 7\n", false).unwrap_err();

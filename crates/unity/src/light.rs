@@ -8,7 +8,7 @@ use crate::project::{Pipeline, Project};
 use crate::quality::ShadowQuality;
 use crate::reference::fref;
 use crate::yaml::Node;
-use formats::{Attenuation, Light, LightKind, Shadows};
+use formats::{Attenuation, ColorSpace, Light, LightKind, Shadows};
 use glam::{Mat4, Vec3, Vec4Swizzles};
 
 /// Unity's `m_Type` of a directional light (its shadow softness is an angle).
@@ -27,17 +27,26 @@ pub struct LightUnits {
     /// A light's `m_UseColorTemperature` tints it by its `m_ColorTemperature` (only
     /// with linear intensity, as Unity applies it).
     pub color_temperature: bool,
+    /// A gamma-space project's shaders take the stored colour times the intensity as it
+    /// is.
+    pub gamma_space: bool,
 }
 
 impl LightUnits {
     /// The units of a project drawn by `pipeline` whose
     /// `ProjectSettings/GraphicsSettings.asset` holds `graphics_settings` (`None` when the
     /// file is absent: Unity's defaults).
-    pub fn of(pipeline: Pipeline, graphics_settings: Option<&str>) -> LightUnits {
+    pub fn of(
+        pipeline: Pipeline,
+        graphics_settings: Option<&str>,
+        space: ColorSpace,
+    ) -> LightUnits {
+        let gamma_space = space == ColorSpace::Gamma;
         if pipeline != Pipeline::BuiltIn {
             return LightUnits {
                 linear_intensity: true,
                 color_temperature: true,
+                gamma_space,
             };
         }
         let body = graphics_settings.and_then(|text| {
@@ -50,6 +59,7 @@ impl LightUnits {
         LightUnits {
             linear_intensity: on("m_LightsUseLinearIntensity"),
             color_temperature: on("m_LightsUseColorTemperature"),
+            gamma_space,
         }
     }
 
@@ -58,6 +68,9 @@ impl LightUnits {
     /// kelvin. The soup keeps the intensity of a white light and the colour as each
     /// channel's share of it, so the product is Unity's final light colour.
     pub fn light(self, gamma: Vec3, intensity: f32, temperature: Option<f32>) -> (Vec3, f32) {
+        if self.gamma_space {
+            return (gamma, intensity);
+        }
         if !self.linear_intensity {
             let white = gamma_to_linear(intensity);
             if !(white.is_normal() && white > 0.0) {
@@ -353,10 +366,12 @@ mod tests {
     const GAMMA: LightUnits = LightUnits {
         linear_intensity: false,
         color_temperature: false,
+        gamma_space: false,
     };
     const LINEAR: LightUnits = LightUnits {
         linear_intensity: true,
         color_temperature: true,
+        gamma_space: false,
     };
 
     #[test]
@@ -401,6 +416,12 @@ mod tests {
         // No light at all keeps a finite colour.
         let (c, i) = GAMMA.light(orange, 0.0, None);
         assert_eq!((c, i), (orange.map(srgb_to_linear), 0.0));
+        // A gamma-space project's shaders take the stored colour times the intensity.
+        let raw = LightUnits {
+            gamma_space: true,
+            ..LINEAR
+        };
+        assert_eq!(raw.light(orange, 1.5, Some(2000.0)), (orange, 1.5));
         // Temperature tints only linear intensities.
         assert_eq!(GAMMA.light(Vec3::ONE, 1.0, Some(2000.0)).0, Vec3::ONE);
         let (c, _) = LINEAR.light(Vec3::ONE, 1.0, Some(2000.0));
@@ -496,19 +517,22 @@ mod tests {
     #[test]
     fn graphics_settings_are_read_for_the_built_in_pipeline_only() {
         let text = "%YAML 1.1\n--- !u!30 &1\nGraphicsSettings:\n  m_LightsUseLinearIntensity: 1\n  m_LightsUseColorTemperature: 0\n";
-        let units = LightUnits::of(Pipeline::BuiltIn, Some(text));
+        let units = LightUnits::of(Pipeline::BuiltIn, Some(text), ColorSpace::Linear);
         assert!(units.linear_intensity && !units.color_temperature);
-        assert_eq!(LightUnits::of(Pipeline::BuiltIn, None), GAMMA);
+        assert_eq!(
+            LightUnits::of(Pipeline::BuiltIn, None, ColorSpace::Linear),
+            GAMMA
+        );
         for junk in ["", "m_LightsUseLinearIntensity: 1", "--- !u!30 &1\n: : ["] {
             assert_eq!(
-                LightUnits::of(Pipeline::BuiltIn, Some(junk)),
+                LightUnits::of(Pipeline::BuiltIn, Some(junk), ColorSpace::Linear),
                 GAMMA,
                 "{junk}"
             );
         }
         let off = text.replace(": 1", ": 0");
         for p in [Pipeline::Universal, Pipeline::HighDefinition] {
-            assert_eq!(LightUnits::of(p, Some(&off)), LINEAR);
+            assert_eq!(LightUnits::of(p, Some(&off), ColorSpace::Linear), LINEAR);
         }
     }
 }

@@ -8,7 +8,7 @@ use crate::model::Model;
 use crate::project::ModelError;
 use crate::reference::Ref;
 use crate::yaml::Node;
-use formats::{Alpha, Cull, Material};
+use formats::{Alpha, ColorSpace, Cull, Material};
 use glam::{Vec3, Vec4};
 use std::borrow::Cow;
 use std::path::Path;
@@ -36,6 +36,24 @@ pub fn gamma_to_linear(x: f32) -> f32 {
         srgb_to_linear(x)
     } else {
         x.powf(2.2)
+    }
+}
+
+/// The inverse of [`srgb_to_linear`], above 1 too.
+pub fn linear_to_srgb(c: f32) -> f32 {
+    if c <= 0.003_130_8 {
+        c * 12.92
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// A stored colour as a project in colour space `space` shades it: decoded to linear in a
+/// linear project, as stored in a gamma one.
+pub fn shaded_rgb(c: Vec4, space: ColorSpace) -> Vec3 {
+    match space {
+        ColorSpace::Linear => linear_rgb(c),
+        ColorSpace::Gamma => c.truncate(),
     }
 }
 

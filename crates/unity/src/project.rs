@@ -11,6 +11,7 @@ use crate::model::Model;
 use crate::obj;
 use crate::quality::ShadowQuality;
 use crate::yaml::Node;
+use formats::ColorSpace;
 use rayon::prelude::*;
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
@@ -138,13 +139,18 @@ impl PipelineAsset {
     }
 }
 
-/// Whether a `ProjectSettings.asset` text sets the Gamma colour space (`m_ActiveColorSpace`
-/// 0; 1 is Linear).
-pub fn gamma_color_space(text: &str) -> bool {
-    docs::split(text)
+/// The colour space a `ProjectSettings.asset` text sets (`m_ActiveColorSpace` 0 Gamma, 1
+/// Linear); Linear where it does not say.
+pub fn color_space(text: &str) -> ColorSpace {
+    let gamma = docs::split(text)
         .into_iter()
         .find(|d| d.class == docs::PLAYER_SETTINGS)
-        .is_some_and(|d| d.parse().i64_at("m_ActiveColorSpace") == Some(0))
+        .is_some_and(|d| d.parse().i64_at("m_ActiveColorSpace") == Some(0));
+    if gamma {
+        ColorSpace::Gamma
+    } else {
+        ColorSpace::Linear
+    }
 }
 
 pub struct Project {
@@ -166,8 +172,8 @@ pub struct Project {
     /// A built-in project without `ProjectSettings/GraphicsSettings.asset`, whose lights take
     /// Unity's default units.
     pub light_units_assumed: bool,
-    /// `ProjectSettings/ProjectSettings.asset` sets the Gamma colour space (absent: linear).
-    pub gamma_color_space: bool,
+    /// The colour space `ProjectSettings/ProjectSettings.asset` sets (absent: linear).
+    pub color_space: ColorSpace,
     /// The realtime shadows the current quality level allows a built-in project (`All` for
     /// URP and HDRP, whose pipeline assets decide, and where the file does not say).
     pub shadow_quality: ShadowQuality,
@@ -247,9 +253,10 @@ impl Project {
             .and_then(crate::quality::shadows)
             .unwrap_or(ShadowQuality::All);
         let light_units_assumed = pipeline == Pipeline::BuiltIn && graphics.is_none();
-        let light_units = LightUnits::of(pipeline, graphics.as_deref());
-        let gamma_color_space =
-            settings("ProjectSettings.asset").is_some_and(|text| gamma_color_space(&text));
+        let color_space = settings("ProjectSettings.asset")
+            .as_deref()
+            .map_or(ColorSpace::Linear, color_space);
+        let light_units = LightUnits::of(pipeline, graphics.as_deref(), color_space);
         let canonical_root = root.canonicalize().unwrap_or_else(|_| root.clone());
         Project {
             canonical_root,
@@ -262,7 +269,7 @@ impl Project {
             universal_shadows,
             light_units,
             light_units_assumed,
-            gamma_color_space,
+            color_space,
             shadow_quality,
             lod_bias,
             files: Mutex::default(),
@@ -289,7 +296,9 @@ impl Project {
             pipeline += ")";
         }
         let units = self.light_units;
-        let intensity = if units.linear_intensity {
+        let intensity = if units.gamma_space {
+            "as stored (gamma space)"
+        } else if units.linear_intensity {
             "linear"
         } else {
             "gamma"
@@ -299,10 +308,9 @@ impl Project {
         } else {
             ""
         };
-        let space = if self.gamma_color_space {
-            "Gamma (rendered linear)"
-        } else {
-            "linear"
+        let space = match self.color_space {
+            ColorSpace::Gamma => "Gamma",
+            ColorSpace::Linear => "linear",
         };
         let shadows = match self.pipeline {
             Pipeline::BuiltIn => format!("; quality-level shadows {:?}", self.shadow_quality),
@@ -310,7 +318,7 @@ impl Project {
         };
         format!(
             "{pipeline}; light intensity {intensity}, colour temperature {}{assumed}; colour space {space}{shadows}; LOD bias {}",
-            on(units.linear_intensity && units.color_temperature),
+            on(units.linear_intensity && units.color_temperature && !units.gamma_space),
             self.lod_bias
         )
     }

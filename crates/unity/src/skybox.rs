@@ -4,13 +4,14 @@
 //! Sided).
 
 use crate::emit::Emitter;
-use crate::material::{gamma_to_linear, keyword_on, linear_rgb, prop, props};
+use crate::material::{gamma_to_linear, keyword_on, linear_rgb, prop, props, shaded_rgb};
 use crate::project::{ext, Pipeline, Project};
 use crate::reference::fref;
 use crate::texture::{load_linear, named_slot, Import, LinearImage};
 use crate::yaml::Node;
 use formats::{
-    Light, LightKind, Panorama, ProceduralSky, Sky, SkyImage, SkyLayout, SunDisk, TexturedSky,
+    ColorSpace, Light, LightKind, Panorama, ProceduralSky, Sky, SkyImage, SkyLayout, SunDisk,
+    TexturedSky,
 };
 use glam::{Vec3, Vec4};
 use std::path::{Path, PathBuf};
@@ -100,12 +101,20 @@ pub fn skybox(
     let p = Props::of(&body);
     // `_Exposure` is a [Gamma] property: a linear-space project takes it decoded. Its
     // inspector keeps it within the shader's range, 0–8.
-    let exposure = gamma_to_linear(p.float("_Exposure").unwrap_or(1.0).clamp(0.0, 8.0));
+    let exposure = p.float("_Exposure").unwrap_or(1.0).clamp(0.0, 8.0);
+    let space = project.color_space;
     let tint = p
-        .colour("_Tint")
-        .unwrap_or(linear_rgb(Vec4::splat(0.5)))
+        .stored_colour("_Tint")
+        .map(|c| shaded_rgb(c, space))
+        .filter(|c| c.is_finite())
+        .unwrap_or(shaded_rgb(Vec4::splat(0.5), space))
         .max(Vec3::ZERO);
-    let scale = tint * COLOUR_SPACE_DOUBLE * exposure;
+    let scale = match space {
+        ColorSpace::Linear => tint * COLOUR_SPACE_DOUBLE * gamma_to_linear(exposure),
+        // A gamma-space project's `unity_ColorSpaceDouble` is 2, and its values stay as
+        // stored.
+        ColorSpace::Gamma => tint * 2.0 * exposure,
+    };
     if !scale.is_finite() {
         return Err(format!(
             "skybox {name}: _Tint times _Exposure is too bright to draw"
@@ -142,9 +151,15 @@ impl<'a> Props<'a> {
     }
 
     fn colour(&self, k: &str) -> Option<Vec3> {
+        self.stored_colour(k)
+            .map(linear_rgb)
+            .filter(|c| c.is_finite())
+    }
+
+    /// A colour as the file stores it (gamma-encoded), where it is finite.
+    fn stored_colour(&self, k: &str) -> Option<Vec4> {
         prop(&self.colours, k)
             .and_then(Node::color)
-            .map(linear_rgb)
             .filter(|c| c.is_finite())
     }
 }
@@ -192,7 +207,9 @@ fn image(
     resize: bool,
 ) -> Result<(LinearImage, Import, String), String> {
     let (path, source) = texture_file(body, property, project)?;
-    let import = Import::read(&path);
+    let mut import = Import::read(&path);
+    // A gamma-space project's shaders take texels as stored.
+    import.srgb &= project.color_space == ColorSpace::Linear;
     let img = load(&path, &source, property, &import, resize)?;
     Ok((img, import, source))
 }

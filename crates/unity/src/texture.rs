@@ -386,15 +386,6 @@ pub fn load_albedo(project: &Project, body: &Node) -> Result<Option<Albedo>, Tex
     }))
 }
 
-fn linear_to_srgb(c: f32) -> f32 {
-    let c = c.clamp(0.0, 1.0);
-    if c <= 0.003_130_8 {
-        c * 12.92
-    } else {
-        1.055 * c.powf(1.0 / 2.4) - 0.055
-    }
-}
-
 /// Decode the image at `path` (named `source` in the texture and in errors) and import it
 /// as `import` says.
 pub fn load(path: &Path, source: &str, import: &Import) -> Result<Texture, TextureError> {
@@ -562,9 +553,9 @@ pub fn decode(
             .flat_map(|p| {
                 let q = |c: f32| (c * 255.0 + 0.5) as u8;
                 [
-                    q(linear_to_srgb(p[0])),
-                    q(linear_to_srgb(p[1])),
-                    q(linear_to_srgb(p[2])),
+                    q(crate::material::linear_to_srgb(p[0].clamp(0.0, 1.0))),
+                    q(crate::material::linear_to_srgb(p[1].clamp(0.0, 1.0))),
+                    q(crate::material::linear_to_srgb(p[2].clamp(0.0, 1.0))),
                     q(p[3].clamp(0.0, 1.0)),
                 ]
             })

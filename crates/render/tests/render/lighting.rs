@@ -390,6 +390,107 @@ fn a_directional_light_shades_by_the_cosine() {
     }
 }
 
+/// A procedural sky, bluish, its sun 30° up.
+fn bluish_sky() -> formats::ProceduralSky {
+    formats::ProceduralSky {
+        sun_disk: formats::SunDisk::HighQuality,
+        sun_size: 0.04,
+        sun_size_convergence: 5.0,
+        atmosphere_thickness: 1.0,
+        exposure: 1.3,
+        sky_tint: Vec3::splat(0.214),
+        ground: Vec3::splat(0.11),
+        sun_direction: Vec3::new(0.0, 0.5, 1.0).normalize(),
+        sun_colour: Vec3::ONE,
+    }
+}
+
+/// The floor under [`bluish_sky`], lit by its Skybox ambient light `intensity` times (black
+/// gradient colours), in a project of colour space `space`.
+fn floor_in_skybox_ambient(
+    intensity: f32,
+    space: formats::ColorSpace,
+) -> (formats::Soup, formats::KdFile) {
+    let mut s = floor_scene();
+    s.soup.environment.color_space = space;
+    s.soup.environment.sky = Some(formats::Sky::Procedural(bluish_sky()));
+    s.soup.environment.ambient = formats::Ambient {
+        mode: AmbientMode::Skybox,
+        sky: Vec3::ZERO,
+        equator: Vec3::ZERO,
+        ground: Vec3::ZERO,
+        intensity,
+    };
+    s.build()
+}
+
+/// Unity's sRGB decoding of a gamma-space frame's value in [0, 1].
+fn srgb_decode(v: f32) -> f32 {
+    if v <= 0.04045 {
+        v / 12.92
+    } else {
+        ((v + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// In a gamma-space project the shaders light the stored colours and the frame holds what
+/// the display shows: each pixel is the sRGB decoding of albedo · intensity · cos, so the
+/// light falls off with the cosine far faster than in a linear project; a procedural sky
+/// shows the square root of its light, and its ambient light is projected from that.
+#[test]
+fn a_gamma_space_frame_is_lit_on_stored_values_and_decoded() {
+    for deg in [0.0f32, 60.0] {
+        let mut s = floor_scene();
+        s.soup.environment.color_space = formats::ColorSpace::Gamma;
+        let r = deg.to_radians();
+        s.light(directional_light(
+            Vec3::new(r.sin(), -r.cos(), 0.0),
+            1.2,
+            Shadows::Hard,
+        ));
+        let (soup, kd) = s.build();
+        let (w, h) = (16, 16);
+        let o = render::RenderOptions {
+            aovs: render::AovSet::parse("albedo").unwrap(),
+            ..opts(w, h)
+        };
+        let out = render_alike_at_tiles(&soup, &kd, &o);
+        let stored = ALBEDO * 1.2 * r.cos();
+        let want = stored.map(srgb_decode);
+        for (x, y) in [(0, 0), (8, 8), (15, 3)] {
+            assert_close(
+                out.frame.pixel(x, y),
+                want,
+                1e-6,
+                &format!("{deg}° at ({x}, {y})"),
+            );
+            let i = out.frame.index(x, y).unwrap();
+            assert_close(
+                out.frame.albedo[i],
+                ALBEDO.map(srgb_decode),
+                1e-6,
+                "albedo AOV",
+            );
+        }
+    }
+    let sky = bluish_sky();
+    let (soup, kd) = floor_in_skybox_ambient(1.0, formats::ColorSpace::Gamma);
+    let (out, _) = render(&soup, &kd, &opts(8, 8));
+    let gamma = render::sky::SkyModel::new(sky).in_space(formats::ColorSpace::Gamma);
+    let want = (ALBEDO * gamma.ambient(1.0).at(Vec3::Y)).map(srgb_decode);
+    assert_close(
+        out.frame.pixel(4, 4),
+        want,
+        1e-6,
+        "the floor in gamma skybox ambient",
+    );
+    // The gamma sky writes √ of the linear one's light.
+    let linear = render::sky::SkyModel::new(sky);
+    let up = Vec3::new(0.0, 0.8, 0.6).normalize();
+    let (g, l) = (gamma.radiance(up), linear.radiance(up));
+    assert!((g - l.map(f32::sqrt)).abs().max_element() < 1e-6, "{g} {l}");
+}
+
 #[test]
 fn ambient_lights_a_face_no_light_reaches() {
     for ambient_on in [false, true] {
@@ -532,17 +633,7 @@ fn the_background_is_the_clear_colour_or_a_sky() {
 
     // With a procedural sky each background pixel is that sky along its camera ray, in
     // single rays and in packets alike.
-    let sky = formats::ProceduralSky {
-        sun_disk: formats::SunDisk::HighQuality,
-        sun_size: 0.04,
-        sun_size_convergence: 5.0,
-        atmosphere_thickness: 1.0,
-        exposure: 1.3,
-        sky_tint: Vec3::splat(0.214),
-        ground: Vec3::splat(0.11),
-        sun_direction: Vec3::new(0.0, 0.5, 1.0).normalize(),
-        sun_colour: Vec3::ONE,
-    };
+    let sky = bluish_sky();
     soup.environment.sky = Some(formats::Sky::Procedural(sky));
     let out = render_alike_at_tiles(&soup, &kd, &opts(8, 64));
     let camera = render::CameraModel::new(&soup.camera, 8, 64).unwrap();
@@ -558,27 +649,8 @@ fn the_background_is_the_clear_colour_or_a_sky() {
 /// gradient colours say, scaled by the ambient intensity; the camera may clear to a colour.
 #[test]
 fn skybox_ambient_is_the_procedural_skys_light() {
-    let mut s = floor_scene();
-    let sky = formats::ProceduralSky {
-        sun_disk: formats::SunDisk::HighQuality,
-        sun_size: 0.04,
-        sun_size_convergence: 5.0,
-        atmosphere_thickness: 1.0,
-        exposure: 1.3,
-        sky_tint: Vec3::splat(0.214),
-        ground: Vec3::splat(0.11),
-        sun_direction: Vec3::new(0.0, 0.5, 1.0).normalize(),
-        sun_colour: Vec3::ONE,
-    };
-    s.soup.environment.sky = Some(formats::Sky::Procedural(sky));
-    s.soup.environment.ambient = formats::Ambient {
-        mode: AmbientMode::Skybox,
-        sky: Vec3::ZERO,
-        equator: Vec3::ZERO,
-        ground: Vec3::ZERO,
-        intensity: 1.5,
-    };
-    let (soup, kd) = s.build();
+    let sky = bluish_sky();
+    let (soup, kd) = floor_in_skybox_ambient(1.5, formats::ColorSpace::Linear);
     let (out, plan) = render(&soup, &kd, &opts(8, 8));
     assert!(plan.ambient.enabled, "{}", plan.ambient.reason);
     let want = ALBEDO * render::sky::SkyModel::new(sky).ambient(1.5).at(Vec3::Y);

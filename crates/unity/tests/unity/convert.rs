@@ -800,30 +800,91 @@ fn the_current_quality_level_limits_a_built_in_projects_shadows() {
     }
 }
 
+/// A bundled project copied to a temporary folder, with `ProjectSettings.asset` setting
+/// colour space `space` (0 Gamma, 1 Linear).
+fn bundled_in_colour_space(name: &str, space: i32) -> tempfile::TempDir {
+    let d = tempfile::tempdir().unwrap();
+    let from = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes")
+        .join(name);
+    copy_dir(&from, d.path());
+    let player = format!("{HEADER}--- !u!129 &1\nPlayerSettings:\n  m_ObjectHideFlags: 0\n  serializedVersion: 26\n  productName: p\n  m_ActiveColorSpace: {space}\n");
+    std::fs::write(
+        d.path().join("ProjectSettings/ProjectSettings.asset"),
+        player,
+    )
+    .unwrap();
+    d
+}
+
+/// A gamma-space project's shaders take colours, lights and texels as Unity stores them:
+/// the soup keeps them so and says so, and the renderer decodes the frame.
 #[test]
-fn a_gamma_colour_space_project_is_warned_about() {
-    let mut sc = Scene::default();
-    sc.light(&Tf::at(0.0, 5.0, 0.0), 2, [1.0, 1.0, 1.0], 1);
-    let player = |space: i32| {
-        format!("{HEADER}--- !u!129 &1\nPlayerSettings:\n  m_ObjectHideFlags: 0\n  serializedVersion: 26\n  productName: p\n  m_ActiveColorSpace: {space}\n")
+fn a_gamma_colour_space_project_keeps_colours_and_texels_as_stored() {
+    let convert_in = |name: &str, scene: &str, space: i32| {
+        let d = bundled_in_colour_space(name, space);
+        let soup = convert(&d.path().join("Assets/Scenes").join(scene));
+        assert!(soup.warnings.is_empty(), "{:?}", soup.warnings);
+        soup
     };
-    for (space, warned) in [(0, true), (1, false)] {
-        let text = player(space);
-        let (_d, root) = project(&[
-            ("Assets/s.unity", sc.text.as_str()),
-            ("ProjectSettings/ProjectSettings.asset", &text),
-        ]);
-        let soup = convert(&root.join("Assets/s.unity"));
-        let said = soup
-            .warnings
+    let linear = convert_in("emission", "Emission.unity", 1);
+    let gamma = convert_in("emission", "Emission.unity", 0);
+    assert_eq!(linear.environment.color_space, formats::ColorSpace::Linear);
+    assert_eq!(gamma.environment.color_space, formats::ColorSpace::Gamma);
+    let cyan = |soup: &formats::Soup| {
+        let m = soup
+            .materials
             .iter()
-            .any(|w| w.contains("Gamma colour space"));
-        assert_eq!(
-            said, warned,
-            "m_ActiveColorSpace {space}: {:?}",
-            soup.warnings
-        );
-    }
+            .find(|m| m.name == "GlowCyan")
+            .unwrap();
+        (m.color, m.emission)
+    };
+    // GlowCyan.mat stores _Color and _EmissionColor (0.1, 0.8, 1).
+    let stored = Vec3::new(0.1, 0.8, 1.0);
+    assert!(close(cyan(&gamma).0, stored, 1e-6) && close(cyan(&gamma).1, stored, 1e-6));
+    assert!(close(
+        cyan(&linear).0,
+        Vec3::new(0.010022826, 0.6038273, 1.0),
+        1e-6
+    ));
+    // The scene's white light of intensity 0.3, as stored; the linear project's bundled
+    // settings ask for linear units (the same here: white).
+    let l = &gamma.lights[0];
+    assert!(
+        close(l.color * l.intensity, Vec3::splat(0.3), 1e-6),
+        "{}",
+        l.color
+    );
+    let d = bundled_in_colour_space("emission", 0);
+    let opts = unity::Options::default();
+    let r = unity::convert_report(&d.path().join("Assets/Scenes/Emission.unity"), &opts).unwrap();
+    let said =
+        "light intensity as stored (gamma space), colour temperature off; colour space Gamma";
+    assert!(r.settings.contains(said), "{}", r.settings);
+    // An image sky: `_Tint` 0.5 and `_Exposure` 1 as stored, times a gamma-space
+    // project's `unity_ColorSpaceDouble`, 2 (a linear one's 0.2140 × 4.5948 × 1).
+    let scale = |space: i32| {
+        let d = bundled_in_colour_space("skybox", space);
+        match convert(&d.path().join("Assets/Scenes/Skybox.unity"))
+            .environment
+            .sky
+        {
+            Some(formats::Sky::Textured(t)) => t.scale,
+            other => panic!("{other:?}"),
+        }
+    };
+    assert!(close(scale(0), Vec3::splat(1.0), 1e-6), "{}", scale(0));
+    assert!(
+        close(scale(1), Vec3::splat(0.21404114 * 4.594794), 1e-5),
+        "{}",
+        scale(1)
+    );
+    // Texels are sampled as stored: the grey texture's bytes, no longer sRGB.
+    let textures = bundled_in_colour_space("textures", 0);
+    let grey = convert(&textures.path().join("Assets/Scenes/Grey.unity"));
+    let t = &grey.textures[0];
+    assert!(!t.srgb && t.texels.chunks(4).all(|c| c == [128, 128, 128, 255]));
+    assert!((t.texel(2, 3)[0] - 128.0 / 255.0).abs() < 1e-6);
 }
 
 const TWO_GROUPS: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 5 0 0\nv 6 0 0\nv 5 1 0\nmtllib two.mtl\ng A\nusemtl red\nf 1 2 3\ng B\nusemtl green\nf 4 5 6\n";

@@ -210,3 +210,16 @@ pub fn bounds(pts: impl Iterator<Item = glam::Vec3>) -> (glam::Vec3, glam::Vec3)
 pub fn close(a: glam::Vec3, b: glam::Vec3, eps: f32) -> bool {
     (a - b).abs().max_element() <= eps
 }
+
+/// Copy folder `from` into `to`, recursively.
+pub fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
+    for e in std::fs::read_dir(from).unwrap().flatten() {
+        let (src, dst) = (e.path(), to.join(e.file_name()));
+        if src.is_dir() {
+            std::fs::create_dir_all(&dst).unwrap();
+            copy_dir(&src, &dst);
+        } else {
+            std::fs::copy(&src, &dst).unwrap();
+        }
+    }
+}

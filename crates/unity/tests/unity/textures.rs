@@ -3,6 +3,7 @@
 //! makes the loader panic; the generated `textures` scenes convert into exactly the
 //! texels, UVs, tiling and alpha they were written with.
 
+use crate::support::copy_dir;
 use formats::texture::{Filter, Wrap};
 use std::path::PathBuf;
 use unity::project::Project;
@@ -413,18 +414,6 @@ fn unreadable_texture_warns_and_strict_refuses() {
             ..Default::default()
         };
         assert!(unity::convert(&scene, &strict).is_err(), "{what}");
-    }
-}
-
-fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
-    for e in std::fs::read_dir(from).unwrap().flatten() {
-        let (src, dst) = (e.path(), to.join(e.file_name()));
-        if src.is_dir() {
-            std::fs::create_dir_all(&dst).unwrap();
-            copy_dir(&src, &dst);
-        } else {
-            std::fs::copy(&src, &dst).unwrap();
-        }
     }
 }
 
