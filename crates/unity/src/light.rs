@@ -63,10 +63,11 @@ impl LightUnits {
         }
     }
 
-    /// The linear colour and intensity of a light whose inspector shows `gamma` (the
-    /// stored colour), `intensity` and, where it uses one, a colour `temperature` in
-    /// kelvin. The soup keeps the intensity of a white light and the colour as each
-    /// channel's share of it, so the product is Unity's final light colour.
+    /// The colour and intensity the project's shaders take (linear, or as stored in a
+    /// gamma-space project) from a light whose inspector shows `gamma` (the stored
+    /// colour), `intensity` and, where it uses one, a colour `temperature` in kelvin. The
+    /// soup keeps the intensity of a white light and the colour as each channel's share
+    /// of it, so the product is Unity's final light colour.
     pub fn light(self, gamma: Vec3, intensity: f32, temperature: Option<f32>) -> (Vec3, f32) {
         if self.gamma_space {
             return (gamma, intensity);
