@@ -4,7 +4,7 @@
 
 use formats::ColorSpace;
 use libfuzzer_sys::fuzz_target;
-use unity::light::{LightUnits, UniversalShadows};
+use unity::light::{LightUnits, UniversalAsset};
 use unity::project::{color_space, PipelineAsset, Pipeline};
 use unity::quality;
 
@@ -17,7 +17,7 @@ fuzz_target!(|data: &[u8]| {
     let _ = quality::render_pipeline_asset(&text);
     let _ = PipelineAsset::of(Some(&text), Some(&text));
     let _ = color_space(&text);
-    let _ = UniversalShadows::of_asset(&text);
+    let _ = UniversalAsset::of_asset(&text);
     for pipeline in [Pipeline::BuiltIn, Pipeline::Universal, Pipeline::HighDefinition] {
         let units = LightUnits::of(pipeline, Some(&text), ColorSpace::Linear);
         // Whatever the file says, a finite light stays finite.

@@ -164,7 +164,7 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
             e.light(gi, c)?;
         }
     }
-    e.universal_shadow_rules();
+    e.universal_rules();
     e.decode_textures();
     e.soup.warnings.extend(camera_warnings);
     // Only an intensity other than 1 lights differently in the two conventions.

@@ -87,45 +87,63 @@ impl LightUnits {
     }
 }
 
-/// The shadows a URP pipeline asset supports (`UniversalRenderPipelineAsset`'s fields;
+/// What a URP pipeline asset lets lights do (`UniversalRenderPipelineAsset`'s fields;
 /// where a field is missing, the default the asset's class gives it).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct UniversalShadows {
+pub struct UniversalAsset {
+    /// `m_MainLightRenderingMode` not Disabled (default Per Pixel): there is a main light.
+    pub main_light: bool,
+    /// `m_AdditionalLightsRenderingMode` not Disabled (default Per Pixel): lights other
+    /// than the main one light anything (per vertex is drawn per pixel here).
+    pub additional_lights: bool,
     /// `m_MainLightShadowsSupported` (default on).
-    pub main: bool,
+    pub main_shadows: bool,
     /// `m_AdditionalLightShadowsSupported`: point and spot lights (default off).
-    pub additional: bool,
+    pub additional_shadows: bool,
     /// `m_SoftShadowsSupported` (default off: soft shadows are drawn hard).
-    pub soft: bool,
+    pub soft_shadows: bool,
 }
 
-impl UniversalShadows {
+impl UniversalAsset {
     /// The settings of a pipeline asset's text; `None` when it holds no URP asset.
-    pub fn of_asset(text: &str) -> Option<UniversalShadows> {
+    pub fn of_asset(text: &str) -> Option<UniversalAsset> {
         let body = docs::split(text)
             .into_iter()
             .filter(|d| d.class == docs::MONO_BEHAVIOUR)
             .map(|d| d.parse())
             .find(|b| b.get("m_MainLightShadowsSupported").is_some())?;
         let flag = |key: &str, default: bool| body.i64_at(key).map_or(default, |v| v != 0);
-        Some(UniversalShadows {
-            main: flag("m_MainLightShadowsSupported", true),
-            additional: flag("m_AdditionalLightShadowsSupported", false),
-            soft: flag("m_SoftShadowsSupported", false),
+        Some(UniversalAsset {
+            main_light: flag("m_MainLightRenderingMode", true),
+            additional_lights: flag("m_AdditionalLightsRenderingMode", true),
+            main_shadows: flag("m_MainLightShadowsSupported", true),
+            additional_shadows: flag("m_AdditionalLightShadowsSupported", false),
+            soft_shadows: flag("m_SoftShadowsSupported", false),
         })
     }
 }
 
-/// Applies URP's shadow rules to a URP scene's `lights`: of the directional lights only
-/// the main light casts shadows (the light RenderSettings names, `sun`, when it is
-/// directional, else the first of the brightest by intensity), and where the pipeline
-/// asset is known (`asset`), its switches for the main light, point and spot lights and
-/// soft shadows. Returns how many lights' shadows changed.
-pub fn universal_shadows(
+/// What URP's rules left of a scene's lights.
+#[derive(Debug, PartialEq, Eq)]
+pub struct UniversalLights {
+    /// How many lights' shadows the rules changed.
+    pub shadows_changed: usize,
+    /// Per light, whether URP draws it at all.
+    pub drawn: Vec<bool>,
+}
+
+/// Applies URP's rules to a URP scene's `lights`. Its main light is the light
+/// RenderSettings names (`sun`) when that is directional, else the first of the
+/// brightest directional lights by intensity, and of the directional lights only it casts
+/// shadows. Where the pipeline asset is known (`asset`): without main-light rendering
+/// there is no main light, and every light is an additional one; without additional
+/// lights only the main light is drawn; its switches for main-light, additional-light
+/// (point, spot) and soft shadows apply.
+pub fn universal_rules(
     lights: &mut [Light],
     sun: Option<usize>,
-    asset: Option<UniversalShadows>,
-) -> usize {
+    asset: Option<UniversalAsset>,
+) -> UniversalLights {
     let directional = |l: &Light| matches!(l.kind, LightKind::Directional);
     let main = sun
         .filter(|&i| lights.get(i).is_some_and(directional))
@@ -137,26 +155,33 @@ pub fn universal_shadows(
                 }
             }
             best.map(|b| b.0)
-        });
-    let mut changed = 0;
+        })
+        .filter(|_| asset.is_none_or(|a| a.main_light));
+    let mut shadows_changed = 0;
+    let mut drawn = Vec::with_capacity(lights.len());
     for (i, l) in lights.iter_mut().enumerate() {
+        let is_main = Some(i) == main;
+        drawn.push(is_main || asset.is_none_or(|a| a.additional_lights));
         let casts = match (directional(l), asset) {
-            (true, _) if Some(i) != main => false,
-            (true, Some(a)) => a.main,
-            (false, Some(a)) => a.additional,
+            (true, _) if !is_main => false,
+            (true, Some(a)) => a.main_shadows,
+            (false, Some(a)) => a.additional_shadows,
             (_, None) => true,
         };
         let shadows = match l.shadows {
             _ if !casts => Shadows::None,
-            Shadows::Soft if asset.is_some_and(|a| !a.soft) => Shadows::Hard,
+            Shadows::Soft if asset.is_some_and(|a| !a.soft_shadows) => Shadows::Hard,
             asked => asked,
         };
         if shadows != l.shadows {
             l.shadows = shadows;
-            changed += 1;
+            shadows_changed += 1;
         }
     }
-    changed
+    UniversalLights {
+        shadows_changed,
+        drawn,
+    }
 }
 
 /// Unity's linear RGB of a black body at `kelvin` (clamped to 1,000–40,000 K), white near
@@ -306,15 +331,16 @@ impl Emitter<'_, '_> {
             .position(|&(file, id)| sun != 0 && file == 0 && id == sun)
     }
 
-    /// URP's shadow rules on the converted lights, said once where they change any.
-    pub(crate) fn universal_shadow_rules(&mut self) {
+    /// URP's rules on the converted lights, said once where they change any.
+    pub(crate) fn universal_rules(&mut self) {
         let g = self.g;
         if g.project.pipeline != Pipeline::Universal {
             return;
         }
         let sun = g.render_settings.as_ref().and_then(|rs| self.sun(rs));
-        let asset = g.project.universal_shadows;
-        let changed = universal_shadows(&mut self.soup.lights, sun, asset);
+        let asset = g.project.universal_asset;
+        let out = universal_rules(&mut self.soup.lights, sun, asset);
+        let changed = out.shadows_changed;
         if changed > 0 {
             let rules = if asset.is_some() {
                 "its main light alone among directional lights, and as its pipeline asset \
@@ -326,6 +352,18 @@ impl Emitter<'_, '_> {
                 "{}: URP draws shadows for {rules}: {changed} light(s) traced so",
                 self.scene_rel
             ));
+        }
+        let dropped = out.drawn.iter().filter(|&&d| !d).count();
+        if dropped > 0 {
+            self.soup.warnings.push(format!(
+                "{}: the URP pipeline asset renders no additional lights (or no main light): \
+                 {dropped} light(s) not drawn, as in Unity",
+                self.scene_rel
+            ));
+            let mut keep = out.drawn.iter().copied();
+            self.soup.lights.retain(|_| keep.next().unwrap_or(true));
+            let mut keep = out.drawn.iter().copied();
+            self.light_ids.retain(|_| keep.next().unwrap_or(true));
         }
     }
 
@@ -446,6 +484,19 @@ mod tests {
         }
     }
 
+    /// A URP asset with every light and shadow on, `change`d.
+    fn urp_asset(change: impl FnOnce(&mut UniversalAsset)) -> Option<UniversalAsset> {
+        let mut a = UniversalAsset {
+            main_light: true,
+            additional_lights: true,
+            main_shadows: true,
+            additional_shadows: true,
+            soft_shadows: true,
+        };
+        change(&mut a);
+        Some(a)
+    }
+
     #[test]
     fn urp_casts_directional_shadows_from_its_main_light_alone() {
         let sun = |i| light(LightKind::Directional, i, Shadows::Soft);
@@ -453,65 +504,79 @@ mod tests {
         let shadows = |ls: &[Light]| ls.iter().map(|l| l.shadows).collect::<Vec<_>>();
         // The brightest directional light is the main one; the first of equals wins.
         let mut ls = vec![sun(1.0), sun(2.0), sun(2.0), lamp.clone()];
-        assert_eq!(universal_shadows(&mut ls, None, None), 2);
+        let out = universal_rules(&mut ls, None, None);
+        assert_eq!(out.shadows_changed, 2);
+        assert_eq!(out.drawn, [true; 4]);
         let (s, n) = (Shadows::Soft, Shadows::None);
         assert_eq!(shadows(&ls), [n, s, n, s]);
         // RenderSettings' sun wins over brightness, unless it is not directional.
         let mut ls = vec![sun(1.0), sun(2.0), lamp.clone()];
-        universal_shadows(&mut ls, Some(0), None);
+        universal_rules(&mut ls, Some(0), None);
         assert_eq!(shadows(&ls), [s, n, s]);
         let mut ls = vec![sun(1.0), sun(2.0), lamp.clone()];
-        universal_shadows(&mut ls, Some(2), None);
+        universal_rules(&mut ls, Some(2), None);
         assert_eq!(shadows(&ls), [n, s, s]);
         // A directional light of intensity 0 is never the main light.
         let mut ls = vec![sun(0.0)];
-        universal_shadows(&mut ls, None, None);
+        universal_rules(&mut ls, None, None);
         assert_eq!(shadows(&ls), [n]);
         // The asset's switches.
-        let asset = |main, additional, soft| {
-            Some(UniversalShadows {
-                main,
-                additional,
-                soft,
-            })
-        };
         let h = Shadows::Hard;
-        for (a, want) in [
-            (asset(true, true, true), [s, n, s]),
-            (asset(true, true, false), [h, n, h]),
-            (asset(true, false, false), [h, n, n]),
-            (asset(false, true, true), [n, n, s]),
+        let (t, f) = (true, false);
+        for (a, want, drawn) in [
+            (urp_asset(|_| {}), [s, n, s], [t, t, t]),
+            (urp_asset(|a| a.soft_shadows = false), [h, n, h], [t, t, t]),
+            (
+                urp_asset(|a| (a.soft_shadows, a.additional_shadows) = (false, false)),
+                [h, n, n],
+                [t, t, t],
+            ),
+            (urp_asset(|a| a.main_shadows = false), [n, n, s], [t, t, t]),
+            // Without additional lights only the main light is drawn.
+            (
+                urp_asset(|a| a.additional_lights = false),
+                [s, n, s],
+                [t, f, f],
+            ),
+            // Without a main light every light is an additional one: drawn, and no
+            // directional light casts a shadow.
+            (urp_asset(|a| a.main_light = false), [n, n, s], [t, t, t]),
+            (
+                urp_asset(|a| (a.main_light, a.additional_lights) = (false, false)),
+                [n, n, s],
+                [f, f, f],
+            ),
         ] {
             let mut ls = vec![sun(2.0), sun(1.0), lamp.clone()];
-            universal_shadows(&mut ls, None, a);
-            assert_eq!(shadows(&ls), want, "{a:?}");
+            let out = universal_rules(&mut ls, None, a);
+            assert_eq!(
+                (shadows(&ls), out.drawn),
+                (want.to_vec(), drawn.to_vec()),
+                "{a:?}"
+            );
         }
     }
 
     #[test]
-    fn a_urp_asset_says_which_shadows_it_supports() {
-        let text = "%YAML 1.1\n--- !u!114 &11400000\nMonoBehaviour:\n  m_Name: UniversalRP-HighQuality\n  m_MainLightShadowsSupported: 1\n  m_AdditionalLightShadowsSupported: 1\n  m_SoftShadowsSupported: 0\n";
-        let got = UniversalShadows::of_asset(text);
-        let want = UniversalShadows {
-            main: true,
-            additional: true,
-            soft: false,
-        };
-        assert_eq!(got, Some(want));
+    fn a_urp_asset_says_what_lights_and_shadows_it_renders() {
+        let text = "%YAML 1.1\n--- !u!114 &11400000\nMonoBehaviour:\n  m_Name: UniversalRP-HighQuality\n  m_MainLightRenderingMode: 1\n  m_AdditionalLightsRenderingMode: 2\n  m_MainLightShadowsSupported: 1\n  m_AdditionalLightShadowsSupported: 1\n  m_SoftShadowsSupported: 0\n";
+        let got = UniversalAsset::of_asset(text);
+        assert_eq!(got, urp_asset(|a| a.soft_shadows = false));
+        let off = text.replace("RenderingMode: 2", "RenderingMode: 0");
+        let want = urp_asset(|a| (a.soft_shadows, a.additional_lights) = (false, false));
+        assert_eq!(UniversalAsset::of_asset(&off), want);
         // Fields an older asset lacks take the class's defaults.
         let old = "--- !u!114 &1\nMonoBehaviour:\n  m_MainLightShadowsSupported: 0\n";
-        let want = UniversalShadows {
-            main: false,
-            additional: false,
-            soft: false,
-        };
-        assert_eq!(UniversalShadows::of_asset(old), Some(want));
+        let want = urp_asset(|a| {
+            (a.main_shadows, a.additional_shadows, a.soft_shadows) = (false, false, false)
+        });
+        assert_eq!(UniversalAsset::of_asset(old), want);
         for other in [
             "",
             "--- !u!114 &1\nMonoBehaviour:\n  m_Name: x\n",
             "\0\u{fffd}",
         ] {
-            assert_eq!(UniversalShadows::of_asset(other), None, "{other:?}");
+            assert_eq!(UniversalAsset::of_asset(other), None, "{other:?}");
         }
     }
 

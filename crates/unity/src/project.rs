@@ -5,7 +5,7 @@
 
 use crate::docs;
 use crate::fbx;
-use crate::light::{LightUnits, UniversalShadows};
+use crate::light::{LightUnits, UniversalAsset};
 use crate::meta::{GuidIndex, ModelMeta};
 use crate::model::Model;
 use crate::obj;
@@ -164,8 +164,8 @@ pub struct Project {
     pub unassigned_pipeline: Option<Pipeline>,
     /// The assigned render pipeline asset's file, where the project holds it.
     pub pipeline_asset: Option<PathBuf>,
-    /// The shadows a URP project's assigned pipeline asset supports, where it is found.
-    pub universal_shadows: Option<UniversalShadows>,
+    /// What a URP project's assigned pipeline asset lets lights do, where it is found.
+    pub universal_asset: Option<UniversalAsset>,
     /// How lights' colours and intensities combine, from the pipeline and
     /// `ProjectSettings/GraphicsSettings.asset`.
     pub light_units: LightUnits,
@@ -237,11 +237,11 @@ impl Project {
             PipelineAsset::Assigned(Some(guid)) => guids.get(guid).cloned(),
             _ => None,
         };
-        let universal_shadows = pipeline_asset
+        let universal_asset = pipeline_asset
             .as_deref()
             .filter(|_| pipeline == Pipeline::Universal)
             .and_then(settings_text)
-            .and_then(|text| UniversalShadows::of_asset(&text));
+            .and_then(|text| UniversalAsset::of_asset(&text));
         let unassigned_pipeline = (pipeline != listed).then_some(listed);
         let lod_bias = quality
             .as_deref()
@@ -266,7 +266,7 @@ impl Project {
             pipeline,
             unassigned_pipeline,
             pipeline_asset,
-            universal_shadows,
+            universal_asset,
             light_units,
             light_units_assumed,
             color_space,
@@ -285,12 +285,15 @@ impl Project {
         let mut pipeline = self.pipeline.name().to_string();
         if let Some(path) = &self.pipeline_asset {
             pipeline += &format!(" (asset {}", self.rel(path));
-            if let Some(u) = self.universal_shadows {
+            if let Some(u) = self.universal_asset {
                 pipeline += &format!(
-                    ": main-light shadows {}, additional-light shadows {}, soft shadows {}",
-                    on(u.main),
-                    on(u.additional),
-                    on(u.soft)
+                    ": main light {}, additional lights {}, main-light shadows {}, \
+                     additional-light shadows {}, soft shadows {}",
+                    on(u.main_light),
+                    on(u.additional_lights),
+                    on(u.main_shadows),
+                    on(u.additional_shadows),
+                    on(u.soft_shadows)
                 );
             }
             pipeline += ")";

@@ -729,18 +729,20 @@ fn a_urp_projects_pipeline_asset_decides_which_lights_cast_shadows() {
     let guid = "19ba41d7c0026c3459d37c2fe90c55a0";
     let graphics = format!("{HEADER}--- !u!30 &1\nGraphicsSettings:\n  m_CustomRenderPipeline: {{fileID: 11400000, guid: {guid}, type: 2}}\n");
     let meta = format!("fileFormatVersion: 2\nguid: {guid}\n");
-    let asset = |additional: i32, soft: i32| {
-        format!("{HEADER}--- !u!114 &11400000\nMonoBehaviour:\n  m_Name: URP\n  m_MainLightShadowsSupported: 1\n  m_AdditionalLightShadowsSupported: {additional}\n  m_SoftShadowsSupported: {soft}\n")
+    let asset = |lights: i32, shadows: i32, soft: i32| {
+        format!("{HEADER}--- !u!114 &11400000\nMonoBehaviour:\n  m_Name: URP\n  m_AdditionalLightsRenderingMode: {lights}\n  m_MainLightShadowsSupported: 1\n  m_AdditionalLightShadowsSupported: {shadows}\n  m_SoftShadowsSupported: {soft}\n")
     };
     let (s, h, n) = (Shadows::Soft, Shadows::Hard, Shadows::None);
-    let cases = [
+    let cases: [(Option<String>, &[Shadows], &str); 4] = [
         // Without the asset only the main light rule holds: the second sun (equal
         // intensity, later) casts none.
-        (None, [s, n, s]),
-        (Some(asset(1, 1)), [s, n, s]),
-        (Some(asset(0, 0)), [h, n, n]),
+        (None, &[s, n, s], "URP; "),
+        (Some(asset(1, 1, 1)), &[s, n, s], "on, on, on"),
+        (Some(asset(1, 0, 0)), &[h, n, n], "on, off, off"),
+        // Without additional lights only the main light is left.
+        (Some(asset(0, 1, 1)), &[s], "off, on, on"),
     ];
-    for (asset, want) in cases {
+    for (asset, want, read) in cases {
         let mut files = vec![
             ("Assets/s.unity", sc.text.as_str()),
             ("Packages/manifest.json", urp),
@@ -756,10 +758,19 @@ fn a_urp_projects_pipeline_asset_decides_which_lights_cast_shadows() {
         let got: Vec<Shadows> = r.soup.lights.iter().map(|l| l.shadows).collect();
         assert_eq!(got, want, "{asset:?}");
         assert_warned(&r.soup, "URP draws shadows for its main light alone");
-        // `--list`'s summary names the asset and what it supports.
+        let dropped = r
+            .soup
+            .warnings
+            .iter()
+            .any(|w| w.contains("2 light(s) not drawn"));
+        assert_eq!(dropped, want.len() == 1, "{:?}", r.soup.warnings);
+        // `--list`'s summary names the asset and what it lets lights do.
         let read = match &asset {
-            None => "URP; ".to_string(),
-            Some(_) => format!("URP (asset Assets/Settings/URP.asset: main-light shadows on, additional-light shadows {0}, soft shadows {0}); ", if want[2] == s { "on" } else { "off" }),
+            None => read.to_string(),
+            Some(_) => {
+                let f: Vec<&str> = read.split(", ").collect();
+                format!("URP (asset Assets/Settings/URP.asset: main light on, additional lights {}, main-light shadows on, additional-light shadows {}, soft shadows {}); ", f[0], f[1], f[2])
+            }
         };
         assert!(r.settings.starts_with(&read), "{}", r.settings);
     }
