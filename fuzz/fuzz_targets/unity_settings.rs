@@ -5,7 +5,7 @@
 use formats::ColorSpace;
 use libfuzzer_sys::fuzz_target;
 use unity::light::{LightUnits, UniversalAsset};
-use unity::project::{color_space, PipelineAsset, Pipeline};
+use unity::settings::{color_space, Pipeline, PipelineAsset};
 use unity::quality;
 
 fuzz_target!(|data: &[u8]| {

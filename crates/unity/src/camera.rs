@@ -94,7 +94,7 @@ impl Emitter<'_, '_> {
         self.camera_mask = crate::layer::culling_mask(b);
         self.soup.environment.clear = clear_flags(b);
         if let Some(bg) = b.get("m_BackGroundColor").and_then(Node::color) {
-            self.soup.environment.background = shaded_rgb(bg, g.project.color_space);
+            self.soup.environment.background = shaded_rgb(bg, g.project.settings.color_space);
         }
         Ok(())
     }

@@ -9,8 +9,8 @@ use crate::docs;
 use crate::graph::{is_transform, Graph, Obj};
 use crate::material::linear_to_srgb;
 use crate::mesh::Mesh;
-use crate::project::Pipeline;
 use crate::quality::ShadowQuality;
+use crate::settings::Pipeline;
 use formats::{ColorSpace, Soup};
 use glam::{Mat4, Vec3};
 use std::collections::HashMap;
@@ -168,7 +168,7 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
     e.decode_textures();
     e.soup.warnings.extend(camera_warnings);
     // Only an intensity other than 1 lights differently in the two conventions.
-    if g.project.light_units_assumed && e.soup.lights.iter().any(|l| l.intensity != 1.0) {
+    if g.project.settings.light_units_assumed && e.soup.lights.iter().any(|l| l.intensity != 1.0) {
         e.soup.warnings.push(
             "ProjectSettings/GraphicsSettings.asset is missing: lights take the built-in \
              pipeline's default, gamma colour × intensity decoded (intensity 0.5 lights as \
@@ -176,7 +176,7 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
                 .into(),
         );
     }
-    if let Some(listed) = g.project.unassigned_pipeline {
+    if let Some(listed) = g.project.settings.unassigned_pipeline {
         e.soup.warnings.push(format!(
             "Packages/manifest.json lists {}, but neither ProjectSettings/GraphicsSettings.asset \
              nor the current quality level assigns a render pipeline asset: Unity draws the \
@@ -184,7 +184,7 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
             listed.name()
         ));
     }
-    let quality_says = match g.project.shadow_quality {
+    let quality_says = match g.project.settings.shadow_quality {
         ShadowQuality::Disable => Some("disables shadows: no light casts one"),
         ShadowQuality::HardOnly => {
             Some("allows hard shadows only: soft-shadow lights cast hard ones")
@@ -199,13 +199,13 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
     if let Some(ambient) = g
         .render_settings
         .as_ref()
-        .and_then(|rs| crate::environment::ambient(rs, g.project.color_space))
+        .and_then(|rs| crate::environment::ambient(rs, g.project.settings.color_space))
     {
         e.soup.environment.ambient = ambient;
     }
     if let Some(rs) = &g.render_settings {
-        let hdrp = g.project.pipeline == Pipeline::HighDefinition;
-        match crate::environment::fog(rs, hdrp, g.project.color_space) {
+        let hdrp = g.project.settings.pipeline == Pipeline::HighDefinition;
+        match crate::environment::fog(rs, hdrp, g.project.settings.color_space) {
             Ok(fog) => e.soup.environment.fog = fog,
             Err(why) => e
                 .soup
@@ -222,7 +222,7 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
     }
     let placements = std::mem::take(&mut e.placements);
     placements.fill(&mut e.soup, &mut e.material_origins);
-    if g.project.color_space == ColorSpace::Gamma {
+    if g.project.settings.color_space == ColorSpace::Gamma {
         keep_gamma(&mut e.soup);
     }
     e.soup.seal();

@@ -33,6 +33,7 @@ pub mod project;
 pub mod quality;
 pub mod reference;
 pub mod renderer;
+pub mod settings;
 pub mod skinned_renderer;
 pub mod skybox;
 pub mod texture;
@@ -142,6 +143,6 @@ pub fn convert_report(scene: &Path, opts: &Options) -> Result<Report, ConvertErr
         cameras,
         material_origins,
         skipped,
-        settings: project.settings(),
+        settings: project.describe_settings(),
     })
 }

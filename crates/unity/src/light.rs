@@ -4,9 +4,10 @@
 use crate::docs;
 use crate::emit::{enabled, flip, EmitError, Emitter};
 use crate::material::{gamma_to_linear, srgb_to_linear};
-use crate::project::{Pipeline, Project};
+use crate::project::Project;
 use crate::quality::ShadowQuality;
 use crate::reference::fref;
+use crate::settings::Pipeline;
 use crate::yaml::Node;
 use formats::{Attenuation, ColorSpace, Light, LightKind, Shadows};
 use glam::{Mat4, Vec3, Vec4Swizzles};
@@ -235,7 +236,7 @@ pub fn convert(
     project: &Project,
     name: String,
 ) -> Option<(Light, Option<String>)> {
-    let pipeline = project.pipeline;
+    let pipeline = project.settings.pipeline;
     let directional = b.i64_at("m_Type").unwrap_or(2) == DIRECTIONAL;
     let angle = b.f32_at("m_SpotAngle").unwrap_or(30.0);
     let gamma = b
@@ -255,7 +256,7 @@ pub fn convert(
         2 => Shadows::Soft,
         _ => Shadows::None,
     };
-    let shadows = match (project.shadow_quality, shadows) {
+    let shadows = match (project.settings.shadow_quality, shadows) {
         (ShadowQuality::Disable, _) => Shadows::None,
         (ShadowQuality::HardOnly, Shadows::Soft) => Shadows::Hard,
         (_, asked) => asked,
@@ -285,7 +286,10 @@ pub fn convert(
         ));
         intensity = mapped;
     }
-    let (color, intensity) = project.light_units.light(gamma, intensity, temperature);
+    let (color, intensity) = project
+        .settings
+        .light_units
+        .light(gamma, intensity, temperature);
     let position = flip(world.w_axis.xyz());
     let direction = flip(world.transform_vector3(Vec3::Z)).normalize_or_zero();
     let all = [
@@ -334,11 +338,11 @@ impl Emitter<'_, '_> {
     /// URP's rules on the converted lights, said once where they change any.
     pub(crate) fn universal_rules(&mut self) {
         let g = self.g;
-        if g.project.pipeline != Pipeline::Universal {
+        if g.project.settings.pipeline != Pipeline::Universal {
             return;
         }
         let sun = g.render_settings.as_ref().and_then(|rs| self.sun(rs));
-        let asset = g.project.universal_asset;
+        let asset = g.project.settings.universal_asset;
         let out = universal_rules(&mut self.soup.lights, sun, asset);
         let changed = out.shadows_changed;
         if changed > 0 {

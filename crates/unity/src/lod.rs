@@ -148,7 +148,7 @@ impl Emitter<'_, '_> {
             size,
             camera.distance(point),
             projection,
-            self.g.project.lod_bias,
+            self.g.project.settings.lod_bias,
         )
     }
 }

@@ -5,8 +5,9 @@
 
 use crate::emit::Emitter;
 use crate::material::{gamma_to_linear, keyword_on, linear_rgb, prop, props, shaded_rgb};
-use crate::project::{ext, Pipeline, Project};
+use crate::project::{ext, Project};
 use crate::reference::fref;
+use crate::settings::Pipeline;
 use crate::texture::{load_linear, named_slot, Import, LinearImage};
 use crate::yaml::Node;
 use formats::{
@@ -64,7 +65,7 @@ pub fn skybox(
     if id == 0 {
         return Ok(None);
     }
-    if project.pipeline == Pipeline::HighDefinition {
+    if project.settings.pipeline == Pipeline::HighDefinition {
         return Err("HDRP ignores RenderSettings' skybox (its sky is a Volume override)".into());
     }
     if guid == BUILTIN_EXTRA && id == DEFAULT_SKYBOX {
@@ -102,7 +103,7 @@ pub fn skybox(
     // `_Exposure` is a [Gamma] property: a linear-space project takes it decoded. Its
     // inspector keeps it within the shader's range, 0–8.
     let exposure = p.float("_Exposure").unwrap_or(1.0).clamp(0.0, 8.0);
-    let space = project.color_space;
+    let space = project.settings.color_space;
     let tint = p
         .stored_colour("_Tint")
         .map(|c| shaded_rgb(c, space))
@@ -209,7 +210,7 @@ fn image(
     let (path, source) = texture_file(body, property, project)?;
     let mut import = Import::read(&path);
     // A gamma-space project's shaders take texels as stored.
-    import.srgb &= project.color_space == ColorSpace::Linear;
+    import.srgb &= project.settings.color_space == ColorSpace::Linear;
     let img = load(&path, &source, property, &import, resize)?;
     Ok((img, import, source))
 }
