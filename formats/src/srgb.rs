@@ -1,13 +1,37 @@
-//! Linear values to 8-bit sRGB codes, exactly as the transfer function rounds them, without
-//! calling `powf` per value: the preview's bytes and the 8-bit mip levels of sRGB textures.
-//! (The other way, code to linear, is a 256-entry table: [`crate::texture::decode_u8`].)
+//! The sRGB transfer functions on floats, both ways, and Unity's gamma-to-linear conversion
+//! (the converter's colours, the renderer's gamma-space frames); and linear values to 8-bit
+//! sRGB codes, exactly as the transfer function rounds them, without calling `powf` per
+//! value: the preview's bytes and the 8-bit mip levels of sRGB textures. (8-bit codes to
+//! linear are a 256-entry table: [`crate::texture::decode_u8`].)
 
-/// The sRGB opto-electronic transfer function (IEC 61966-2-1) on a linear value in [0, 1].
-fn srgb_oetf(c: f32) -> f32 {
+/// The sRGB opto-electronic transfer function (IEC 61966-2-1), linear to encoded; above 1
+/// it follows the same curve (Unity's HDR colours are encoded so).
+pub fn linear_to_srgb(c: f32) -> f32 {
     if c <= 0.003_130_8 {
         12.92 * c
     } else {
         1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// The sRGB electro-optical transfer function, encoded to linear: the inverse of
+/// [`linear_to_srgb`], above 1 too.
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Unity's gamma-to-linear conversion of a value that may exceed 1 (a `[Gamma]` float, a
+/// light's colour times its intensity, a gamma-space frame's pixel): the sRGB curve up to
+/// 1, x^2.2 above.
+pub fn gamma_to_linear(x: f32) -> f32 {
+    if x <= 1.0 {
+        srgb_to_linear(x)
+    } else {
+        x.powf(2.2)
     }
 }
 
@@ -20,7 +44,7 @@ pub fn encode(linear: f32) -> u8 {
 /// [`encode`] through the transfer function itself, on a value in [0, 1]: what [`Encoder`]
 /// is built from, and gives back exactly.
 fn encode_by_powf(v: f32) -> u8 {
-    (srgb_oetf(v) * 255.0 + 0.5) as u8
+    (linear_to_srgb(v) * 255.0 + 0.5) as u8
 }
 
 /// Buckets of [`Encoder`]: [0, 1] in equal steps, few enough that a bucket's table stays in

@@ -152,18 +152,14 @@ fn render_tiles(
 }
 
 /// A gamma-space project's pixel as the display shows it, in linear RGB: its frame holds
-/// sRGB-encoded values (Unity's gamma-to-linear conversion: the sRGB curve to 1, x^2.2
-/// above; negative values, which no colour has, as 0).
+/// sRGB-encoded values (Unity's gamma-to-linear conversion; negative values, which no
+/// colour has, as 0).
 fn decode(c: Vec3) -> Vec3 {
     c.map(|v| {
         if v <= 0.0 {
             0.0
-        } else if v <= 0.04045 {
-            v / 12.92
-        } else if v <= 1.0 {
-            ((v + 0.055) / 1.055).powf(2.4)
         } else {
-            v.powf(2.2)
+            formats::srgb::gamma_to_linear(v)
         }
     })
 }

@@ -9,7 +9,6 @@ use crate::docs;
 use crate::graph::{is_transform, Graph, Obj};
 use crate::material::linear_to_srgb;
 use crate::mesh::Mesh;
-use crate::quality::ShadowQuality;
 use crate::settings::Pipeline;
 use formats::{ColorSpace, Soup};
 use glam::{Mat4, Vec3};
@@ -167,35 +166,8 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
     e.universal_rules();
     e.decode_textures();
     e.soup.warnings.extend(camera_warnings);
-    // Only an intensity other than 1 lights differently in the two conventions.
-    if g.project.settings.light_units_assumed && e.soup.lights.iter().any(|l| l.intensity != 1.0) {
-        e.soup.warnings.push(
-            "ProjectSettings/GraphicsSettings.asset is missing: lights take the built-in \
-             pipeline's default, gamma colour × intensity decoded (intensity 0.5 lights as \
-             0.21, 2 as 4.6); a project set to Lights Use Linear Intensity looks different"
-                .into(),
-        );
-    }
-    if let Some(listed) = g.project.settings.unassigned_pipeline {
-        e.soup.warnings.push(format!(
-            "Packages/manifest.json lists {}, but neither ProjectSettings/GraphicsSettings.asset \
-             nor the current quality level assigns a render pipeline asset: Unity draws the \
-             project with the built-in pipeline, and so does unitrace",
-            listed.name()
-        ));
-    }
-    let quality_says = match g.project.settings.shadow_quality {
-        ShadowQuality::Disable => Some("disables shadows: no light casts one"),
-        ShadowQuality::HardOnly => {
-            Some("allows hard shadows only: soft-shadow lights cast hard ones")
-        }
-        ShadowQuality::All => None,
-    };
-    if let Some(says) = quality_says.filter(|_| !e.soup.lights.is_empty()) {
-        e.soup.warnings.push(format!(
-            "ProjectSettings/QualitySettings.asset: the current quality level {says}, as in Unity"
-        ));
-    }
+    let notes = g.project.settings.notes(&e.soup.lights);
+    e.soup.warnings.extend(notes);
     if let Some(ambient) = g
         .render_settings
         .as_ref()

@@ -8,6 +8,7 @@ use crate::model::Model;
 use crate::project::ModelError;
 use crate::reference::Ref;
 use crate::yaml::Node;
+pub use formats::srgb::{gamma_to_linear, linear_to_srgb, srgb_to_linear};
 use formats::{Alpha, ColorSpace, Cull, Material};
 use glam::{Vec3, Vec4};
 use std::borrow::Cow;
@@ -18,35 +19,6 @@ const BUILTIN_EXTRA_GUID: &str = "0000000000000000f000000000000000";
 
 /// Default-Material's fileID among the built-in extra resources.
 const DEFAULT_MATERIAL_ID: i64 = 10303;
-
-/// sRGB electro-optical transfer function, per channel; HDR values above 1 follow the
-/// same curve (Unity stores HDR colours gamma-encoded too).
-pub fn srgb_to_linear(c: f32) -> f32 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-/// Unity's gamma-to-linear conversion of a value that may exceed 1 (a `[Gamma]` float, a
-/// light's colour times its intensity): the sRGB curve up to 1, x^2.2 above.
-pub fn gamma_to_linear(x: f32) -> f32 {
-    if x <= 1.0 {
-        srgb_to_linear(x)
-    } else {
-        x.powf(2.2)
-    }
-}
-
-/// The inverse of [`srgb_to_linear`], above 1 too.
-pub fn linear_to_srgb(c: f32) -> f32 {
-    if c <= 0.003_130_8 {
-        c * 12.92
-    } else {
-        1.055 * c.powf(1.0 / 2.4) - 0.055
-    }
-}
 
 /// A stored colour as a project in colour space `space` shades it: decoded to linear in a
 /// linear project, as stored in a gamma one.
@@ -354,6 +326,18 @@ impl Emitter<'_, '_> {
         (i, origin)
     }
 
+    /// The texture maps of material `m`, converted from Material `body` (`what` names it
+    /// in warnings).
+    fn mat_maps(&mut self, m: &mut Material, body: &Node, what: &str) {
+        m.albedo_map = self.mat_albedo(body, what);
+        // Unlit shaders sample no normal, emission or occlusion map.
+        if !m.unlit {
+            m.normal_map = self.mat_normal(body, what);
+            m.emission_map = self.mat_emission(body, m.emission, what);
+            m.occlusion_map = self.mat_occlusion(body, what);
+        }
+    }
+
     /// A Material document of file `file` (guid-less reference).
     fn embedded_material(&mut self, id: i64, file: usize, what: &str) -> (u32, String) {
         let key = format!("local:{file}:{id}");
@@ -370,13 +354,7 @@ impl Emitter<'_, '_> {
             Some((docs::MATERIAL, body)) => {
                 let body = self.inherit(&body, &src);
                 let (mut m, _notes) = convert(&body, &src);
-                m.albedo_map = self.mat_albedo(&body, &src);
-                // Unlit shaders sample no normal, emission or occlusion map.
-                if !m.unlit {
-                    m.normal_map = self.mat_normal(&body, &src);
-                    m.emission_map = self.mat_emission(&body, m.emission, &src);
-                    m.occlusion_map = self.mat_occlusion(&body, &src);
-                }
+                self.mat_maps(&mut m, &body, &src);
                 (self.add_material(key, || m), format!("override {src}"))
             }
             _ => {
@@ -401,13 +379,7 @@ impl Emitter<'_, '_> {
                 for n in notes {
                     self.soup.warnings.push(format!("{rel}: {n}"));
                 }
-                m.albedo_map = self.mat_albedo(&b, &rel);
-                // Unlit shaders sample no normal, emission or occlusion map.
-                if !m.unlit {
-                    m.normal_map = self.mat_normal(&b, &rel);
-                    m.emission_map = self.mat_emission(&b, m.emission, &rel);
-                    m.occlusion_map = self.mat_occlusion(&b, &rel);
-                }
+                self.mat_maps(&mut m, &b, &rel);
                 self.add_material(key, || m)
             }
             Ok(None) => self.warn_default(what, format!("{rel} holds no Material")),

@@ -8,7 +8,7 @@ use crate::docs;
 use crate::light::{LightUnits, UniversalAsset};
 use crate::meta::GuidIndex;
 use crate::quality::ShadowQuality;
-use formats::ColorSpace;
+use formats::{ColorSpace, Light};
 use std::path::{Path, PathBuf};
 
 /// The render pipeline a project draws with. Its lights, sky and fog follow that
@@ -188,6 +188,42 @@ impl Settings {
                 .and_then(crate::quality::lod_bias)
                 .unwrap_or(1.0),
         }
+    }
+
+    /// What a scene lit by `lights` should be told of these settings: defaults assumed for
+    /// a missing file, a pipeline package left unassigned, shadows the quality level limits.
+    pub fn notes(&self, lights: &[Light]) -> Vec<String> {
+        let mut notes = Vec::new();
+        // Only an intensity other than 1 lights differently in the two conventions.
+        if self.light_units_assumed && lights.iter().any(|l| l.intensity != 1.0) {
+            notes.push(
+                "ProjectSettings/GraphicsSettings.asset is missing: lights take the built-in \
+                 pipeline's default, gamma colour × intensity decoded (intensity 0.5 lights as \
+                 0.21, 2 as 4.6); a project set to Lights Use Linear Intensity looks different"
+                    .into(),
+            );
+        }
+        if let Some(listed) = self.unassigned_pipeline {
+            notes.push(format!(
+                "Packages/manifest.json lists {}, but neither ProjectSettings/GraphicsSettings.asset \
+                 nor the current quality level assigns a render pipeline asset: Unity draws the \
+                 project with the built-in pipeline, and so does unitrace",
+                listed.name()
+            ));
+        }
+        let quality_says = match self.shadow_quality {
+            ShadowQuality::Disable => Some("disables shadows: no light casts one"),
+            ShadowQuality::HardOnly => {
+                Some("allows hard shadows only: soft-shadow lights cast hard ones")
+            }
+            ShadowQuality::All => None,
+        };
+        if let Some(says) = quality_says.filter(|_| !lights.is_empty()) {
+            notes.push(format!(
+                "ProjectSettings/QualitySettings.asset: the current quality level {says}, as in Unity"
+            ));
+        }
+        notes
     }
 
     /// What was read, in one line (for `--list`); `rel` names the pipeline asset's file.

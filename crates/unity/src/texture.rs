@@ -551,13 +551,9 @@ pub fn decode(
         let bytes: Vec<u8> = img
             .pixels()
             .flat_map(|p| {
-                let q = |c: f32| (c * 255.0 + 0.5) as u8;
-                [
-                    q(crate::material::linear_to_srgb(p[0].clamp(0.0, 1.0))),
-                    q(crate::material::linear_to_srgb(p[1].clamp(0.0, 1.0))),
-                    q(crate::material::linear_to_srgb(p[2].clamp(0.0, 1.0))),
-                    q(p[3].clamp(0.0, 1.0)),
-                ]
+                let q = |c: f32| (c.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+                let encode = |c: f32| q(formats::srgb::linear_to_srgb(c.clamp(0.0, 1.0)));
+                [encode(p[0]), encode(p[1]), encode(p[2]), q(p[3])]
             })
             .collect();
         (bytes, true)
