@@ -7,6 +7,7 @@ use crate::emit::Emitter;
 use crate::model::Model;
 use crate::project::ModelError;
 use crate::reference::Ref;
+use crate::settings::Pipeline;
 use crate::yaml::Node;
 pub use formats::srgb::{gamma_to_linear, linear_to_srgb, srgb_to_linear};
 use formats::{Alpha, ColorSpace, Cull, Material};
@@ -19,6 +20,32 @@ const BUILTIN_EXTRA_GUID: &str = "0000000000000000f000000000000000";
 
 /// Default-Material's fileID among the built-in extra resources.
 const DEFAULT_MATERIAL_ID: i64 = 10303;
+
+/// The GUID of URP's own Lit material (the package's `Runtime/Materials/Lit.mat`), which URP
+/// gives every object made in its editor. It lives in the package cache, outside the
+/// project's folders, so it never resolves there.
+const URP_LIT_MATERIAL_GUID: &str = "31321ba15b8f8eb4c954353edc038b1d";
+
+/// That material's properties that change an image, as URP has shipped them since its first
+/// releases: the Lit shader, opaque, back faces culled, a mid-grey base colour (stored in
+/// sRGB), smoothness 0.5, not metallic, no emission and no maps.
+const URP_LIT_MATERIAL: &str = "--- !u!21 &2100000
+Material:
+  m_Name: Lit
+  m_Shader: {fileID: 4800000, guid: 933532a4fcc9baf4fa0491de14d08ed7, type: 3}
+  m_SavedProperties:
+    m_Floats:
+    - _AlphaClip: 0
+    - _Cull: 2
+    - _Metallic: 0
+    - _Smoothness: 0.5
+    - _Surface: 0
+    - _WorkflowMode: 1
+    m_Colors:
+    - _BaseColor: {r: 0.5, g: 0.5, b: 0.5, a: 1}
+    - _Color: {r: 0.5, g: 0.5, b: 0.5, a: 1}
+    - _EmissionColor: {r: 0, g: 0, b: 0, a: 1}
+";
 
 /// A stored colour as a project in colour space `space` shades it: decoded to linear in a
 /// linear project, as stored in a gamma one.
@@ -268,6 +295,26 @@ impl Emitter<'_, '_> {
         i
     }
 
+    /// URP's Lit material, where the project lists the URP package that holds it.
+    fn package_material(&mut self, guid: &str) -> Option<(u32, String)> {
+        let settings = &self.g.project.settings;
+        let urp = settings.pipeline == Pipeline::Universal
+            || settings.unassigned_pipeline == Some(Pipeline::Universal);
+        if guid != URP_LIT_MATERIAL_GUID || !urp {
+            return None;
+        }
+        let source = "package:com.unity.render-pipelines.universal/Runtime/Materials/Lit.mat";
+        let i = self.add_material(source.into(), || {
+            let body = docs::split(URP_LIT_MATERIAL)
+                .into_iter()
+                .find(|d| d.class == docs::MATERIAL)
+                .map(|d| d.parse())
+                .unwrap_or(Node::Map(vec![]));
+            convert(&body, source).0
+        });
+        Some((i, "URP's Lit.mat".into()))
+    }
+
     /// Unity's default material, with a warning about `what` saying why.
     fn warn_default(&mut self, what: &str, why: String) -> u32 {
         self.soup
@@ -300,6 +347,9 @@ impl Emitter<'_, '_> {
         }
         let project = self.g.project;
         let Some(path) = project.resolve(guid).cloned() else {
+            if let Some(found) = self.package_material(guid) {
+                return found;
+            }
             let why =
                 format!("material GUID {guid} is not in the project (a package or deleted asset)");
             return (self.warn_default(what, why), default());
@@ -421,6 +471,9 @@ impl Emitter<'_, '_> {
                 .find(|(ty, n, _)| ty == "UnityEngine:Material" && n == name);
             if let Some((_, _, guid)) = remap {
                 let Some(mat) = self.g.project.resolve(guid).cloned() else {
+                    if let Some(found) = self.package_material(guid) {
+                        return found;
+                    }
                     let why = format!(
                         "{rel}: material '{name}' is remapped to GUID {guid}, which is not in the project"
                     );

@@ -1032,6 +1032,42 @@ fn model_materials_take_the_mtl_colour() {
     assert_eq!(soup.materials[0].source, "Assets/two.obj#red");
 }
 
+#[test]
+fn urps_own_lit_material_is_mid_grey_where_the_project_lists_urp() {
+    // The URP package's Lit.mat lives in the package cache, never under Assets/.
+    let lit = (2100000, "31321ba15b8f8eb4c954353edc038b1d");
+    let sc = mesh_scene("Cube", 10202, BUILTIN, &[lit]);
+    let urp = "{\n  \"dependencies\": {\n    \"com.unity.render-pipelines.universal\": \"12.1.15\"\n  }\n}\n";
+    let (_d, root) = project(&[
+        ("Assets/s.unity", &sc.text),
+        ("Packages/manifest.json", urp),
+    ]);
+    let soup = convert(&root.join("Assets/s.unity"));
+    assert!(
+        !soup.warnings.iter().any(|w| w.contains("material")),
+        "{:?}",
+        soup.warnings
+    );
+    let m = &soup.materials[0];
+    // Its base colour, 0.5 in sRGB, is 0.2140 in linear.
+    assert!(close(m.color, Vec3::splat(0.21404114), 1e-6), "{}", m.color);
+    assert_eq!(
+        (m.smoothness, m.metallic, m.cull),
+        (0.5, 0.0, formats::Cull::Back)
+    );
+    assert_eq!(
+        m.source,
+        "package:com.unity.render-pipelines.universal/Runtime/Materials/Lit.mat"
+    );
+    // Without URP the GUID names nothing the project has.
+    let soup = convert_scene(&sc.text);
+    assert_warned(
+        &soup,
+        "31321ba15b8f8eb4c954353edc038b1d is not in the project",
+    );
+    assert_eq!(soup.materials[0].color, Vec3::ONE);
+}
+
 /// A MeshFilter whose mesh GUID is not in the project, on an object named after the only
 /// model, `Assets/Models/m.obj`.
 fn unresolved_mesh_project() -> (tempfile::TempDir, PathBuf) {

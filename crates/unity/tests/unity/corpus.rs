@@ -112,13 +112,13 @@ fn expectations() -> Vec<Expect> {
         // is the scene's, the other comes with a prefab instance.
         Expect { scene: "thespeedyboy__CreateWithVR2021/Assets/Scenes/TravisRoom.unity",
                  objects: 4 + 56, triangles: 2 * CUBE + PLANE + SPHERE + 13947 - 8,
-                 lights: 6, cameras: 2, warns: &["Foreground_Buildings", "31321ba15b8f8eb4c954353edc038b1d"] },
+                 lights: 6, cameras: 2, warns: &["Foreground_Buildings"] },
         // 6 Cubes and 41 FBX objects (the ASCII wall kit ×18 with the models' own
         // materials, guns), their faces 5391 triangles, 142 zero-area (9mm.pistol base
         // 132).
         Expect { scene: "thespeedyboy__CreateWithVR2021/Assets/Scenes/final.unity",
                  objects: 6 + 41, triangles: 6 * CUBE + 5391 - 142,
-                 lights: 1, cameras: 1, warns: &["31321ba15b8f8eb4c954353edc038b1d"] },
+                 lights: 1, cameras: 1, warns: &[] },
         // A Sphere (the player) and 5 FBX objects: the island (148) and SkyDome.fbx's
         // four meshes (160 + 18 + 66 + 20), from their faces, none zero-area.
         Expect { scene: "DarthTekin__Prototype4_CreateWithCode2_UnityLearn_05.04.2023/Assets/Scenes/Prototype 4.unity",
@@ -189,6 +189,34 @@ fn every_text_scene_converts_to_the_hand_derived_counts() {
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn urp_projects_draw_the_packages_lit_material_as_urp_ships_it() {
+    let Some(root) = corpus() else { return };
+    let scene = "Ayinzhang__Rigidbody-Fracture/Assets/Scenes/RigidbodyFracture.unity";
+    let soup = report(&root.join(scene)).soup;
+    assert!(soup.warnings.is_empty(), "{:#?}", soup.warnings);
+    // Five of the six objects (all but the glass cube) use URP's Lit.mat: mid grey.
+    let lit = soup
+        .materials
+        .iter()
+        .position(|m| {
+            m.source
+                .ends_with("com.unity.render-pipelines.universal/Runtime/Materials/Lit.mat")
+        })
+        .expect("URP's Lit material");
+    assert!(crate::support::close(
+        soup.materials[lit].color,
+        glam::Vec3::splat(0.21404114),
+        1e-6
+    ));
+    let users: std::collections::HashSet<u32> = (soup.tri_object.iter())
+        .zip(&soup.tri_material)
+        .filter(|(_, &m)| m == lit as u32)
+        .map(|(&o, _)| o)
+        .collect();
+    assert_eq!(users.len(), 5);
 }
 
 /// Σ (corners − 2) over the faces of each mesh node of an FBX file, by node name (the
