@@ -22,7 +22,7 @@ pub use sky::{Panorama, ProceduralSky, Sky, SkyImage, SkyLayout, SunDisk, Textur
 pub use soup::{
     Alpha, Ambient, AmbientMode, Attenuation, Camera, CastShadows, ClearFlags, ColorSpace, Cull,
     Environment, Fog, FogMode, Light, LightKind, Material, NormalMap, Object, OcclusionMap,
-    Projection, Shadows, Soup, SoupGeometry, SoupKey,
+    Projection, ShadowDistance, Shadows, Soup, SoupGeometry, SoupKey,
 };
 pub use texture::{Texture, TextureRef, Tiling};
 

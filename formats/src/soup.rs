@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 pub const MAGIC: &[u8; 8] = b"UTSOUP\0\0";
-pub const VERSION: u32 = 10;
+pub const VERSION: u32 = 11;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Soup {
@@ -457,6 +457,49 @@ pub struct Environment {
     pub sky: Option<Sky>,
     /// The colour space the project's shaders compute in.
     pub color_space: ColorSpace,
+    /// How far from the camera realtime shadows reach, where the project's pipeline limits
+    /// them (None: at any distance).
+    pub shadow_distance: Option<ShadowDistance>,
+}
+
+/// URP's shadow distance: beyond `distance` from the camera no realtime shadow is drawn,
+/// and the last stretch fades out over the `border` share of it (squared), as URP's
+/// shaders fade a shadow toward the lit value.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ShadowDistance {
+    /// The pipeline asset's Max Distance, metres.
+    pub distance: f32,
+    /// The last cascade's Border, 0–1 (a soup holding another value is refused); 0 cuts
+    /// shadows off at `distance`.
+    pub border: f32,
+}
+
+impl ShadowDistance {
+    /// Where shadows end seen from `camera`: the shadow distance, or the camera's far
+    /// plane where that is nearer (URP clamps one to the other).
+    pub fn far(&self, camera: &Camera) -> f32 {
+        if camera.far > camera.near {
+            self.distance.min(camera.far)
+        } else {
+            self.distance
+        }
+    }
+
+    /// The scale and bias URP's `GetScaleAndBiasForLinearDistanceFade` derives for a
+    /// shadow that ends `far` from the camera (the smaller of `distance` and the camera's far
+    /// plane): the fade at squared distance d² is clamp(d²·scale + bias, 0, 1), rising
+    /// linearly in d² from (1 − border)²·far² to far². A border under 10⁻⁴ makes it a step.
+    pub fn scale_bias(&self, far: f32) -> (f32, f32) {
+        // A far plane so near that its square is zero ends shadows at the camera.
+        let end = (far * far).max(f32::MIN_POSITIVE);
+        if self.border < 1e-4 {
+            let scale = 1000.0;
+            return (scale, -end * scale);
+        }
+        let keep = (1.0 - self.border).powi(2);
+        let start = keep * end;
+        (1.0 / (end - start), -start / (end - start))
+    }
 }
 
 /// The colour space a Unity project renders in (Player settings' Color Space).
@@ -489,6 +532,7 @@ impl Default for Environment {
             fog: None,
             sky: None,
             color_space: ColorSpace::Linear,
+            shadow_distance: None,
         }
     }
 }
@@ -650,6 +694,14 @@ impl Soup {
         }
         if let Some(sky) = &self.environment.sky {
             sky.validate()?;
+        }
+        if let Some(d) = self.environment.shadow_distance {
+            if !(d.distance > 0.0 && d.distance.is_finite() && (0.0..=1.0).contains(&d.border)) {
+                return Err(format!(
+                    "shadow distance {} with border {}",
+                    d.distance, d.border
+                ));
+            }
         }
         if !self.environment.ambient.intensity.is_finite() {
             return Err(format!(

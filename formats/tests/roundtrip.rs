@@ -139,7 +139,7 @@ fn soup_round_trips_through_a_file() {
     assert_eq!(Soup::read(&path).unwrap(), s);
     let bytes = std::fs::read(&path).unwrap();
     assert_eq!(&bytes[..8], b"UTSOUP\0\0");
-    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 10);
+    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 11);
     // Nothing but the artifact is left in the folder (the temp file was renamed).
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     // A gamma-space project's soup says so.
@@ -148,6 +148,58 @@ fn soup_round_trips_through_a_file() {
     g.write(&path).unwrap();
     assert_eq!(Soup::read(&path).unwrap(), g);
     assert_ne!(g, s);
+    // So does a URP project's shadow distance.
+    let mut u = sample_soup();
+    u.environment.shadow_distance = Some(ShadowDistance {
+        distance: 42.0,
+        border: 0.1,
+    });
+    u.write(&path).unwrap();
+    assert_eq!(Soup::read(&path).unwrap(), u);
+}
+
+#[test]
+fn a_shadow_distance_fades_as_urp_computes_it_and_must_be_sane() {
+    let d = ShadowDistance {
+        distance: 50.0,
+        border: 0.2,
+    };
+    // URP's fade runs linearly in d² from (0.8 · 50)² = 1600 to 2500.
+    let (scale, bias) = d.scale_bias(50.0);
+    let fade = |d2: f32| (d2 * scale + bias).clamp(0.0, 1.0);
+    assert!((scale - 1.0 / 900.0).abs() < 1e-9 && (bias + 1600.0 / 900.0).abs() < 1e-5);
+    assert!((fade(1600.0)).abs() < 1e-5 && (fade(2050.0) - 0.5).abs() < 1e-5);
+    assert_eq!(fade(2500.0 + 1.0), 1.0);
+    // A near far plane caps it; no border cuts shadows off at the distance.
+    let mut camera = Soup::empty().camera;
+    camera.far = 30.0;
+    assert_eq!(d.far(&camera), 30.0);
+    camera.far = 0.0;
+    assert_eq!(
+        d.far(&camera),
+        50.0,
+        "no far plane beyond the near one: no cap"
+    );
+    let cut = ShadowDistance { border: 0.0, ..d };
+    let (scale, bias) = cut.scale_bias(50.0);
+    assert_eq!(
+        (
+            (2499.0 * scale + bias).max(0.0),
+            2501.0 * scale + bias >= 1.0
+        ),
+        (0.0, true)
+    );
+    for (distance, border) in [
+        (0.0, 0.2),
+        (f32::INFINITY, 0.2),
+        (10.0, 1.5),
+        (10.0, f32::NAN),
+    ] {
+        refused(
+            &|s| s.environment.shadow_distance = Some(ShadowDistance { distance, border }),
+            &format!("shadow distance {distance} with border {border}"),
+        );
+    }
 }
 
 /// A killed writer's temporary is removed by the next write into its folder once it is
@@ -775,13 +827,13 @@ fn atomic_outputs_get_the_umask_permissions_not_the_temporary_files() {
 }
 
 #[test]
-fn a_version_9_soup_is_refused_with_the_versions_named() {
+fn a_version_10_soup_is_refused_with_the_versions_named() {
     let p = Path::new("old.soup");
     let mut b = sample_soup().to_bytes(p).unwrap();
-    b[8..12].copy_from_slice(&9u32.to_le_bytes());
+    b[8..12].copy_from_slice(&10u32.to_le_bytes());
     let msg = Soup::from_bytes(&b, p).unwrap_err().to_string();
     assert!(
-        msg.contains("soup format version 9, this build reads version 10"),
+        msg.contains("soup format version 10, this build reads version 11"),
         "{msg}"
     );
     assert!(msg.contains("re-run the stage that made it"), "{msg}");

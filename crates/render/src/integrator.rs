@@ -123,15 +123,65 @@ struct Lit {
     layer: u8,
     /// The object receives shadows.
     receives: bool,
+    /// How far its shadows have faded out with distance from the camera: 0 where they are
+    /// whole, 1 where none is drawn ([`ShadowFade`]).
+    fade: f32,
     reflectance: Vec3,
 }
 
 impl Lit {
-    /// Adds a light's share arriving from `inc` at cosine `cos`, `visible` of it unshadowed.
+    /// Adds a light's share arriving from `inc` at cosine `cos`, `visible` of it unshadowed
+    /// before the shadow's fade with distance.
     #[inline(always)]
     fn add(&mut self, inc: &Incident, cos: f32, visible: f32) {
+        let visible = if self.fade > 0.0 {
+            visible + (1.0 - visible) * self.fade
+        } else {
+            visible
+        };
         if visible > 0.0 {
             self.l += inc.radiance * (cos * visible) * self.albedo;
+        }
+    }
+}
+
+/// URP's shadow fade with distance from the camera: a shadow's light becomes
+/// lerp(shadowed, lit, fade), the fade clamp(d²·scale + bias, 0, 1) at squared distance d²,
+/// as URP's `GetMainLightShadowFade` computes it (see [`formats::ShadowDistance`]).
+#[derive(Clone, Copy, Debug)]
+struct ShadowFade {
+    camera: Vec3,
+    scale: f32,
+    bias: f32,
+}
+
+impl ShadowFade {
+    /// The fade of `soup`'s shadows, where its pipeline limits their distance and some
+    /// light traces shadows: they end at the shadow distance or the camera's far plane,
+    /// whichever is nearer.
+    fn of(soup: &Soup, lights: &[ActiveLight]) -> Option<ShadowFade> {
+        let d = soup.environment.shadow_distance?;
+        if lights.iter().all(|l| l.shadows == ShadowMode::None) {
+            return None;
+        }
+        let (scale, bias) = d.scale_bias(d.far(&soup.camera));
+        Some(ShadowFade {
+            camera: soup.camera.position,
+            scale,
+            bias,
+        })
+    }
+
+    /// The fade at point `p`: 0 where shadows are whole, 1 where none is drawn.
+    fn at(&self, p: Vec3) -> f32 {
+        let f = (p - self.camera).length_squared() * self.scale + self.bias;
+        // Written so that a NaN (a far plane at the camera) keeps the shadow whole.
+        if f >= 1.0 {
+            1.0
+        } else if f > 0.0 {
+            f
+        } else {
+            0.0
         }
     }
 }
@@ -269,6 +319,8 @@ pub struct Integrator<'a> {
     /// The MikkTSpace tangents of the objects whose normal map the plan reads, each
     /// object's computed when a ray first reads its map.
     tangents: Option<Tangents<'a>>,
+    /// How shadows fade out with distance from the camera, where the pipeline limits it.
+    shadow_fade: Option<ShadowFade>,
 }
 
 /// [`Integrator::sides`] bits: camera and reflection rays that meet the triangle's front
@@ -333,7 +385,7 @@ impl<'a> Integrator<'a> {
     /// Builds a sampler (the mip levels below the full-size image) for each texture the
     /// plan reads, so this is the render's texture setup step (`setup_seconds`).
     pub fn new(soup: &'a Soup, accel: &'a Accel, plan: &Plan, opts: &RenderOptions) -> Self {
-        let lights = soup
+        let lights: Vec<ActiveLight> = soup
             .lights
             .iter()
             .zip(&plan.lights)
@@ -343,6 +395,7 @@ impl<'a> Integrator<'a> {
                 shadows: p.shadows,
             })
             .collect();
+        let shadow_fade = ShadowFade::of(soup, &lights);
         let textures = plan.textures.enabled;
         let alpha = plan.alpha.enabled;
         let read = &plan.textures.read;
@@ -436,6 +489,7 @@ impl<'a> Integrator<'a> {
                 .map(|sky| Skybox::new(sky, soup.environment.color_space)),
             sky_ambient: sky_ambient(soup, plan).map(Box::new),
             tangents,
+            shadow_fade,
         }
     }
 
@@ -798,7 +852,8 @@ impl<'a> Integrator<'a> {
         if cos <= 0.0 {
             return None;
         }
-        let shadows = if lit.receives {
+        // Where the shadow has faded out entirely, no shadow ray can change the light.
+        let shadows = if lit.receives && lit.fade < 1.0 {
             al.shadows
         } else {
             ShadowMode::None

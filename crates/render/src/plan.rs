@@ -201,6 +201,12 @@ impl Plan {
             .lights
             .iter()
             .map(|l| light_plan(l, diffuse, opts))
+            .map(|mut l| {
+                if let (Some(reach), true) = (shadow_reach(soup), l.shadows != ShadowMode::None) {
+                    l.reason += &reach;
+                }
+                l
+            })
             .collect();
         let lit = lights.iter().filter(|l| l.enabled).count();
         let direct = Effect {
@@ -758,6 +764,20 @@ fn rim_probe(l: &formats::Light, opts: &RenderOptions) -> String {
             crate::soft::probe_distance(l)
         ),
     }
+}
+
+/// How far from the camera the pipeline draws shadows, where it limits them.
+fn shadow_reach(soup: &Soup) -> Option<String> {
+    let d = soup.environment.shadow_distance?;
+    let far = d.far(&soup.camera);
+    Some(if d.border < 1e-4 {
+        format!("; none beyond {far} m from the camera (the pipeline's shadow distance)")
+    } else {
+        format!(
+            "; fading out from {} m to {far} m from the camera (the pipeline's shadow distance)",
+            (1.0 - d.border) * far
+        )
+    })
 }
 
 fn light_plan(l: &formats::Light, diffuse: bool, opts: &RenderOptions) -> LightPlan {

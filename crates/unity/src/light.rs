@@ -9,7 +9,7 @@ use crate::quality::ShadowQuality;
 use crate::reference::fref;
 use crate::settings::Pipeline;
 use crate::yaml::Node;
-use formats::{Attenuation, ColorSpace, Light, LightKind, Shadows};
+use formats::{Attenuation, ColorSpace, Light, LightKind, ShadowDistance, Shadows};
 use glam::{Mat4, Vec3, Vec4Swizzles};
 
 /// Unity's `m_Type` of a directional light (its shadow softness is an angle).
@@ -90,7 +90,7 @@ impl LightUnits {
 
 /// What a URP pipeline asset lets lights do (`UniversalRenderPipelineAsset`'s fields;
 /// where a field is missing, the default the asset's class gives it).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct UniversalAsset {
     /// `m_MainLightRenderingMode` not Disabled (default Per Pixel): there is a main light.
     pub main_light: bool,
@@ -103,6 +103,9 @@ pub struct UniversalAsset {
     pub additional_shadows: bool,
     /// `m_SoftShadowsSupported` (default off: soft shadows are drawn hard).
     pub soft_shadows: bool,
+    /// `m_ShadowDistance` (default 50 m) and `m_CascadeBorder` (default 0.2): how far from
+    /// the camera shadows reach, and the share of that over which they fade out.
+    pub shadow_distance: ShadowDistance,
 }
 
 impl UniversalAsset {
@@ -120,6 +123,16 @@ impl UniversalAsset {
             main_shadows: flag("m_MainLightShadowsSupported", true),
             additional_shadows: flag("m_AdditionalLightShadowsSupported", false),
             soft_shadows: flag("m_SoftShadowsSupported", false),
+            shadow_distance: ShadowDistance {
+                distance: body
+                    .f32_at("m_ShadowDistance")
+                    .filter(|d| d.is_finite() && *d >= 0.0)
+                    .unwrap_or(50.0),
+                border: body
+                    .f32_at("m_CascadeBorder")
+                    .filter(|b| b.is_finite())
+                    .map_or(0.2, |b| b.clamp(0.0, 1.0)),
+            },
         })
     }
 }
@@ -369,6 +382,32 @@ impl Emitter<'_, '_> {
             let mut keep = out.drawn.iter().copied();
             self.light_ids.retain(|_| keep.next().unwrap_or(true));
         }
+        if let Some(u) = asset {
+            self.shadow_distance(u.shadow_distance);
+        }
+    }
+
+    /// URP's shadow distance, capped by the camera's far plane: none at all where that is
+    /// nearer than the near plane (URP then turns shadows off), else the fade the renderer
+    /// draws them with.
+    fn shadow_distance(&mut self, d: ShadowDistance) {
+        if self.soup.lights.iter().all(|l| l.shadows == Shadows::None) {
+            return;
+        }
+        let cam = &self.soup.camera;
+        let far = d.far(cam);
+        if far > 0.0 && far >= cam.near {
+            self.soup.environment.shadow_distance = Some(d);
+            return;
+        }
+        for l in &mut self.soup.lights {
+            l.shadows = Shadows::None;
+        }
+        self.soup.warnings.push(format!(
+            "{}: the URP pipeline asset's shadow distance ({} m) is nearer than the camera's \
+             near plane ({} m): no shadows, as in Unity",
+            self.scene_rel, d.distance, cam.near
+        ));
     }
 
     /// Light component `c` of GameObject `go`.
@@ -496,6 +535,10 @@ mod tests {
             main_shadows: true,
             additional_shadows: true,
             soft_shadows: true,
+            shadow_distance: ShadowDistance {
+                distance: 50.0,
+                border: 0.2,
+            },
         };
         change(&mut a);
         Some(a)

@@ -235,12 +235,15 @@ impl Settings {
             if let Some(u) = self.universal_asset {
                 pipeline += &format!(
                     ": main light {}, additional lights {}, main-light shadows {}, \
-                     additional-light shadows {}, soft shadows {}",
+                     additional-light shadows {}, soft shadows {}, shadow distance {} m \
+                     (border {})",
                     on(u.main_light),
                     on(u.additional_lights),
                     on(u.main_shadows),
                     on(u.additional_shadows),
-                    on(u.soft_shadows)
+                    on(u.soft_shadows),
+                    u.shadow_distance.distance,
+                    u.shadow_distance.border
                 );
             }
             pipeline += ")";

@@ -107,6 +107,7 @@ fn environment(background: Vec3, ambient: Vec3) -> Environment {
         fog: None,
         sky: None,
         color_space: formats::ColorSpace::Linear,
+        shadow_distance: None,
     }
 }
 

@@ -140,6 +140,7 @@ impl Integrator<'_> {
             l += ambient * albedo * occlusion;
         }
         Some(Lit {
+            fade: self.shadow_fade.map_or(0.0, |f| f.at(surf.p)),
             l,
             a,
             albedo,

@@ -802,3 +802,63 @@ fn an_orthographic_camera_spans_its_half_height() {
         assert_eq!(out.frame.pixel(4, y), want, "row {y}");
     }
 }
+
+/// URP's shadow distance: a shadow fades from whole to none as d² runs from (1 − border)²·D²
+/// to D² (d the distance from the camera), the light becoming lerp(shadowed, lit, fade);
+/// beyond D no shadow ray is traced. Hard and soft, alone and in packets.
+#[test]
+fn shadows_fade_out_toward_the_pipelines_shadow_distance() {
+    for shadows in [Shadows::Hard, Shadows::Soft] {
+        let mut s = floor_scene();
+        // A shadows-only roof over the whole floor, under a sun straight above.
+        let m = s.diffuse(Vec3::ONE);
+        let roof = s.quad(
+            "roof",
+            Vec3::new(-6.0, 2.0, -6.0),
+            Vec3::new(0.0, 0.0, 12.0),
+            Vec3::new(12.0, 0.0, 0.0),
+            m,
+        );
+        s.soup.objects[roof as usize].cast_shadows = formats::CastShadows::ShadowsOnly;
+        s.light(formats::Light {
+            shadow_radius: 0.5,
+            ..directional_light(-Vec3::Y, 1.0, shadows)
+        });
+        // Seen from 10 m up, the floor's points lie 10–11.2 m from the camera: shadows
+        // fade from 8.8 m to 11 m, so the middle is half faded and the corners bare.
+        s.soup.environment.shadow_distance = Some(formats::ShadowDistance {
+            distance: 11.0,
+            border: 0.2,
+        });
+        let (soup, kd) = s.build();
+        let (w, h) = (40, 40);
+        let out = render_alike_at_tiles(&soup, &kd, &opts(w, h));
+        let (start, end) = (8.8f32 * 8.8, 11.0f32 * 11.0);
+        let (mut faded, mut bare) = (0, 0);
+        for py in 0..h {
+            for px in 0..w {
+                let p = ortho_point(&soup.camera, w, h, px, py, 0.0);
+                let d2 = (p - soup.camera.position).length_squared();
+                let fade = ((d2 - start) / (end - start)).clamp(0.0, 1.0);
+                let got = out.frame.pixel(px, py);
+                assert_close(got, ALBEDO * fade, 1e-3, &format!("pixel ({px}, {py})"));
+                if fade >= 1.0 {
+                    bare += 1;
+                } else {
+                    faded += 1;
+                }
+            }
+        }
+        assert!(
+            faded > 400 && bare > 100,
+            "{faded} faded, {bare} bare pixels"
+        );
+        // No shadow ray leaves a point whose shadow has faded out entirely (a soft
+        // shadow's rim probes decide each point here: four rays).
+        let (rays, per_point) = match shadows {
+            Shadows::Hard => (out.counts.shadow, 1),
+            _ => (out.counts.soft_shadow, 4),
+        };
+        assert_eq!(rays, faded * per_point, "{shadows:?}: shadow rays");
+    }
+}

@@ -769,11 +769,60 @@ fn a_urp_projects_pipeline_asset_decides_which_lights_cast_shadows() {
             None => read.to_string(),
             Some(_) => {
                 let f: Vec<&str> = read.split(", ").collect();
-                format!("URP (asset Assets/Settings/URP.asset: main light on, additional lights {}, main-light shadows on, additional-light shadows {}, soft shadows {}); ", f[0], f[1], f[2])
+                format!("URP (asset Assets/Settings/URP.asset: main light on, additional lights {}, main-light shadows on, additional-light shadows {}, soft shadows {}, shadow distance 50 m (border 0.2)); ", f[0], f[1], f[2])
             }
         };
         assert!(r.settings.starts_with(&read), "{}", r.settings);
+        // Shadows end where the asset's class default puts them: 50 m, faded over 0.2.
+        let reach = asset.as_ref().map(|_| formats::ShadowDistance {
+            distance: 50.0,
+            border: 0.2,
+        });
+        assert_eq!(r.soup.environment.shadow_distance, reach);
     }
+}
+
+#[test]
+fn a_urp_assets_shadow_distance_reaches_the_soup_or_turns_shadows_off() {
+    let mut sc = Scene::default();
+    sc.camera(&Tf::at(0.0, 1.0, -10.0));
+    sc.light(&Tf::at(0.0, 5.0, 0.0), 1, [1.0, 1.0, 1.0], 2);
+    let urp = "{\"dependencies\": {\"com.unity.render-pipelines.universal\": \"14.0.9\"}}";
+    let guid = "19ba41d7c0026c3459d37c2fe90c55a0";
+    let graphics = format!("{HEADER}--- !u!30 &1\nGraphicsSettings:\n  m_CustomRenderPipeline: {{fileID: 11400000, guid: {guid}, type: 2}}\n");
+    let meta = format!("fileFormatVersion: 2\nguid: {guid}\n");
+    let asset = |distance: &str| {
+        format!("{HEADER}--- !u!114 &11400000\nMonoBehaviour:\n  m_Name: URP\n  m_MainLightShadowsSupported: 1\n  m_ShadowDistance: {distance}\n  m_CascadeBorder: 0.1\n")
+    };
+    let convert = |distance: &str| {
+        let text = asset(distance);
+        let (_d, root) = project(&[
+            ("Assets/s.unity", sc.text.as_str()),
+            ("Packages/manifest.json", urp),
+            (GRAPHICS_SETTINGS, graphics.as_str()),
+            ("Assets/Settings/URP.asset", text.as_str()),
+            ("Assets/Settings/URP.asset.meta", meta.as_str()),
+        ]);
+        convert(&root.join("Assets/s.unity"))
+    };
+    let soup = convert("42");
+    assert_eq!(
+        soup.environment.shadow_distance,
+        Some(formats::ShadowDistance {
+            distance: 42.0,
+            border: 0.1
+        })
+    );
+    // (Soft shadows are off by the asset's class default: drawn hard.)
+    assert_eq!(soup.lights[0].shadows, Shadows::Hard);
+    // A distance nearer than the camera's near plane (0.3 m) leaves URP drawing no shadow.
+    let soup = convert("0.2");
+    assert_eq!(soup.environment.shadow_distance, None);
+    assert_eq!(soup.lights[0].shadows, Shadows::None);
+    assert_warned(
+        &soup,
+        "shadow distance (0.2 m) is nearer than the camera's near plane (0.3 m)",
+    );
 }
 
 #[test]
