@@ -21,8 +21,8 @@ pub use rays::{Hit, RayRecord};
 pub use sky::{Panorama, ProceduralSky, Sky, SkyImage, SkyLayout, SunDisk, TexturedSky};
 pub use soup::{
     Alpha, Ambient, AmbientMode, Attenuation, Camera, CastShadows, ClearFlags, ColorSpace, Cull,
-    Environment, Fog, FogMode, Light, LightKind, Material, NormalMap, Object, OcclusionMap,
-    Projection, ShadowDistance, Shadows, Soup, SoupGeometry, SoupKey,
+    Environment, Fog, FogMode, Frustum, GateFit, Light, LightKind, Material, NormalMap, Object,
+    OcclusionMap, Projection, ShadowDistance, Shadows, Soup, SoupGeometry, SoupKey,
 };
 pub use texture::{Texture, TextureRef, Tiling};
 

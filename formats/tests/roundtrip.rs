@@ -1169,3 +1169,62 @@ fn writing_over_a_folder_fails_and_keeps_the_folder() {
         .collect();
     assert_eq!(names, ["scene.soup"]);
 }
+
+#[test]
+fn a_physical_camera_frames_its_sensor_as_unitys_gate_fit_says() {
+    let lens = |gate_fit| Projection::Physical {
+        focal_length: 50.0,
+        sensor: Vec2::new(36.0, 24.0),
+        lens_shift: Vec2::new(0.1, -0.2),
+        gate_fit,
+    };
+    // The sensor spans 0.72 × 0.48 at unit distance; the shift moves the view by 0.1 of
+    // its width right and 0.2 of its height down.
+    let centre = Vec2::new(0.1 * 36.0 / 50.0, -0.2 * 24.0 / 50.0);
+    let frame = |fit, aspect: f32| {
+        let f = lens(fit).frustum(aspect).unwrap();
+        assert!((f.centre - centre).abs().max_element() < 1e-6, "{fit:?}");
+        (f.half_w, f.half_h)
+    };
+    let close = |a: (f32, f32), b: (f32, f32)| (a.0 - b.0).abs() < 1e-6 && (a.1 - b.1).abs() < 1e-6;
+    use GateFit::*;
+    // An image of the sensor's own aspect shows the sensor whatever the fit.
+    for fit in [None, Vertical, Horizontal, Fill, Overscan] {
+        assert!(close(frame(fit, 1.5), (0.36, 0.24)), "{fit:?}");
+    }
+    // A wider image (2:1): Fill crops the sensor's height, Overscan shows more than its
+    // width, None stretches it.
+    let (tall, wide) = ((0.48, 0.24), (0.36, 0.18));
+    for (fit, want) in [
+        (None, (0.36, 0.24)),
+        (Vertical, tall),
+        (Horizontal, wide),
+        (Fill, wide),
+        (Overscan, tall),
+    ] {
+        assert!(
+            close(frame(fit, 2.0), want),
+            "{fit:?}: {:?}",
+            frame(fit, 2.0)
+        );
+    }
+    // A narrower one (1:1): Fill crops the width, Overscan shows more than the height.
+    assert!(close(frame(Fill, 1.0), (0.24, 0.24)));
+    assert!(close(frame(Overscan, 1.0), (0.36, 0.36)));
+    // Unity's field of view is the sensor height's: 2·atan(12/50).
+    let fov = lens(Horizontal).fov_y().unwrap();
+    assert!((fov - 26.991467).abs() < 1e-4, "{fov}");
+    assert_eq!(lens(Horizontal).fault(), Option::None);
+    let blind = Projection::Physical {
+        focal_length: 0.0,
+        sensor: Vec2::new(36.0, 24.0),
+        lens_shift: Vec2::ZERO,
+        gate_fit: Fill,
+    };
+    assert!(blind.fault().unwrap().contains("focal length 0 mm"));
+    // It survives the soup file.
+    let mut s = sample_soup();
+    s.camera.projection = lens(Overscan);
+    let p = Path::new("physical.soup");
+    assert_eq!(Soup::from_bytes(&s.to_bytes(p).unwrap(), p).unwrap(), s);
+}

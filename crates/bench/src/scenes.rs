@@ -45,8 +45,9 @@ pub fn load_soup(path: &Path) -> Result<Scene, BenchError> {
         });
     }
     let mut notes = vec![];
-    let view = match soup.camera.projection {
-        formats::Projection::Perspective { fov_y } => {
+    // A physical camera's rays are framed by its field of view (its sensor height's).
+    let view = match soup.camera.projection.fov_y() {
+        Some(fov_y) => {
             notes.push(format!(
                 "{}: primary rays from the soup's camera `{}`",
                 stem(path),
@@ -59,7 +60,7 @@ pub fn load_soup(path: &Path) -> Result<Scene, BenchError> {
                 fov_y,
             })
         }
-        formats::Projection::Orthographic { .. } => None,
+        None => None,
     };
     Ok(Scene {
         name: stem(path),

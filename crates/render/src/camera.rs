@@ -1,9 +1,10 @@
-//! Camera rays: perspective (vertical field of view) or orthographic (half height).
+//! Camera rays: perspective (vertical field of view), physical (focal length, sensor, lens
+//! shift and gate fit) or orthographic (half height).
 
 use crate::cone::RayCone;
 use crate::RenderError;
 use formats::{Camera, Projection};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use kdtree::Ray;
 
 /// A soup camera prepared for an image of `width`×`height` pixels.
@@ -16,6 +17,9 @@ pub struct CameraModel {
     /// Half extent of the view at unit distance (perspective) or in metres (orthographic).
     half_w: f32,
     half_h: f32,
+    /// Where the view's centre lies off `forward` at unit distance (a physical camera's
+    /// lens shift), along right and up.
+    centre: Vec2,
     ortho: bool,
     near: f32,
     /// Infinite when the camera sets no far limit beyond `near`.
@@ -41,23 +45,17 @@ impl CameraModel {
             )));
         }
         let up = right.cross(forward);
+        if let Some(fault) = cam.projection.fault() {
+            return Err(bad(fault));
+        }
         let aspect = width as f32 / height as f32;
-        let (half_h, ortho) = match cam.projection {
-            Projection::Perspective { fov_y } => {
-                if !(fov_y > 0.0 && fov_y < 180.0) {
-                    return Err(bad(format!(
-                        "vertical field of view {fov_y}° is not in (0, 180)"
-                    )));
-                }
-                ((fov_y.to_radians() * 0.5).tan(), false)
-            }
-            Projection::Orthographic { half_height } => {
-                if !(half_height > 0.0 && half_height.is_finite()) {
-                    return Err(bad(format!(
-                        "orthographic size {half_height} is not positive"
-                    )));
-                }
-                (half_height, true)
+        let (half_w, half_h, centre, ortho) = match cam.projection.frustum(aspect) {
+            Some(f) => (f.half_w, f.half_h, f.centre, false),
+            None => {
+                let Projection::Orthographic { half_height } = cam.projection else {
+                    unreachable!("only an orthographic projection has no frustum")
+                };
+                (half_height * aspect, half_height, Vec2::ZERO, true)
             }
         };
         Ok(CameraModel {
@@ -65,8 +63,9 @@ impl CameraModel {
             forward,
             right,
             up,
-            half_w: half_h * aspect,
+            half_w,
             half_h,
+            centre,
             ortho,
             near: if cam.near.is_finite() {
                 cam.near.max(0.0)
@@ -105,8 +104,8 @@ impl CameraModel {
     /// nearer than the camera's near clip plane or beyond its far one is not seen, as in
     /// Unity.
     pub fn ray(&self, px: f32, py: f32) -> Ray {
-        let sx = (2.0 * px / self.width - 1.0) * self.half_w;
-        let sy = (1.0 - 2.0 * py / self.height) * self.half_h;
+        let sx = (2.0 * px / self.width - 1.0) * self.half_w + self.centre.x;
+        let sy = (1.0 - 2.0 * py / self.height) * self.half_h + self.centre.y;
         if self.ortho {
             Ray {
                 origin: self.position + self.right * sx + self.up * sy,
@@ -173,6 +172,44 @@ mod tests {
         };
         let c = CameraModel::new(&ortho, 100, 100).unwrap().cone();
         assert_eq!((c.width, c.spread), (0.04, 0.0));
+    }
+
+    #[test]
+    fn a_physical_cameras_rays_cross_its_shifted_sensor() {
+        // 50 mm over 36 × 24 mm, shifted a quarter of the sensor up, fitted horizontally
+        // to a 2:1 image: at unit distance the image spans ±0.36 across and ±0.18 up,
+        // centred 0.12 above the view direction.
+        let cam = Camera {
+            projection: Projection::Physical {
+                focal_length: 50.0,
+                sensor: glam::Vec2::new(36.0, 24.0),
+                lens_shift: glam::Vec2::new(0.0, 0.25),
+                gate_fit: formats::GateFit::Horizontal,
+            },
+            ..Camera::default()
+        };
+        let m = CameraModel::new(&cam, 200, 100).unwrap();
+        let at = |px: f32, py: f32| {
+            let d = m.ray(px, py).dir;
+            (d / d.dot(cam.forward)) - cam.forward
+        };
+        let close = |a: Vec3, b: Vec3| (a - b).length() < 1e-6;
+        let up = Vec3::Y;
+        let right = cam.right();
+        assert!(close(at(100.0, 50.0), up * 0.12), "{}", at(100.0, 50.0));
+        assert!(close(at(0.0, 0.0), right * -0.36 + up * 0.30));
+        assert!(close(at(200.0, 100.0), right * 0.36 + up * -0.06));
+        let blind = Camera {
+            projection: Projection::Physical {
+                focal_length: -1.0,
+                sensor: glam::Vec2::new(36.0, 24.0),
+                lens_shift: glam::Vec2::ZERO,
+                gate_fit: formats::GateFit::Fill,
+            },
+            ..Camera::default()
+        };
+        let err = CameraModel::new(&blind, 10, 10).unwrap_err().to_string();
+        assert!(err.contains("focal length -1 mm"), "{err}");
     }
 
     #[test]

@@ -5,8 +5,8 @@ use crate::emit::{flip, EmitError, Emitter};
 use crate::material::shaded_rgb;
 use crate::reference::fref;
 use crate::yaml::Node;
-use formats::{Camera, ClearFlags, Projection};
-use glam::{Mat4, Vec3, Vec4Swizzles};
+use formats::{Camera, ClearFlags, GateFit, Projection};
+use glam::{Mat4, Vec2, Vec3, Vec4Swizzles};
 
 /// The camera a body and world transform describe; `None` when its orientation is
 /// degenerate.
@@ -21,6 +21,8 @@ pub fn convert(b: &Node, world: Mat4, name: String) -> Option<Camera> {
         Projection::Orthographic {
             half_height: b.f32_at("orthographic size").unwrap_or(5.0),
         }
+    } else if b.i64_at("m_projectionMatrixMode") == Some(PHYSICAL) {
+        physical(b)
     } else {
         Projection::Perspective {
             fov_y: b.f32_at("field of view").unwrap_or(60.0),
@@ -35,6 +37,31 @@ pub fn convert(b: &Node, world: Mat4, name: String) -> Option<Camera> {
         near: b.f32_at("near clip plane").unwrap_or(0.3),
         far: b.f32_at("far clip plane").unwrap_or(1000.0),
     })
+}
+
+/// `m_projectionMatrixMode` of a Physical Camera (its projection from lens and sensor).
+const PHYSICAL: i64 = 2;
+
+/// A Physical Camera's lens, sensor, lens shift and gate fit; a field it lacks takes the
+/// default of a new camera: 50 mm over a 36 × 24 mm sensor, no shift, Horizontal fit.
+fn physical(b: &Node) -> Projection {
+    let vec2 = |key: &str, default: Vec2| {
+        b.get(key)
+            .and_then(|v| Some(Vec2::new(v.f32_at("x")?, v.f32_at("y")?)))
+            .unwrap_or(default)
+    };
+    Projection::Physical {
+        focal_length: b.f32_at("m_FocalLength").unwrap_or(50.0),
+        sensor: vec2("m_SensorSize", Vec2::new(36.0, 24.0)),
+        lens_shift: vec2("m_LensShift", Vec2::ZERO),
+        gate_fit: match b.i64_at("m_GateFitMode") {
+            Some(0) => GateFit::None,
+            Some(1) => GateFit::Vertical,
+            Some(3) => GateFit::Fill,
+            Some(4) => GateFit::Overscan,
+            _ => GateFit::Horizontal,
+        },
+    }
 }
 
 /// What the camera clears to: the skybox (`m_ClearFlags` 1) or a solid colour.

@@ -27,12 +27,13 @@ use std::collections::{HashMap, HashSet};
 /// Relative screen height of a group of world size `size` whose reference point is
 /// `distance` from a camera with `projection`, under `lod_bias`.
 pub fn relative_height(size: f32, distance: f32, projection: Projection, lod_bias: f32) -> f32 {
-    match projection {
-        Projection::Perspective { fov_y } => {
-            let half_angle = (fov_y.to_radians() * 0.5).tan();
+    // A physical camera counts by its field of view, as Unity's LOD code takes it.
+    match (projection, projection.fov_y()) {
+        (Projection::Orthographic { half_height }, _) => size * 0.5 / (half_height / lod_bias),
+        (_, fov_y) => {
+            let half_angle = (fov_y.unwrap_or(60.0).to_radians() * 0.5).tan();
             size * 0.5 / (distance / lod_bias * half_angle)
         }
-        Projection::Orthographic { half_height } => size * 0.5 / (half_height / lod_bias),
     }
 }
 
@@ -168,6 +169,16 @@ mod tests {
         let o = Projection::Orthographic { half_height: 4.0 };
         assert_eq!(relative_height(1.0, 100.0, o, 1.0), 0.125);
         assert_eq!(relative_height(1.0, 1.0, o, 2.0), 0.25);
+        // A physical camera counts by its sensor height's field of view: 24 mm at 50 mm
+        // spans tan = 0.24 either side.
+        let lens = Projection::Physical {
+            focal_length: 50.0,
+            sensor: glam::Vec2::new(36.0, 24.0),
+            lens_shift: glam::Vec2::ZERO,
+            gate_fit: formats::GateFit::Horizontal,
+        };
+        let h = relative_height(1.0, 2.0, lens, 1.0);
+        assert!((h - 0.5 / (2.0 * 0.24)).abs() < 1e-5, "{h}");
         assert_eq!(shown_level(0.3, &[0.5, 0.2, 0.05]), Some(1));
         assert_eq!(shown_level(0.5, &[0.5, 0.2, 0.05]), Some(0));
         assert_eq!(shown_level(0.01, &[0.5, 0.2, 0.05]), None);

@@ -1413,3 +1413,38 @@ fn project_root_is_found_or_given() {
     let err = convert_error(&lone.path().join("s.unity"));
     assert!(err.contains("--assets"), "{err}");
 }
+
+#[test]
+fn a_physical_camera_keeps_its_lens_sensor_shift_and_gate_fit() {
+    let camera = |fields: &str| {
+        let mut sc = Scene::default();
+        let (go, _) = sc.object("Cam", &Tf::at(0.0, 1.0, -10.0), 0, true);
+        sc.raw(&format!("--- !u!20 &900\nCamera:\n  m_GameObject: {{fileID: {go}}}\n  m_Enabled: 1\n  m_ClearFlags: 2\n  near clip plane: 0.3\n  field of view: 39.6\n  orthographic: 0\n  m_Depth: -1\n{fields}"));
+        convert_scene(&sc.text).camera.projection
+    };
+    let physical = "  m_projectionMatrixMode: 2\n  m_SensorSize: {x: 24.89, y: 18.66}\n  m_LensShift: {x: 0.1, y: -0.05}\n  m_GateFitMode: 3\n  m_FocalLength: 35\n";
+    assert_eq!(
+        camera(physical),
+        formats::Projection::Physical {
+            focal_length: 35.0,
+            sensor: glam::Vec2::new(24.89, 18.66),
+            lens_shift: glam::Vec2::new(0.1, -0.05),
+            gate_fit: formats::GateFit::Fill,
+        }
+    );
+    // Fields a file lacks take a new camera's: 50 mm, 36 × 24 mm, no shift, Horizontal.
+    assert_eq!(
+        camera("  m_projectionMatrixMode: 2\n"),
+        formats::Projection::Physical {
+            focal_length: 50.0,
+            sensor: glam::Vec2::new(36.0, 24.0),
+            lens_shift: glam::Vec2::ZERO,
+            gate_fit: formats::GateFit::Horizontal,
+        }
+    );
+    // Implicit projection (the default) keeps the field of view; the lens is not read.
+    assert_eq!(
+        camera(&physical.replace("Mode: 2", "Mode: 1")),
+        formats::Projection::Perspective { fov_y: 39.6 }
+    );
+}
