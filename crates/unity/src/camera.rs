@@ -1,9 +1,11 @@
 //! Camera (class 20) → the soup's camera and the environment's clear flags and
 //! background: the Game view's camera among the scene's enabled ones.
 
+use crate::docs;
 use crate::emit::{flip, EmitError, Emitter};
 use crate::material::shaded_rgb;
 use crate::reference::fref;
+use crate::settings::Pipeline;
 use crate::yaml::Node;
 use formats::{Camera, ClearFlags, GateFit, Projection};
 use glam::{Mat4, Vec2, Vec3, Vec4Swizzles};
@@ -64,6 +66,12 @@ fn physical(b: &Node) -> Projection {
     }
 }
 
+/// A (GameObject, Camera component) pair.
+type Pair = (usize, usize);
+
+/// The script of URP's per-camera settings (`UniversalAdditionalCameraData`).
+pub(crate) const URP_CAMERA_DATA: &str = "a79441f348de89743a2939f4d699eac1";
+
 /// What the camera clears to: the skybox (`m_ClearFlags` 1) or a solid colour.
 pub fn clear_flags(b: &Node) -> ClearFlags {
     if b.i64_at("m_ClearFlags").unwrap_or(1) == 1 {
@@ -74,31 +82,80 @@ pub fn clear_flags(b: &Node) -> ClearFlags {
 }
 
 impl Emitter<'_, '_> {
+    /// URP's settings for the camera on GameObject `go`, where a URP project has them.
+    fn urp_camera_data(&self, go: usize) -> Option<&Node> {
+        if self.g.project.settings.pipeline != Pipeline::Universal {
+            return None;
+        }
+        self.go_comps.get(&go)?.iter().find_map(|&i| {
+            let o = &self.g.objs[i];
+            let script = fref(o.body.get("m_Script")).1;
+            (o.class == docs::MONO_BEHAVIOUR && script.as_deref() == Some(URP_CAMERA_DATA))
+                .then_some(&o.body)
+        })
+    }
+
+    /// Camera component `c` on `go` draws over the image of the cameras below it: in URP an
+    /// Overlay camera (`m_CameraType` 1), else one that clears only depth or nothing
+    /// (`m_ClearFlags` 3 or 4).
+    fn overlay(&self, go: usize, c: usize) -> bool {
+        if self.g.project.settings.pipeline == Pipeline::Universal {
+            return self
+                .urp_camera_data(go)
+                .and_then(|d| d.i64_at("m_CameraType"))
+                == Some(1);
+        }
+        matches!(self.g.objs[c].body.i64_at("m_ClearFlags"), Some(3 | 4))
+    }
+
     /// The soup's camera from the enabled `(GameObject, Camera)` pairs.
     pub(crate) fn camera(&mut self, cams: &[(usize, usize)]) -> Result<(), EmitError> {
         let (g, scene_rel) = (self.g, self.scene_rel);
         let depth = |c: usize| g.objs[c].body.f32_at("m_Depth").unwrap_or(0.0);
         // The Game view shows the display cameras; the highest depth draws last.
-        let display: Vec<&(usize, usize)> = cams
+        let display: Vec<(usize, usize)> = cams
             .iter()
+            .copied()
             .filter(|(_, c)| fref(g.objs[*c].body.get("m_TargetTexture")).0 == 0)
             .collect();
-        let mut best: Option<&(usize, usize)> = None;
-        for c in &display {
+        // A camera that draws over the others' image (a depth-only or URP overlay camera:
+        // a weapon, a UI) is not the view; the highest camera that clears is.
+        let (overlays, base): (Vec<Pair>, Vec<Pair>) =
+            display.iter().partition(|&&(go, c)| self.overlay(go, c));
+        let candidates = if base.is_empty() { &overlays } else { &base };
+        let mut best: Option<(usize, usize)> = None;
+        for &c in candidates {
             if best.is_none_or(|b| depth(c.1) > depth(b.1)) {
                 best = Some(c);
             }
         }
-        let Some(&(go, c)) = best else {
+        let Some((go, c)) = best else {
             self.soup.warnings.push(format!("{scene_rel}: no enabled camera renders to the display; Unity's default camera used"));
             return Ok(());
         };
-        if display.len() > 1 {
+        if candidates.len() > 1 {
             self.soup.warnings.push(format!(
                 "{scene_rel}: {} enabled cameras; using '{}' (highest depth, first in the file)",
-                display.len(),
+                candidates.len(),
                 self.path(go)
             ));
+        }
+        if !base.is_empty() && !overlays.is_empty() {
+            let names: Vec<String> = overlays.iter().map(|&(o, _)| self.path(o)).collect();
+            self.soup.warnings.push(format!(
+                "{scene_rel}: camera(s) '{}' draw over '{}' in Unity (depth-only or URP \
+                 overlay); not composited: the image is '{}''s view alone",
+                names.join("', '"),
+                self.path(go),
+                self.path(go)
+            ));
+        }
+        if self
+            .urp_camera_data(go)
+            .and_then(|d| d.i64_at("m_RenderShadows"))
+            == Some(0)
+        {
+            self.camera_shadows = false;
         }
         let b = &g.objs[c].body;
         let world = self.checked_world(go)?;

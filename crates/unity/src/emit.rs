@@ -71,6 +71,8 @@ pub(crate) struct Emitter<'g, 'p> {
     /// Per soup light: the file and fileID of its Light component (RenderSettings names
     /// the sun so).
     pub(crate) light_ids: Vec<(usize, i64)>,
+    /// The chosen camera renders shadows (a URP camera's Render Shadows can turn them off).
+    pub(crate) camera_shadows: bool,
 }
 
 /// What [`emit`] produces.
@@ -109,6 +111,7 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
         skipped: Vec::new(),
         placements: Default::default(),
         light_ids: Vec::new(),
+        camera_shadows: true,
     };
     e.soup.warnings = g.warnings.clone();
     for (i, o) in g.objs.iter().enumerate() {

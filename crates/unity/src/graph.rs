@@ -108,10 +108,14 @@ pub fn read_text(project: &Project, path: &Path) -> Result<String, LoadError> {
     Ok(text)
 }
 
-/// Classes whose bodies the converter reads.
-fn wanted(class: u32) -> bool {
+/// Documents whose bodies the converter reads: its classes, and of the MonoBehaviours only
+/// URP's camera settings (a scene holds many scripts it does not read).
+fn wanted(d: &Doc) -> bool {
+    if d.class == docs::MONO_BEHAVIOUR {
+        return d.body.contains(crate::camera::URP_CAMERA_DATA);
+    }
     matches!(
-        class,
+        d.class,
         docs::GAME_OBJECT
             | docs::TRANSFORM
             | docs::RECT_TRANSFORM
@@ -376,7 +380,7 @@ impl<'p> Graph<'p> {
             if d.class == docs::RENDER_SETTINGS && top {
                 self.render_settings = Some(d.parse());
             }
-            if !wanted(d.class) {
+            if !wanted(d) {
                 continue;
             }
             if let Some((line, what)) = yaml::malformed(d.body) {

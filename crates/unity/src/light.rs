@@ -382,6 +382,20 @@ impl Emitter<'_, '_> {
             let mut keep = out.drawn.iter().copied();
             self.light_ids.retain(|_| keep.next().unwrap_or(true));
         }
+        let casting = self
+            .soup
+            .lights
+            .iter()
+            .filter(|l| l.shadows != Shadows::None);
+        if !self.camera_shadows && casting.count() > 0 {
+            for l in &mut self.soup.lights {
+                l.shadows = Shadows::None;
+            }
+            self.soup.warnings.push(format!(
+                "{}: the camera's Render Shadows is off (URP): no shadows, as in Unity",
+                self.scene_rel
+            ));
+        }
         if let Some(u) = asset {
             self.shadow_distance(u.shadow_distance);
         }

@@ -1448,3 +1448,60 @@ fn a_physical_camera_keeps_its_lens_sensor_shift_and_gate_fit() {
         formats::Projection::Perspective { fov_y: 39.6 }
     );
 }
+
+/// A scene with a main camera at z = −10 (depth −1, clear `main_clear`) and a second one at
+/// z = −3 (depth 1, clear `over_clear`), each with URP camera data of `m_CameraType`
+/// `types` and `m_RenderShadows` `shadows` when given, and a shadowed sun.
+fn two_camera_scene(
+    (main_clear, over_clear): (i32, i32),
+    urp: Option<((i32, i32), i32)>,
+) -> String {
+    let mut sc = Scene::default();
+    sc.light(&Tf::at(0.0, 5.0, 0.0), 1, [1.0, 1.0, 1.0], 1);
+    for (i, (z, depth, clear)) in [(-10.0, -1, main_clear), (-3.0, 1, over_clear)]
+        .into_iter()
+        .enumerate()
+    {
+        let name = ["Main", "Weapon"][i];
+        let (go, _) = sc.object(name, &Tf::at(0.0, 1.0, z), 0, true);
+        let id = 900 + 2 * i;
+        sc.raw(&format!("--- !u!20 &{id}\nCamera:\n  m_GameObject: {{fileID: {go}}}\n  m_Enabled: 1\n  m_ClearFlags: {clear}\n  near clip plane: 0.3\n  field of view: 60\n  orthographic: 0\n  m_Depth: {depth}\n"));
+        if let Some(((main_type, over_type), shadows)) = urp {
+            let ty = [main_type, over_type][i];
+            sc.raw(&format!("--- !u!114 &{}\nMonoBehaviour:\n  m_GameObject: {{fileID: {go}}}\n  m_Enabled: 1\n  m_Script: {{fileID: 11500000, guid: a79441f348de89743a2939f4d699eac1, type: 3}}\n  m_RenderShadows: {shadows}\n  m_CameraType: {ty}\n", id + 1));
+        }
+    }
+    sc.text
+}
+
+#[test]
+fn the_view_is_the_highest_camera_that_clears_not_one_drawn_over_it() {
+    // Built-in: a depth-only (3) or don't-clear (4) camera draws over the main one.
+    for over in [3, 4] {
+        let soup = convert_scene(&two_camera_scene((1, over), None));
+        assert_eq!(soup.camera.position.z, -10.0, "clear flags {over}");
+        assert_warned(&soup, "camera(s) 'Weapon' draw over 'Main'");
+    }
+    // One that clears is the view, as before.
+    let soup = convert_scene(&two_camera_scene((1, 2), None));
+    assert_eq!(soup.camera.position.z, -3.0);
+    assert_warned(&soup, "2 enabled cameras; using 'Weapon'");
+    // URP: its camera data's type decides, not the clear flags.
+    let urp = "{\"dependencies\": {\"com.unity.render-pipelines.universal\": \"14.0.9\"}}";
+    let convert_urp = |text: &str| {
+        let (_d, root) = project(&[("Assets/s.unity", text), ("Packages/manifest.json", urp)]);
+        convert(&root.join("Assets/s.unity"))
+    };
+    let soup = convert_urp(&two_camera_scene((1, 1), Some(((0, 1), 1))));
+    assert_eq!(soup.camera.position.z, -10.0);
+    assert_eq!(soup.lights[0].shadows, Shadows::Hard);
+    let soup = convert_urp(&two_camera_scene((1, 3), Some(((0, 0), 1))));
+    assert_eq!(
+        soup.camera.position.z, -3.0,
+        "a URP base camera, whatever its clear flags"
+    );
+    // The chosen URP camera's Render Shadows off leaves no shadow.
+    let soup = convert_urp(&two_camera_scene((1, 1), Some(((0, 1), 0))));
+    assert_eq!(soup.lights[0].shadows, Shadows::None);
+    assert_warned(&soup, "Render Shadows is off");
+}
