@@ -108,9 +108,28 @@ impl Emitter<'_, '_> {
         matches!(self.g.objs[c].body.i64_at("m_ClearFlags"), Some(3 | 4))
     }
 
-    /// The soup's camera from the enabled `(GameObject, Camera)` pairs.
-    pub(crate) fn camera(&mut self, cams: &[(usize, usize)]) -> Result<(), EmitError> {
+    /// The soup's camera from the enabled `(GameObject, Camera)` pairs: the one `asked`
+    /// names (by GameObject name or path), else the Game view's.
+    pub(crate) fn camera(&mut self, cams: &[Pair], asked: Option<&str>) -> Result<(), EmitError> {
         let (g, scene_rel) = (self.g, self.scene_rel);
+        if let Some(name) = asked {
+            let named = cams.iter().find(|&&(go, _)| {
+                let path = self.path(go);
+                path == name || path.rsplit('/').next() == Some(name)
+            });
+            let Some(&(go, c)) = named else {
+                let mut all: Vec<String> = cams.iter().map(|&(go, _)| self.path(go)).collect();
+                if all.is_empty() {
+                    all.push("none".into());
+                }
+                return Err(EmitError::NoSuchCamera {
+                    file: scene_rel.to_string(),
+                    asked: name.to_string(),
+                    cameras: all.join(", "),
+                });
+            };
+            return self.use_camera(go, c);
+        }
         let depth = |c: usize| g.objs[c].body.f32_at("m_Depth").unwrap_or(0.0);
         // The Game view shows the display cameras; the highest depth draws last.
         let display: Vec<(usize, usize)> = cams
@@ -150,6 +169,12 @@ impl Emitter<'_, '_> {
                 self.path(go)
             ));
         }
+        self.use_camera(go, c)
+    }
+
+    /// Camera component `c` on GameObject `go` becomes the soup's camera.
+    fn use_camera(&mut self, go: usize, c: usize) -> Result<(), EmitError> {
+        let (g, scene_rel) = (self.g, self.scene_rel);
         if self
             .urp_camera_data(go)
             .and_then(|d| d.i64_at("m_RenderShadows"))

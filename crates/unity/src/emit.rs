@@ -24,6 +24,12 @@ pub enum EmitError {
         file_id: i64,
         detail: String,
     },
+    #[error("{file}: no enabled camera is named '{asked}'; the enabled cameras: {cameras}")]
+    NoSuchCamera {
+        file: String,
+        asked: String,
+        cameras: String,
+    },
 }
 
 /// Unity space → soup space for points and directions.
@@ -91,7 +97,7 @@ pub struct Emitted {
 
 /// The soup, how many enabled cameras on active objects the scene has, where the
 /// objects' materials came from, and the renderers skipped by Unity's draw rules.
-pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
+pub fn emit(g: &Graph, scene_rel: &str, camera: Option<&str>) -> Result<Emitted, EmitError> {
     let mut e = Emitter {
         g,
         scene_rel,
@@ -135,7 +141,7 @@ pub fn emit(g: &Graph, scene_rel: &str) -> Result<Emitted, EmitError> {
         }
     }
     let before = e.soup.warnings.len();
-    e.camera(&cameras)?;
+    e.camera(&cameras, camera)?;
     // Keep the camera's warnings after the objects', where they have always been.
     let camera_warnings = e.soup.warnings.split_off(before);
     let lod_hidden = e.lod_hidden();

@@ -62,6 +62,9 @@ pub struct Options {
     pub project: Option<PathBuf>,
     /// Turn warnings into an error.
     pub strict: bool,
+    /// The camera to render, by GameObject name or hierarchy path (`Parent/Child`), instead
+    /// of the Game view's.
+    pub camera: Option<String>,
 }
 
 /// A converted scene with the counts the soup does not hold.
@@ -114,7 +117,7 @@ pub fn convert_report(scene: &Path, opts: &Options) -> Result<Report, ConvertErr
         cameras,
         material_origins,
         skipped,
-    } = emit::emit(&g, &scene_rel)?;
+    } = emit::emit(&g, &scene_rel, opts.camera.as_deref())?;
     // Model-level warnings (missing .mtl …), once per model used.
     let mut model_warnings: Vec<String> = Vec::new();
     for f in soup

@@ -1,4 +1,4 @@
-//! unity2soup SCENE.unity -o scene.soup [--assets DIR] [--json] [--strict]
+//! unity2soup SCENE.unity -o scene.soup [--assets DIR] [--camera NAME] [--json] [--strict]
 use anyhow::Context;
 use clap::Parser;
 use formats::TextureRef;
@@ -26,6 +26,10 @@ struct Args {
     /// Treat every warning as an error.
     #[arg(long)]
     strict: bool,
+    /// Render the enabled camera on this GameObject (its name or hierarchy path,
+    /// `Parent/Child`) instead of the Game view's.
+    #[arg(long)]
+    camera: Option<String>,
     /// List the project settings read (render pipeline, light units, colour space,
     /// quality level), every converted object (triangles, source, materials, layer, shadows), every
     /// material (texture, tiling, opacity, alpha mode), every renderer Unity's draw rules
@@ -55,6 +59,7 @@ fn run(args: &Args) -> anyhow::Result<()> {
     let opts = unity::Options {
         project: args.assets.clone(),
         strict: args.strict,
+        camera: args.camera.clone(),
     };
     let report = unity::convert_report(&args.scene, &opts)?;
     let soup = &report.soup;

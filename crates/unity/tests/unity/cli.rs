@@ -193,3 +193,37 @@ fn unity2soup_list_marks_unlit_materials() {
         "{stderr}"
     );
 }
+
+#[test]
+fn unity2soup_renders_the_camera_it_is_asked_for_and_names_the_others_when_none_matches() {
+    let (d, scene) = scene();
+    let out = d.path().join("s.soup");
+    let run = |name: &str| {
+        Command::new(env!("CARGO_BIN_EXE_unity2soup"))
+            .arg(&scene)
+            .arg("-o")
+            .arg(&out)
+            .arg("--camera")
+            .arg(name)
+            .output()
+            .unwrap()
+    };
+    let o = run("Main Camera");
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let soup = formats::Soup::read(&out).unwrap();
+    assert_eq!(soup.camera.position, glam::Vec3::new(0.0, 1.0, -10.0));
+    std::fs::remove_file(&out).unwrap();
+    let o = run("Drone");
+    assert_eq!(o.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        e.contains("no enabled camera is named 'Drone'; the enabled cameras: Main Camera"),
+        "{e}"
+    );
+    assert!(!out.exists(), "no output on failure");
+}

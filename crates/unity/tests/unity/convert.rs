@@ -1267,6 +1267,7 @@ fn strict_turns_warnings_into_an_error() {
     let opts = unity::Options {
         project: None,
         strict: true,
+        camera: None,
     };
     let err = unity::convert(&root.join("Assets/s.unity"), &opts).unwrap_err();
     assert!(err.to_string().contains("no enabled camera"), "{err}");
@@ -1401,6 +1402,7 @@ fn project_root_is_found_or_given() {
         let opts = unity::Options {
             project: Some(given),
             strict: false,
+            camera: None,
         };
         assert_eq!(
             unity::convert(&scene, &opts).unwrap().triangles,
@@ -1504,4 +1506,24 @@ fn the_view_is_the_highest_camera_that_clears_not_one_drawn_over_it() {
     let soup = convert_urp(&two_camera_scene((1, 1), Some(((0, 1), 0))));
     assert_eq!(soup.lights[0].shadows, Shadows::None);
     assert_warned(&soup, "Render Shadows is off");
+}
+
+#[test]
+fn an_asked_for_camera_is_the_view_by_name_or_path_overlay_or_not() {
+    let text = two_camera_scene((1, 3), None);
+    let (_d, root) = project(&[("Assets/s.unity", text.as_str())]);
+    let with = |camera: &str| {
+        let opts = unity::Options {
+            camera: Some(camera.into()),
+            ..Default::default()
+        };
+        unity::convert(&root.join("Assets/s.unity"), &opts)
+    };
+    // The depth-only camera the Game view draws over the main one, asked for by name.
+    let soup = with("Weapon").unwrap();
+    assert_eq!(soup.camera.position.z, -3.0);
+    assert!(!soup.warnings.iter().any(|w| w.contains("draw over")));
+    assert_eq!(with("Main").unwrap().camera.position.z, -10.0);
+    let err = with("Drone").unwrap_err().to_string();
+    assert!(err.contains("the enabled cameras: Main, Weapon"), "{err}");
 }

@@ -330,6 +330,7 @@ fn binary_scene_is_refused_with_a_fix() {
         &unity::Options {
             project: Some(root.join("candycat1992__Unity_Shaders_Book")),
             strict: false,
+            camera: None,
         },
     )
     .expect_err("binary scene must be refused");

@@ -440,6 +440,7 @@ fn authoring_tool_files_lfs_pointers_and_broken_fbx_are_one_warning_each() {
         &unity::Options {
             project: None,
             strict: true,
+            camera: None,
         },
     )
     .expect_err("--strict turns the warnings into an error");
