@@ -4,6 +4,7 @@
 //! then a bincode payload. The field-by-field specification is in `SOUP.md`, `KD.md` and
 //! `RAYS.md` next to this crate, so that programs in other languages can read the files.
 
+pub mod camera;
 pub mod envelope;
 pub mod error;
 pub mod kd;
@@ -14,15 +15,16 @@ pub mod srgb;
 pub mod texture;
 pub mod threads;
 
+pub use camera::{Camera, Frustum, GateFit, Projection};
 pub use envelope::write_atomic;
 pub use error::FormatError;
 pub use kd::{BuildParams, KdFile, KdHeader, KdNode, TreeStats};
 pub use rays::{Hit, RayRecord};
 pub use sky::{Panorama, ProceduralSky, Sky, SkyImage, SkyLayout, SunDisk, TexturedSky};
 pub use soup::{
-    Alpha, Ambient, AmbientMode, Attenuation, Camera, CastShadows, ClearFlags, ColorSpace, Cull,
-    Environment, Fog, FogMode, Frustum, GateFit, Light, LightKind, Material, NormalMap, Object,
-    OcclusionMap, Projection, ShadowDistance, Shadows, Soup, SoupGeometry, SoupKey,
+    Alpha, Ambient, AmbientMode, Attenuation, CastShadows, ClearFlags, ColorSpace, Cull,
+    Environment, Fog, FogMode, Light, LightKind, Material, NormalMap, Object, OcclusionMap,
+    ShadowDistance, Shadows, Soup, SoupGeometry, SoupKey,
 };
 pub use texture::{Texture, TextureRef, Tiling};
 
