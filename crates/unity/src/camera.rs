@@ -159,8 +159,15 @@ impl Emitter<'_, '_> {
                 self.path(go)
             ));
         }
-        if !base.is_empty() && !overlays.is_empty() {
-            let names: Vec<String> = overlays.iter().map(|&(o, _)| self.path(o)).collect();
+        // A built-in depth-only camera below the view is cleared away by it; URP draws an
+        // overlay camera in the stack of a base camera, whatever its depth.
+        let urp = g.project.settings.pipeline == Pipeline::Universal;
+        let names: Vec<String> = overlays
+            .iter()
+            .filter(|&&(_, o)| !base.is_empty() && (urp || depth(o) > depth(c)))
+            .map(|&(o, _)| self.path(o))
+            .collect();
+        if !names.is_empty() {
             self.soup.warnings.push(format!(
                 "{scene_rel}: camera(s) '{}' draw over '{}' in Unity (depth-only or URP \
                  overlay); not composited: the image is '{}''s view alone",

@@ -1484,6 +1484,15 @@ fn the_view_is_the_highest_camera_that_clears_not_one_drawn_over_it() {
         assert_eq!(soup.camera.position.z, -10.0, "clear flags {over}");
         assert_warned(&soup, "camera(s) 'Weapon' draw over 'Main'");
     }
+    // Below the main camera, a depth-only camera is cleared away: nothing to say.
+    let low = two_camera_scene((1, 3), None).replace("m_Depth: 1\n", "m_Depth: -2\n");
+    let soup = convert_scene(&low);
+    assert_eq!(soup.camera.position.z, -10.0);
+    assert!(
+        !soup.warnings.iter().any(|w| w.contains("draw over")),
+        "{:?}",
+        soup.warnings
+    );
     // One that clears is the view, as before.
     let soup = convert_scene(&two_camera_scene((1, 2), None));
     assert_eq!(soup.camera.position.z, -3.0);
