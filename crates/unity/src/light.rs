@@ -382,12 +382,8 @@ impl Emitter<'_, '_> {
             let mut keep = out.drawn.iter().copied();
             self.light_ids.retain(|_| keep.next().unwrap_or(true));
         }
-        let casting = self
-            .soup
-            .lights
-            .iter()
-            .filter(|l| l.shadows != Shadows::None);
-        if !self.camera_shadows && casting.count() > 0 {
+        let casting = self.soup.lights.iter().any(|l| l.shadows != Shadows::None);
+        if !self.camera_shadows && casting {
             for l in &mut self.soup.lights {
                 l.shadows = Shadows::None;
             }
