@@ -21,15 +21,18 @@ const BUILTIN_EXTRA_GUID: &str = "0000000000000000f000000000000000";
 /// Default-Material's fileID among the built-in extra resources.
 const DEFAULT_MATERIAL_ID: i64 = 10303;
 
-/// The GUID of URP's own Lit material (the package's `Runtime/Materials/Lit.mat`), which URP
-/// gives every object made in its editor. It lives in the package cache, outside the
-/// project's folders, so it never resolves there.
-const URP_LIT_MATERIAL_GUID: &str = "31321ba15b8f8eb4c954353edc038b1d";
-
-/// That material's properties that change an image, as URP has shipped them since its first
-/// releases: the Lit shader, opaque, back faces culled, a mid-grey base colour (stored in
-/// sRGB), smoothness 0.5, not metallic, no emission and no maps.
-const URP_LIT_MATERIAL: &str = "--- !u!21 &2100000
+/// The default materials the scriptable pipelines give every object made in their editors:
+/// (GUID, the pipeline whose package holds it, its path there, its properties that change
+/// an image). They live in the package cache, outside the project's folders, so they never
+/// resolve there. Their values are as the packages have shipped them since their first
+/// releases: opaque Lit materials, back faces culled, not metallic, no emission and no maps,
+/// URP's mid grey (0.5 in sRGB) at smoothness 0.5, HDRP's light grey (0.728) at 0.7.
+const PACKAGE_MATERIALS: [(&str, Pipeline, &str, &str); 2] = [
+    (
+        "31321ba15b8f8eb4c954353edc038b1d",
+        Pipeline::Universal,
+        "com.unity.render-pipelines.universal/Runtime/Materials/Lit.mat",
+        "--- !u!21 &2100000
 Material:
   m_Name: Lit
   m_Shader: {fileID: 4800000, guid: 933532a4fcc9baf4fa0491de14d08ed7, type: 3}
@@ -40,12 +43,30 @@ Material:
     - _Metallic: 0
     - _Smoothness: 0.5
     - _Surface: 0
-    - _WorkflowMode: 1
     m_Colors:
     - _BaseColor: {r: 0.5, g: 0.5, b: 0.5, a: 1}
-    - _Color: {r: 0.5, g: 0.5, b: 0.5, a: 1}
     - _EmissionColor: {r: 0, g: 0, b: 0, a: 1}
-";
+",
+    ),
+    (
+        "73c176f402d2c2f4d929aa5da7585d17",
+        Pipeline::HighDefinition,
+        "com.unity.render-pipelines.high-definition/Runtime/RenderPipelineResources/Material/DefaultHDMaterial.mat",
+        "--- !u!21 &2100000
+Material:
+  m_Name: DefaultHDMaterial
+  m_Shader: {fileID: 4800000, guid: 6e4ae4064600d784cac1e41a9e6f2e59, type: 3}
+  m_SavedProperties:
+    m_Floats:
+    - _AlphaCutoffEnable: 0
+    - _Metallic: 0
+    - _Smoothness: 0.7
+    - _SurfaceType: 0
+    m_Colors:
+    - _BaseColor: {r: 0.72794116, g: 0.72794116, b: 0.72794116, a: 1}
+",
+    ),
+];
 
 /// A stored colour as a project in colour space `space` shades it: decoded to linear in a
 /// linear project, as stored in a gamma one.
@@ -295,24 +316,26 @@ impl Emitter<'_, '_> {
         i
     }
 
-    /// URP's Lit material, where the project lists the URP package that holds it.
+    /// A pipeline's default material ([`PACKAGE_MATERIALS`]), where the project lists the
+    /// package that holds it; with where it came from.
     fn package_material(&mut self, guid: &str) -> Option<(u32, String)> {
         let settings = &self.g.project.settings;
-        let urp = settings.pipeline == Pipeline::Universal
-            || settings.unassigned_pipeline == Some(Pipeline::Universal);
-        if guid != URP_LIT_MATERIAL_GUID || !urp {
-            return None;
-        }
-        let source = "package:com.unity.render-pipelines.universal/Runtime/Materials/Lit.mat";
-        let i = self.add_material(source.into(), || {
-            let body = docs::split(URP_LIT_MATERIAL)
+        let listed =
+            |p: Pipeline| settings.pipeline == p || settings.unassigned_pipeline == Some(p);
+        let &(_, _, path, text) = PACKAGE_MATERIALS
+            .iter()
+            .find(|&&(g, pipeline, _, _)| g == guid && listed(pipeline))?;
+        let source = format!("package:{path}");
+        let i = self.add_material(source.clone(), || {
+            let body = docs::split(text)
                 .into_iter()
                 .find(|d| d.class == docs::MATERIAL)
                 .map(|d| d.parse())
                 .unwrap_or(Node::Map(vec![]));
-            convert(&body, source).0
+            convert(&body, &source).0
         });
-        Some((i, "URP's Lit.mat".into()))
+        let name = path.rsplit('/').next().unwrap_or(path);
+        Some((i, format!("the pipeline's {name}")))
     }
 
     /// Unity's default material, with a warning about `what` saying why.

@@ -1082,7 +1082,7 @@ fn model_materials_take_the_mtl_colour() {
 }
 
 #[test]
-fn urps_own_lit_material_is_mid_grey_where_the_project_lists_urp() {
+fn the_pipelines_own_default_materials_are_drawn_as_their_packages_ship_them() {
     // The URP package's Lit.mat lives in the package cache, never under Assets/.
     let lit = (2100000, "31321ba15b8f8eb4c954353edc038b1d");
     let sc = mesh_scene("Cube", 10202, BUILTIN, &[lit]);
@@ -1115,6 +1115,27 @@ fn urps_own_lit_material_is_mid_grey_where_the_project_lists_urp() {
         "31321ba15b8f8eb4c954353edc038b1d is not in the project",
     );
     assert_eq!(soup.materials[0].color, Vec3::ONE);
+    // HDRP's default material: light grey (0.728 in sRGB), smoothness 0.7; not in URP.
+    let hd = (2100000, "73c176f402d2c2f4d929aa5da7585d17");
+    let sc = mesh_scene("Cube", 10202, BUILTIN, &[hd]);
+    let hdrp = urp.replace("universal", "high-definition");
+    let (_h, root) = project(&[
+        ("Assets/s.unity", &sc.text),
+        ("Packages/manifest.json", &hdrp),
+    ]);
+    let m = &convert(&root.join("Assets/s.unity")).materials[0];
+    let grey = formats::srgb::srgb_to_linear(0.72794116);
+    assert!(close(m.color, Vec3::splat(grey), 1e-6), "{}", m.color);
+    assert_eq!((m.smoothness, m.metallic), (0.7, 0.0));
+    assert!(m.source.ends_with("DefaultHDMaterial.mat"), "{}", m.source);
+    let (_u, root) = project(&[
+        ("Assets/s.unity", &sc.text),
+        ("Packages/manifest.json", urp),
+    ]);
+    assert_eq!(
+        convert(&root.join("Assets/s.unity")).materials[0].color,
+        Vec3::ONE
+    );
 }
 
 /// A MeshFilter whose mesh GUID is not in the project, on an object named after the only
