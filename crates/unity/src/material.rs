@@ -22,49 +22,24 @@ const BUILTIN_EXTRA_GUID: &str = "0000000000000000f000000000000000";
 const DEFAULT_MATERIAL_ID: i64 = 10303;
 
 /// The default materials the scriptable pipelines give every object made in their editors:
-/// (GUID, the pipeline whose package holds it, its path there, its properties that change
-/// an image). They live in the package cache, outside the project's folders, so they never
-/// resolve there. Their values are as the packages have shipped them since their first
-/// releases: opaque Lit materials, back faces culled, not metallic, no emission and no maps,
-/// URP's mid grey (0.5 in sRGB) at smoothness 0.5, HDRP's light grey (0.728) at 0.7.
-const PACKAGE_MATERIALS: [(&str, Pipeline, &str, &str); 2] = [
+/// (GUID, the pipeline whose package holds it, its path there, its Lit base colour's grey
+/// in sRGB, its smoothness). They live in the package cache, outside the project's folders,
+/// so they never resolve there. Both are opaque, back-face culled, not metallic, without
+/// emission or maps, and have kept these values since their packages' first releases.
+const PACKAGE_MATERIALS: [(&str, Pipeline, &str, f32, f32); 2] = [
     (
         "31321ba15b8f8eb4c954353edc038b1d",
         Pipeline::Universal,
         "com.unity.render-pipelines.universal/Runtime/Materials/Lit.mat",
-        "--- !u!21 &2100000
-Material:
-  m_Name: Lit
-  m_Shader: {fileID: 4800000, guid: 933532a4fcc9baf4fa0491de14d08ed7, type: 3}
-  m_SavedProperties:
-    m_Floats:
-    - _AlphaClip: 0
-    - _Cull: 2
-    - _Metallic: 0
-    - _Smoothness: 0.5
-    - _Surface: 0
-    m_Colors:
-    - _BaseColor: {r: 0.5, g: 0.5, b: 0.5, a: 1}
-    - _EmissionColor: {r: 0, g: 0, b: 0, a: 1}
-",
+        0.5,
+        0.5,
     ),
     (
         "73c176f402d2c2f4d929aa5da7585d17",
         Pipeline::HighDefinition,
         "com.unity.render-pipelines.high-definition/Runtime/RenderPipelineResources/Material/DefaultHDMaterial.mat",
-        "--- !u!21 &2100000
-Material:
-  m_Name: DefaultHDMaterial
-  m_Shader: {fileID: 4800000, guid: 6e4ae4064600d784cac1e41a9e6f2e59, type: 3}
-  m_SavedProperties:
-    m_Floats:
-    - _AlphaCutoffEnable: 0
-    - _Metallic: 0
-    - _Smoothness: 0.7
-    - _SurfaceType: 0
-    m_Colors:
-    - _BaseColor: {r: 0.72794116, g: 0.72794116, b: 0.72794116, a: 1}
-",
+        0.72794116,
+        0.7,
     ),
 ];
 
@@ -322,19 +297,18 @@ impl Emitter<'_, '_> {
         let settings = &self.g.project.settings;
         let listed =
             |p: Pipeline| settings.pipeline == p || settings.unassigned_pipeline == Some(p);
-        let &(_, _, path, text) = PACKAGE_MATERIALS
+        let &(_, _, path, grey, smoothness) = PACKAGE_MATERIALS
             .iter()
-            .find(|&&(g, pipeline, _, _)| g == guid && listed(pipeline))?;
+            .find(|&&(g, pipeline, ..)| g == guid && listed(pipeline))?;
         let source = format!("package:{path}");
-        let i = self.add_material(source.clone(), || {
-            let body = docs::split(text)
-                .into_iter()
-                .find(|d| d.class == docs::MATERIAL)
-                .map(|d| d.parse())
-                .unwrap_or(Node::Map(vec![]));
-            convert(&body, &source).0
-        });
         let name = path.rsplit('/').next().unwrap_or(path);
+        let i = self.add_material(source.clone(), || Material {
+            name: name.trim_end_matches(".mat").to_string(),
+            source,
+            color: Vec3::splat(srgb_to_linear(grey)),
+            smoothness,
+            ..Material::unity_default()
+        });
         Some((i, format!("the pipeline's {name}")))
     }
 
