@@ -37,6 +37,10 @@ const SIX_FACES: [&str; 6] = [
     "_BackTex",
 ];
 
+/// The Skybox/Procedural shader's default sky tint and ground colour, as stored.
+const DEFAULT_TINT: Vec4 = Vec4::new(0.5, 0.5, 0.5, 1.0);
+const DEFAULT_GROUND: Vec4 = Vec4::new(0.369, 0.349, 0.341, 1.0);
+
 /// The Skybox/Procedural shader's property defaults, which Default-Skybox keeps.
 fn default_sky() -> ProceduralSky {
     ProceduralSky {
@@ -45,11 +49,24 @@ fn default_sky() -> ProceduralSky {
         sun_size_convergence: 5.0,
         atmosphere_thickness: 1.0,
         exposure: 1.3,
-        sky_tint: linear_rgb(Vec4::new(0.5, 0.5, 0.5, 1.0)),
-        ground: linear_rgb(Vec4::new(0.369, 0.349, 0.341, 1.0)),
+        sky_tint: linear_rgb(DEFAULT_TINT),
+        ground: linear_rgb(DEFAULT_GROUND),
         sun_direction: Vec3::Z,
         sun_colour: Vec3::ZERO,
     }
+}
+
+/// A procedural sky's tint and ground colour as a gamma-space project's shader takes them,
+/// from the stored colours (`tint`, `ground`; the defaults where the material has none).
+/// The soup keeps a linear project's values: the renderer raises the tint to 1/2.2 and uses
+/// the ground as it is, where Unity's gamma-space shader uses the stored tint and squares
+/// the stored ground colour (its `COLOR_2_GAMMA` and `COLOR_2_LINEAR`); so the tint is
+/// kept as stored^2.2 and the ground as stored².
+fn in_gamma_space(sky: &mut ProceduralSky, tint: Option<Vec4>, ground: Option<Vec4>) {
+    let tint = tint.unwrap_or(DEFAULT_TINT).truncate();
+    let ground = ground.unwrap_or(DEFAULT_GROUND).truncate();
+    sky.sky_tint = tint.powf(2.2);
+    sky.ground = ground * ground;
 }
 
 /// The sky RenderSettings names (a procedural sky's sun still unset), `Ok(None)` without
@@ -69,7 +86,11 @@ pub fn skybox(
         return Err("HDRP ignores RenderSettings' skybox (its sky is a Volume override)".into());
     }
     if guid == BUILTIN_EXTRA && id == DEFAULT_SKYBOX {
-        return Ok(Some(Sky::Procedural(default_sky())));
+        let mut sky = default_sky();
+        if project.settings.color_space == ColorSpace::Gamma {
+            in_gamma_space(&mut sky, None, None);
+        }
+        return Ok(Some(Sky::Procedural(sky)));
     }
     let Some(path) = project.resolve(&guid) else {
         return Err(format!("skybox material GUID {guid} is not in the project"));
@@ -87,7 +108,10 @@ pub fn skybox(
         ));
     }
     let layout = match shader.0 {
-        PROCEDURAL_SHADER => return Ok(Some(Sky::Procedural(read_material(&body)))),
+        PROCEDURAL_SHADER => {
+            let sky = read_material(&body, project.settings.color_space);
+            return Ok(Some(Sky::Procedural(sky)));
+        }
         PANORAMIC_SHADER => panoramic(&body, project),
         CUBEMAP_SHADER => cubemap(&body, project),
         SIX_SIDED_SHADER => six_sided(&body, project, &name, warnings),
@@ -404,7 +428,7 @@ fn resized(img: &LinearImage, w: u32, h: u32) -> LinearImage {
 }
 
 /// A Skybox/Procedural material's properties over the shader's defaults.
-fn read_material(body: &Node) -> ProceduralSky {
+fn read_material(body: &Node, space: ColorSpace) -> ProceduralSky {
     let mut sky = default_sky();
     let p = Props::of(body);
     let float = |k: &str| p.float(k);
@@ -415,6 +439,10 @@ fn read_material(body: &Node) -> ProceduralSky {
     sky.exposure = float("_Exposure").unwrap_or(sky.exposure);
     sky.sky_tint = colour("_SkyTint").unwrap_or(sky.sky_tint);
     sky.ground = colour("_GroundColor").unwrap_or(sky.ground);
+    if space == ColorSpace::Gamma {
+        let stored = |k: &str| p.stored_colour(k).filter(|c| c.truncate().is_finite());
+        in_gamma_space(&mut sky, stored("_SkyTint"), stored("_GroundColor"));
+    }
     // The keyword picks the shader variant; without one the float mirrors it.
     let on = |k: &str| keyword_on(body, k) == Some(true);
     sky.sun_disk = if on("_SUNDISK_NONE") {
@@ -492,13 +520,46 @@ mod tests {
         let m = parse(
             "Material:\n  m_Shader: {fileID: 106, guid: 0000000000000000f000000000000000, type: 0}\n  m_ShaderKeywords: _SUNDISK_SIMPLE\n  m_SavedProperties:\n    m_Floats:\n    - _AtmosphereThickness: 0.53\n    - _Exposure: 1.25\n    m_Colors:\n    - _SkyTint: {r: 1, g: 1, b: 1, a: 1}\n",
         );
-        let sky = read_material(m.get("Material").unwrap());
+        let sky = read_material(m.get("Material").unwrap(), ColorSpace::Linear);
         assert_eq!(sky.atmosphere_thickness, 0.53);
         assert_eq!(sky.exposure, 1.25);
         assert_eq!(sky.sky_tint, Vec3::ONE);
         assert_eq!(sky.sun_disk, SunDisk::Simple);
         assert_eq!(sky.sun_size, 0.04, "the shader's default");
         assert_eq!(sky.ground, default_sky().ground);
+    }
+
+    #[test]
+    fn a_gamma_space_project_keeps_the_tint_as_stored_and_squares_the_ground() {
+        let m = parse(
+            "Material:\n  m_SavedProperties:\n    m_Colors:\n    - _SkyTint: {r: 0.6, g: 0.5, b: 0.4, a: 1}\n    - _GroundColor: {r: 0.3, g: 0.2, b: 0.1, a: 1}\n",
+        );
+        let sky = read_material(m.get("Material").unwrap(), ColorSpace::Gamma);
+        // The renderer raises the tint to 1/2.2: Unity's gamma shader's stored tint.
+        let seen = sky.sky_tint.powf(1.0 / 2.2);
+        assert!(
+            (seen - Vec3::new(0.6, 0.5, 0.4)).abs().max_element() < 1e-6,
+            "{seen}"
+        );
+        assert!(
+            (sky.ground - Vec3::new(0.09, 0.04, 0.01))
+                .abs()
+                .max_element()
+                < 1e-6
+        );
+        // A material without them takes the shader's defaults, so converted.
+        let bare = parse("Material:\n  m_SavedProperties:\n    m_Colors: []\n");
+        let sky = read_material(bare.get("Material").unwrap(), ColorSpace::Gamma);
+        assert!(
+            (sky.sky_tint - Vec3::splat(0.5f32.powf(2.2)))
+                .abs()
+                .max_element()
+                < 1e-6
+        );
+        assert!((sky.ground.x - 0.369 * 0.369).abs() < 1e-6);
+        // A linear project decodes both from sRGB, as before.
+        let sky = read_material(m.get("Material").unwrap(), ColorSpace::Linear);
+        assert_eq!(sky.ground, linear_rgb(Vec4::new(0.3, 0.2, 0.1, 1.0)));
     }
 
     /// Every texel of a `w`×`h` image its own number, and the faces cut from it.
@@ -547,7 +608,7 @@ mod tests {
         let m = parse(
             "Material:\n  m_SavedProperties:\n    m_Floats:\n    - _Exposure: NaN\n    - _SunSize: Infinity\n    m_Colors:\n    - _SkyTint: {r: NaN, g: 1, b: 1, a: 1}\n",
         );
-        let sky = read_material(m.get("Material").unwrap());
+        let sky = read_material(m.get("Material").unwrap(), ColorSpace::Linear);
         let default = default_sky();
         assert_eq!(
             (sky.exposure, sky.sun_size, sky.sky_tint),
