@@ -69,6 +69,14 @@ pub fn has_document(text: &str) -> bool {
         .any(|l| l.starts_with("--- !u!") && header(l.trim_end()).is_some())
 }
 
+/// The first document of `class` in `text`, parsed.
+pub fn first(text: &str, class: u32) -> Option<Node> {
+    split(text)
+        .into_iter()
+        .find(|d| d.class == class)
+        .map(|d| d.parse())
+}
+
 /// All documents of a text file, in file order.
 pub fn split(text: &str) -> Vec<Doc<'_>> {
     let mut docs = Vec::new();

@@ -50,12 +50,7 @@ impl LightUnits {
                 gamma_space,
             };
         }
-        let body = graphics_settings.and_then(|text| {
-            docs::split(text)
-                .into_iter()
-                .find(|d| d.class == docs::GRAPHICS_SETTINGS)
-                .map(|d| d.parse())
-        });
+        let body = graphics_settings.and_then(|text| docs::first(text, docs::GRAPHICS_SETTINGS));
         let on = |key: &str| body.as_ref().and_then(|b| b.i64_at(key)) == Some(1);
         LightUnits {
             linear_intensity: on("m_LightsUseLinearIntensity"),
@@ -382,15 +377,8 @@ impl Emitter<'_, '_> {
             let mut keep = out.drawn.iter().copied();
             self.light_ids.retain(|_| keep.next().unwrap_or(true));
         }
-        let casting = self.soup.lights.iter().any(|l| l.shadows != Shadows::None);
-        if !self.camera_shadows && casting {
-            for l in &mut self.soup.lights {
-                l.shadows = Shadows::None;
-            }
-            self.soup.warnings.push(format!(
-                "{}: the camera's Render Shadows is off (URP): no shadows, as in Unity",
-                self.scene_rel
-            ));
+        if !self.camera_shadows {
+            self.no_shadows("the camera's Render Shadows is off (URP)".into());
         }
         if let Some(u) = asset {
             self.shadow_distance(u.shadow_distance);
@@ -410,13 +398,25 @@ impl Emitter<'_, '_> {
             self.soup.environment.shadow_distance = Some(d);
             return;
         }
+        let why = format!(
+            "the URP pipeline asset's shadow distance ({} m) is nearer than the camera's \
+             near plane ({} m)",
+            d.distance, cam.near
+        );
+        self.no_shadows(why);
+    }
+
+    /// No light casts a shadow, because `why`; said where some light would have.
+    fn no_shadows(&mut self, why: String) {
+        if self.soup.lights.iter().all(|l| l.shadows == Shadows::None) {
+            return;
+        }
         for l in &mut self.soup.lights {
             l.shadows = Shadows::None;
         }
         self.soup.warnings.push(format!(
-            "{}: the URP pipeline asset's shadow distance ({} m) is nearer than the camera's \
-             near plane ({} m): no shadows, as in Unity",
-            self.scene_rel, d.distance, cam.near
+            "{}: {why}: no shadows, as in Unity",
+            self.scene_rel
         ));
     }
 

@@ -148,10 +148,7 @@ impl Project {
     pub fn mat(&self, path: &Path) -> MatResult {
         cached(&self.mats, path, || {
             Arc::new(match std::fs::read_to_string(path) {
-                Ok(text) => Ok(docs::split(&text)
-                    .into_iter()
-                    .find(|d| d.class == docs::MATERIAL)
-                    .map(|d| d.parse())),
+                Ok(text) => Ok(docs::first(&text, docs::MATERIAL)),
                 Err(e) => Err(e.to_string()),
             })
         })

@@ -22,10 +22,7 @@ pub enum ShadowQuality {
 /// `f` of the current quality level of a `QualitySettings.asset`'s text; `None` when the
 /// text names no such level.
 fn current_level<T>(text: &str, f: impl FnOnce(&Node) -> Option<T>) -> Option<T> {
-    let body = docs::split(text)
-        .into_iter()
-        .find(|d| d.class == docs::QUALITY_SETTINGS)?
-        .parse();
+    let body = docs::first(text, docs::QUALITY_SETTINGS)?;
     let current = usize::try_from(body.i64_at("m_CurrentQuality")?).ok()?;
     f(body.get("m_QualitySettings")?.as_seq().get(current)?)
 }

@@ -87,10 +87,7 @@ impl PipelineAsset {
             }
         }
         let default = graphics.and_then(|text| {
-            let body = docs::split(text)
-                .into_iter()
-                .find(|d| d.class == docs::GRAPHICS_SETTINGS)?
-                .parse();
+            let body = docs::first(text, docs::GRAPHICS_SETTINGS)?;
             Some(crate::reference::fref(Some(
                 body.get("m_CustomRenderPipeline")?,
             )))
@@ -106,10 +103,8 @@ impl PipelineAsset {
 /// The colour space a `ProjectSettings.asset` text sets (`m_ActiveColorSpace` 0 Gamma, 1
 /// Linear); Linear where it does not say.
 pub fn color_space(text: &str) -> ColorSpace {
-    let gamma = docs::split(text)
-        .into_iter()
-        .find(|d| d.class == docs::PLAYER_SETTINGS)
-        .is_some_and(|d| d.parse().i64_at("m_ActiveColorSpace") == Some(0));
+    let gamma = docs::first(text, docs::PLAYER_SETTINGS)
+        .is_some_and(|b| b.i64_at("m_ActiveColorSpace") == Some(0));
     if gamma {
         ColorSpace::Gamma
     } else {
