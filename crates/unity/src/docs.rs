@@ -17,13 +17,18 @@ pub const MESH: u32 = 43;
 pub const QUALITY_SETTINGS: u32 = 47;
 pub const RENDER_SETTINGS: u32 = 104;
 pub const LIGHT: u32 = 108;
+pub const TEXT_MESH: u32 = 102;
 pub const MONO_BEHAVIOUR: u32 = 114;
+pub const LINE_RENDERER: u32 = 120;
 pub const PLAYER_SETTINGS: u32 = 129;
 pub const SKINNED_MESH_RENDERER: u32 = 137;
+pub const PARTICLE_SYSTEM_RENDERER: u32 = 199;
 pub const LOD_GROUP: u32 = 205;
+pub const SPRITE_RENDERER: u32 = 212;
 pub const TERRAIN: u32 = 218;
 pub const RECT_TRANSFORM: u32 = 224;
 pub const PREFAB_INSTANCE: u32 = 1001;
+pub const TILEMAP_RENDERER: u32 = 483693784;
 
 pub struct Doc<'a> {
     pub class: u32,

@@ -145,6 +145,7 @@ pub fn emit(g: &Graph, scene_rel: &str, camera: Option<&str>) -> Result<Emitted,
     // Keep the camera's warnings after the objects', where they have always been.
     let camera_warnings = e.soup.warnings.split_off(before);
     let lod_hidden = e.lod_hidden();
+    let mut undrawn = crate::undrawn::Undrawn::default();
     for (gi, o) in g.objs.iter().enumerate() {
         if o.class != docs::GAME_OBJECT || !e.active(gi) {
             continue;
@@ -162,16 +163,12 @@ pub fn emit(g: &Graph, scene_rel: &str, camera: Option<&str>) -> Result<Emitted,
                 e.skinned_object(gi, smr)?;
             }
         }
-        if class_of(docs::TERRAIN).is_some() {
-            let w = e.describe(gi);
-            e.soup
-                .warnings
-                .push(format!("{w}: Terrain is not converted; skipped"));
-        }
+        e.note_undrawn(gi, &comps, &mut undrawn);
         for &c in comps.iter().filter(|&&i| g.objs[i].class == docs::LIGHT) {
             e.light(gi, c)?;
         }
     }
+    e.warn_undrawn(undrawn);
     e.universal_rules();
     e.decode_textures();
     e.soup.warnings.extend(camera_warnings);

@@ -126,6 +126,11 @@ fn wanted(d: &Doc) -> bool {
             | docs::SKINNED_MESH_RENDERER
             | docs::TERRAIN
             | docs::LOD_GROUP
+            | docs::SPRITE_RENDERER
+            | docs::TEXT_MESH
+            | docs::LINE_RENDERER
+            | docs::PARTICLE_SYSTEM_RENDERER
+            | docs::TILEMAP_RENDERER
     )
 }
 

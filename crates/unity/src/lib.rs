@@ -38,6 +38,7 @@ pub mod skinned_renderer;
 pub mod skybox;
 pub mod texture;
 pub mod transform;
+mod undrawn;
 pub mod yaml;
 
 use formats::Soup;

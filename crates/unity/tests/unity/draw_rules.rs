@@ -440,3 +440,61 @@ fn list_names_the_renderers_unitys_rules_skip() {
     );
     assert!(err.contains("cull Back"), "{err}");
 }
+
+/// A component of `class` (its YAML name `kind`) on GameObject `go`.
+fn component(sc: &mut Scene, id: i64, class: u32, kind: &str, go: i64, enabled: bool) {
+    sc.raw(&format!(
+        "--- !u!{class} &{id}\n{kind}:\n  m_GameObject: {{fileID: {go}}}\n  m_Enabled: {}\n",
+        enabled as i32
+    ));
+}
+
+#[test]
+fn sprites_text_lines_particles_and_terrains_the_camera_would_show_are_named_once_per_kind() {
+    let mut sc = Scene::default();
+    sc.camera(&Tf::at(0.0, 0.0, -5.0));
+    sc.raw("  m_CullingMask:\n    serializedVersion: 2\n    m_Bits: 4294967039\n");
+    let mut id = 5000;
+    let mut on = |sc: &mut Scene, name: &str, class: u32, kind: &str, enabled: bool| {
+        let (go, _) = sc.object(name, &Tf::at(0.0, 0.0, 0.0), 0, true);
+        id += 1;
+        component(sc, id, class, kind, go, enabled);
+        go
+    };
+    for name in ["S1", "S2", "S3", "S4", "S5"] {
+        on(&mut sc, name, 212, "SpriteRenderer", true);
+    }
+    on(&mut sc, "OffSprite", 212, "SpriteRenderer", false);
+    on(&mut sc, "Line", 120, "LineRenderer", true);
+    on(&mut sc, "Ground", 218, "Terrain", true);
+    // A TextMesh draws through its MeshRenderer: shown when that renderer is enabled.
+    let label = on(&mut sc, "Label", 102, "TextMesh", true);
+    component(&mut sc, 6001, 23, "MeshRenderer", label, true);
+    let mute = on(&mut sc, "Mute", 102, "TextMesh", true);
+    component(&mut sc, 6002, 23, "MeshRenderer", mute, false);
+    // On layer 8, which the camera leaves out.
+    let smoke = on(&mut sc, "Smoke", 199, "ParticleSystemRenderer", true);
+    sc.text = sc.text.replace(
+        &format!("--- !u!1 &{smoke}\nGameObject:\n  m_ObjectHideFlags: 0\n  serializedVersion: 6\n  m_Component:\n  - component: {{fileID: {}}}\n  m_Layer: 0", smoke + 1),
+        &format!("--- !u!1 &{smoke}\nGameObject:\n  m_ObjectHideFlags: 0\n  serializedVersion: 6\n  m_Component:\n  - component: {{fileID: {}}}\n  m_Layer: 8", smoke + 1),
+    );
+    assert!(sc.text.contains("m_Layer: 8"), "Smoke moved to layer 8");
+    let inactive = sc.object("Hidden", &Tf::at(0.0, 0.0, 0.0), 0, false).0;
+    component(&mut sc, 7001, 120, "LineRenderer", inactive, true);
+    let soup = convert_scene(&sc.text);
+    let undrawn: Vec<&String> = soup
+        .warnings
+        .iter()
+        .filter(|w| w.contains("not drawn"))
+        .collect();
+    assert_eq!(
+        undrawn,
+        [
+            "Assets/s.unity: object 'Ground': Terrain not drawn: terrain heightmaps are not converted",
+            "Assets/s.unity: 5 SpriteRenderers not drawn ('S1', 'S2', 'S3' and 2 more): sprites are not converted",
+            "Assets/s.unity: object 'Label': TextMesh not drawn: 3D text is not converted",
+            "Assets/s.unity: object 'Line': LineRenderer not drawn: lines are not converted",
+        ]
+    );
+    assert_eq!(soup.triangles.len(), 0);
+}
