@@ -8,7 +8,7 @@ use std::sync::Once;
 use unity::texture::{decode, Import};
 
 /// The extensions the decoder accepts, and one it refuses.
-const EXTENSIONS: [&str; 8] = ["png", "jpg", "tga", "tif", "exr", "psd", "hdr", "dds"];
+const EXTENSIONS: [&str; 9] = ["png", "jpg", "tga", "tif", "exr", "psd", "hdr", "bmp", "dds"];
 
 /// The `psd` crate panics on many malformed files; the decoder catches those panics and
 /// reports a decode error, which is the behaviour under test. libfuzzer-sys's hook aborts

@@ -28,7 +28,9 @@ pub enum TextureError {
     Read { path: String, message: String },
     #[error("{path}: a Git LFS pointer, not the texture itself")]
     LfsPointer { path: String },
-    #[error("{path}: .{ext} textures are not supported (png, jpg, tga, tif, exr, hdr, psd are)")]
+    #[error(
+        "{path}: .{ext} textures are not supported (png, jpg, tga, tif, bmp, exr, hdr, psd are)"
+    )]
     Unsupported { path: String, ext: String },
     #[error("{path}: not a readable {format} image: {message}")]
     Decode {
@@ -437,6 +439,7 @@ pub fn decode_image(
             "tif" | "tiff" => ImageFormat::Tiff,
             "exr" => ImageFormat::OpenExr,
             "hdr" => ImageFormat::Hdr,
+            "bmp" => ImageFormat::Bmp,
             _ => {
                 return Err(TextureError::Unsupported {
                     path: source.to_string(),
@@ -1033,6 +1036,7 @@ m_SavedProperties:
             (ImageFormat::Png, "png"),
             (ImageFormat::Tga, "tga"),
             (ImageFormat::Tiff, "tif"),
+            (ImageFormat::Bmp, "bmp"),
         ] {
             let bytes = encode(&four_colours(), format);
             let t = decode(&bytes, ext, "t", &Import::default()).unwrap();

@@ -11,7 +11,7 @@ fn repo() -> PathBuf {
 }
 
 /// The texture target's first byte picks the claimed extension (index into its list:
-/// png, jpg, tga, tif, exr, psd, hdr, dds).
+/// png, jpg, tga, tif, exr, psd, hdr, bmp, dds; then the size limit, by index ÷ 9).
 fn texture_seed(extension_index: u8, file: &[u8]) -> Vec<u8> {
     let mut v = vec![extension_index];
     v.extend_from_slice(file);
@@ -122,10 +122,14 @@ fn seeds() -> Vec<(PathBuf, Vec<u8>)> {
             fuzz.join("unity_texture/seed-psd-trailing.bin"),
             texture_seed(5, &[psd(), vec![0; 20]].concat()),
         ),
+        (
+            fuzz.join("unity_texture/seed-bmp.bin"),
+            texture_seed(7, &encoded(&img, ImageFormat::Bmp)),
+        ),
         // The PNG with a size limit of 1 texel, so the downscale runs.
         (
             fuzz.join("unity_texture/seed-png-max1.bin"),
-            texture_seed(24, &png),
+            texture_seed(27, &png),
         ),
     ]
 }
