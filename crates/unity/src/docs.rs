@@ -29,6 +29,7 @@ pub const TERRAIN: u32 = 218;
 pub const RECT_TRANSFORM: u32 = 224;
 pub const PREFAB_INSTANCE: u32 = 1001;
 pub const TILEMAP_RENDERER: u32 = 483693784;
+pub const TERRAIN_LAYER: u32 = 1953259897;
 
 pub struct Doc<'a> {
     pub class: u32,

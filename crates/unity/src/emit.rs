@@ -163,6 +163,11 @@ pub fn emit(g: &Graph, scene_rel: &str, camera: Option<&str>) -> Result<Emitted,
                 e.skinned_object(gi, smr)?;
             }
         }
+        if let Some(t) = class_of(docs::TERRAIN) {
+            if e.draws(gi, t, &lod_hidden) {
+                e.terrain(gi, t)?;
+            }
+        }
         e.note_undrawn(gi, &comps, &mut undrawn);
         for &c in comps.iter().filter(|&&i| g.objs[i].class == docs::LIGHT) {
             e.light(gi, c)?;

@@ -276,7 +276,7 @@ pub fn alpha_mode(body: &Node, float: &dyn Fn(&str) -> Option<f32>) -> Alpha {
 }
 
 impl Emitter<'_, '_> {
-    fn default_material(&mut self) -> u32 {
+    pub(crate) fn default_material(&mut self) -> u32 {
         self.add_material("builtin:Default-Material".into(), Material::unity_default)
     }
 
@@ -371,6 +371,18 @@ impl Emitter<'_, '_> {
             format!("{origin} {}", self.g.project.rel(path))
         };
         (i, origin)
+    }
+
+    /// A material made from Material `body` that no file holds (a terrain layer's),
+    /// named `name`, kept under `source`.
+    pub(crate) fn synthetic_material(&mut self, body: &Node, name: &str, source: String) -> u32 {
+        if let Some(&i) = self.materials.get(&source) {
+            return i;
+        }
+        let (mut m, _notes) = convert(body, &source);
+        m.name = name.to_string();
+        self.mat_maps(&mut m, body, &source);
+        self.add_material(source, || m)
     }
 
     /// The texture maps of material `m`, converted from Material `body` (`what` names it

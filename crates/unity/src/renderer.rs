@@ -114,7 +114,13 @@ struct Placement {
 }
 
 impl Placements {
-    fn push(&mut self, mesh: Arc<Mesh>, world: Mat4, parts: Vec<(usize, u32)>, object: u32) {
+    pub(crate) fn push(
+        &mut self,
+        mesh: Arc<Mesh>,
+        world: Mat4,
+        parts: Vec<(usize, u32)>,
+        object: u32,
+    ) {
         let triangles = parts.iter().map(|&(si, _)| mesh.submeshes[si].len()).sum();
         let job = Placement {
             vertex: self.vertices,

@@ -1,5 +1,5 @@
-//! Components that draw in Unity's view but not in unitrace's: terrains, sprites, 3D text,
-//! lines and particles. None is converted; each kind enabled on a layer the camera draws is
+//! Components that draw in Unity's view but not in unitrace's: sprites, 3D text, lines
+//! and particles. None is converted; each kind enabled on a layer the camera draws is
 //! named once, with how many there are and the first few objects, so that a picture
 //! without them does not come as a surprise.
 
@@ -9,13 +9,7 @@ use crate::layer::layer;
 
 /// The kinds said: the class of the component that decides whether one is drawn, its
 /// name, plural, and why it is missing.
-const KINDS: [(u32, &str, &str, &str); 6] = [
-    (
-        docs::TERRAIN,
-        "Terrain",
-        "Terrains",
-        "terrain heightmaps are not converted",
-    ),
+const KINDS: [(u32, &str, &str, &str); 5] = [
     (
         docs::SPRITE_RENDERER,
         "SpriteRenderer",

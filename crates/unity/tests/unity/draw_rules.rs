@@ -450,7 +450,7 @@ fn component(sc: &mut Scene, id: i64, class: u32, kind: &str, go: i64, enabled: 
 }
 
 #[test]
-fn sprites_text_lines_particles_and_terrains_the_camera_would_show_are_named_once_per_kind() {
+fn sprites_text_lines_and_particles_the_camera_would_show_are_named_once_per_kind() {
     let mut sc = Scene::default();
     sc.camera(&Tf::at(0.0, 0.0, -5.0));
     sc.raw("  m_CullingMask:\n    serializedVersion: 2\n    m_Bits: 4294967039\n");
@@ -490,11 +490,12 @@ fn sprites_text_lines_particles_and_terrains_the_camera_would_show_are_named_onc
     assert_eq!(
         undrawn,
         [
-            "Assets/s.unity: object 'Ground': Terrain not drawn: terrain heightmaps are not converted",
             "Assets/s.unity: 5 SpriteRenderers not drawn ('S1', 'S2', 'S3' and 2 more): sprites are not converted",
             "Assets/s.unity: object 'Label': TextMesh not drawn: 3D text is not converted",
             "Assets/s.unity: object 'Line': LineRenderer not drawn: lines are not converted",
         ]
     );
     assert_eq!(soup.triangles.len(), 0);
+    assert_warned(&soup, "object 'Ground' (fileID");
+    assert_warned(&soup, "Terrain has no TerrainData; skipped");
 }

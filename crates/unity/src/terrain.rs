@@ -1,0 +1,611 @@
+//! Terrain (class 218): the heightmap of its TerrainData as a grid of triangles, drawn
+//! with the texture of its first terrain layer tiled as the layer tiles it.
+//!
+//! Unity writes TerrainData assets in its binary format whatever the project's
+//! serialization mode, so they are read through [`crate::serialized`]. A height is a
+//! 16-bit sample where 32766 is the terrain's full height (Unity's terrain tools scale
+//! heights by 32766 / 65535 into a 16-bit texture). A terrain ignores its Transform's
+//! rotation and scale: it lies along the world axes from its position. Splat maps (the
+//! painted blend of several layers), holes, trees and detail grass are not converted; a
+//! warning says so where the terrain has them.
+
+use crate::emit::{EmitError, Emitter};
+use crate::reference::Ref;
+use crate::serialized::{SerializedFile, Value};
+use formats::{CastShadows, Object};
+use glam::{Mat4, Vec2, Vec3};
+use std::sync::Arc;
+
+/// The class of a TerrainData object.
+const TERRAIN_DATA: i32 = 156;
+/// The height sample that stands for the terrain's full height.
+const FULL_HEIGHT: f32 = 32766.0;
+/// The most grid cells a side is drawn with: a 4097² heightmap would be 33.5 million
+/// triangles; beyond this many, every k-th sample is taken (Unity itself draws distant
+/// parts of a terrain at coarser levels of detail).
+const MAX_CELLS: usize = 1024;
+
+/// A terrain's geometry, read from its TerrainData.
+pub struct Heightfield {
+    /// Samples per side.
+    pub resolution: usize,
+    /// Row-major, rows along z: `heights[z * resolution + x]`, 0 to 1 of the full height.
+    pub heights: Vec<f32>,
+    /// Terrain size in metres (x, full height, z).
+    pub size: Vec3,
+}
+
+/// One terrain layer: its albedo texture by GUID and how it tiles.
+pub struct Layer {
+    pub name: String,
+    pub texture: Option<String>,
+    pub tile_size: Vec2,
+    pub tile_offset: Vec2,
+    pub smoothness: f32,
+    pub metallic: f32,
+}
+
+/// Read a TerrainData `id` of a binary asset: its heightfield, and its layers' GUIDs (of
+/// TerrainLayer assets, or with older files the textures of inline splat prototypes).
+pub fn read(file: &SerializedFile, id: i64) -> Result<(Heightfield, LayerRefs), String> {
+    let object = file
+        .objects
+        .iter()
+        .find(|o| o.path_id == id && o.class_id == TERRAIN_DATA)
+        .or_else(|| file.objects.iter().find(|o| o.class_id == TERRAIN_DATA))
+        .ok_or("holds no TerrainData")?;
+    let data = file.read(object.path_id).map_err(|e| e.to_string())?;
+    let hm = data
+        .get("m_Heightmap")
+        .ok_or("TerrainData has no m_Heightmap")?;
+    let resolution = hm
+        .get("m_Resolution")
+        .or_else(|| hm.get("m_Width"))
+        .and_then(Value::as_i64)
+        .ok_or("m_Heightmap has no resolution")?;
+    let Some(Value::Numbers(samples)) = hm.get("m_Heights") else {
+        return Err("m_Heightmap has no m_Heights".into());
+    };
+    let resolution = usize::try_from(resolution).unwrap_or(0);
+    if resolution < 2 || samples.len() != resolution * resolution {
+        return Err(format!(
+            "m_Heights holds {} samples for a resolution of {resolution}",
+            samples.len()
+        ));
+    }
+    let scale = hm.get("m_Scale").ok_or("m_Heightmap has no m_Scale")?;
+    let axis = |k: &str| scale.get(k).and_then(Value::as_f64).map(|v| v as f32);
+    let (Some(sx), Some(sy), Some(sz)) = (axis("x"), axis("y"), axis("z")) else {
+        return Err("m_Scale is not a vector".into());
+    };
+    let cells = (resolution - 1) as f32;
+    let size = Vec3::new(sx * cells, sy, sz * cells);
+    if !size.is_finite() {
+        return Err(format!("its size {size} is not finite"));
+    }
+    let heights = samples
+        .iter()
+        .map(|&h| (h as f32 / FULL_HEIGHT).clamp(0.0, 1.0))
+        .collect();
+    let field = Heightfield {
+        resolution,
+        heights,
+        size,
+    };
+    Ok((field, layer_refs(file, &data)))
+}
+
+/// Where a TerrainData's layers are: TerrainLayer assets (Unity 2018.3 and later) or
+/// splat prototypes written inline (earlier).
+pub enum LayerRefs {
+    Assets(Vec<Option<String>>),
+    Inline(Vec<Layer>),
+}
+
+/// The GUID a PPtr of `file` names (None for a local or empty reference).
+fn guid_of(file: &SerializedFile, pptr: &Value) -> Option<String> {
+    let index = pptr.get("m_FileID")?.as_i64()?;
+    let external = file
+        .externals
+        .get(usize::try_from(index).ok()?.checked_sub(1)?)?;
+    Some(external.guid.clone())
+}
+
+fn layer_refs(file: &SerializedFile, data: &Value) -> LayerRefs {
+    let splat = data.get("m_SplatDatabase");
+    let seq = |key: &str| match splat.and_then(|s| s.get(key)) {
+        Some(Value::Seq(items)) => Some(items.as_slice()),
+        _ => None,
+    };
+    if let Some(layers) = seq("m_TerrainLayers") {
+        return LayerRefs::Assets(layers.iter().map(|p| guid_of(file, p)).collect());
+    }
+    let prototypes = seq("m_Splats").unwrap_or_default();
+    let vec2 = |v: Option<&Value>, default: f32| {
+        let axis = |k| v.and_then(|v| v.get(k)).and_then(Value::as_f64);
+        Vec2::new(
+            axis("x").unwrap_or(default as f64) as f32,
+            axis("y").unwrap_or(default as f64) as f32,
+        )
+    };
+    LayerRefs::Inline(
+        prototypes
+            .iter()
+            .enumerate()
+            .map(|(i, p)| Layer {
+                name: format!("splat {i}"),
+                texture: p.get("texture").and_then(|t| guid_of(file, t)),
+                tile_size: vec2(p.get("tileSize"), 15.0),
+                tile_offset: vec2(p.get("tileOffset"), 0.0),
+                smoothness: p.get("smoothness").and_then(Value::as_f64).unwrap_or(0.0) as f32,
+                metallic: p.get("metallic").and_then(Value::as_f64).unwrap_or(0.0) as f32,
+            })
+            .collect(),
+    )
+}
+
+/// A TerrainLayer asset (`.terrainlayer`, text YAML).
+pub fn layer_asset(text: &str, name: &str) -> Option<Layer> {
+    let body = crate::docs::first(text, crate::docs::TERRAIN_LAYER)?;
+    let v2 = |k: &str, default: Vec2| {
+        body.get(k)
+            .and_then(|n| Some(Vec2::new(n.f32_at("x")?, n.f32_at("y")?)))
+            .unwrap_or(default)
+    };
+    let texture = body.get("m_DiffuseTexture").and_then(|n| {
+        let r = Ref::read(Some(n), 0);
+        r.guid.filter(|_| r.file_id != 0)
+    });
+    Some(Layer {
+        name: body.str_at("m_Name").unwrap_or(name).to_string(),
+        texture,
+        tile_size: v2("m_TileSize", Vec2::splat(15.0)),
+        tile_offset: v2("m_TileOffset", Vec2::ZERO),
+        smoothness: body.f32_at("m_Smoothness").unwrap_or(0.0),
+        metallic: body.f32_at("m_Metallic").unwrap_or(0.0),
+    })
+}
+
+impl Heightfield {
+    /// The grid as a mesh in the terrain's own space (Unity axes, origin at its corner),
+    /// every `step`-th sample a vertex, UVs 0 to 1 across it.
+    pub fn mesh(&self) -> crate::mesh::Mesh {
+        let res = self.resolution;
+        let step = (res - 1).div_ceil(MAX_CELLS);
+        let n = (res - 1) / step + 1;
+        // The last row and column always reach the far edge.
+        let sample = |k: usize| (k * step).min(res - 1);
+        let h = |x: usize, z: usize| self.heights[sample(z) * res + sample(x)] * self.size.y;
+        let along = |k: usize, extent: f32| sample(k) as f32 / (res - 1) as f32 * extent;
+        let mut positions = Vec::with_capacity(n * n);
+        let mut normals = Vec::with_capacity(n * n);
+        let mut uvs = Vec::with_capacity(n * n);
+        for z in 0..n {
+            for x in 0..n {
+                let (px, pz) = (along(x, self.size.x), along(z, self.size.z));
+                positions.push(Vec3::new(px, h(x, z), pz));
+                uvs.push(Vec2::new(
+                    sample(x) as f32 / (res - 1) as f32,
+                    sample(z) as f32 / (res - 1) as f32,
+                ));
+                // Central differences (one-sided at the edges) across the drawn grid.
+                let (x0, x1) = (x.saturating_sub(1), (x + 1).min(n - 1));
+                let (z0, z1) = (z.saturating_sub(1), (z + 1).min(n - 1));
+                let dx = (h(x1, z) - h(x0, z)) / (along(x1, self.size.x) - along(x0, self.size.x));
+                let dz = (h(x, z1) - h(x, z0)) / (along(z1, self.size.z) - along(z0, self.size.z));
+                let normal = Vec3::new(-dx, 1.0, -dz).normalize_or(Vec3::Y);
+                normals.push(normal);
+            }
+        }
+        let v = |x: usize, z: usize| (z * n + x) as u32;
+        let mut triangles = Vec::with_capacity(2 * (n - 1) * (n - 1));
+        for z in 0..n - 1 {
+            for x in 0..n - 1 {
+                // Clockwise seen from above: Unity's front faces, facing +y.
+                triangles.push([v(x, z), v(x, z + 1), v(x + 1, z)]);
+                triangles.push([v(x, z + 1), v(x + 1, z + 1), v(x + 1, z)]);
+            }
+        }
+        crate::mesh::Mesh {
+            positions,
+            normals,
+            submeshes: vec![triangles],
+            uvs,
+        }
+    }
+}
+
+impl Emitter<'_, '_> {
+    /// Draw Terrain component `terrain` on GameObject `go`, or say why not.
+    pub(crate) fn terrain(&mut self, go: usize, terrain: usize) -> Result<(), EmitError> {
+        let g = self.g;
+        let what = self.describe(go);
+        let body = &g.objs[terrain].body;
+        if body.i64_at("m_DrawHeightmap") == Some(0) {
+            return Ok(());
+        }
+        let r = Ref::read(body.get("m_TerrainData"), g.objs[terrain].file);
+        let Some(guid) = r.guid.as_deref().filter(|_| r.file_id != 0) else {
+            self.warn(format!("{what}: Terrain has no TerrainData; skipped"));
+            return Ok(());
+        };
+        let Some(path) = g.project.resolve(guid).cloned() else {
+            self.warn(format!(
+                "{what}: TerrainData GUID {guid} is not in the project; skipped"
+            ));
+            return Ok(());
+        };
+        let rel = g.project.rel(&path);
+        let parsed = std::fs::read(&path)
+            .map_err(|e| e.to_string())
+            .and_then(|bytes| {
+                if !SerializedFile::is_serialized_file(&bytes) {
+                    return Err("is not a binary Unity asset".into());
+                }
+                SerializedFile::parse(bytes, &rel).map_err(|e| e.to_string())
+            })
+            .and_then(|file| {
+                let (field, layers) = read(&file, r.file_id)?;
+                Ok((field, layers))
+            });
+        let (field, layers) = match parsed {
+            Ok(x) => x,
+            Err(why) => {
+                let why = why
+                    .strip_prefix(&format!("{rel}: "))
+                    .unwrap_or(&why)
+                    .to_string();
+                self.warn(format!("{what}: TerrainData {rel}: {why}; skipped"));
+                return Ok(());
+            }
+        };
+        let world = self.checked_world(go)?;
+        // A terrain takes its position alone.
+        let world = Mat4::from_translation(world.w_axis.truncate());
+        let layers = self.terrain_layers(layers, &what);
+        let material = self.terrain_material(&layers, field.size, &what, &rel);
+        if field.resolution - 1 > MAX_CELLS {
+            let step = (field.resolution - 1).div_ceil(MAX_CELLS);
+            self.warn(format!(
+                "{what}: its {r}×{r} heightmap is drawn from every {step}th sample \
+                 ({MAX_CELLS} cells a side at most)",
+                r = field.resolution
+            ));
+        }
+        let mesh = Arc::new(field.mesh());
+        let object = self.soup.objects.len() as u32;
+        self.soup.objects.push(Object {
+            name: self.path(go),
+            source: rel.clone(),
+            layer: crate::layer::layer(&g.objs[go].body),
+            cast_shadows: match body.i64_at("m_ShadowCastingMode") {
+                Some(0) => CastShadows::Off,
+                Some(2) => CastShadows::TwoSided,
+                Some(3) => CastShadows::ShadowsOnly,
+                _ => CastShadows::On,
+            },
+            receive_shadows: true,
+        });
+        self.material_origins
+            .push(vec![(material, format!("terrain layers of {rel}"))]);
+        self.placements
+            .push(mesh, world, vec![(0, material)], object);
+        Ok(())
+    }
+
+    fn warn(&mut self, line: String) {
+        self.soup.warnings.push(line);
+    }
+
+    /// The layers as listed, TerrainLayer assets read; a missing asset is left out with a
+    /// warning.
+    fn terrain_layers(&mut self, refs: LayerRefs, what: &str) -> Vec<Layer> {
+        let guids = match refs {
+            LayerRefs::Inline(layers) => return layers,
+            LayerRefs::Assets(guids) => guids,
+        };
+        let mut layers = Vec::new();
+        for guid in guids.into_iter().flatten() {
+            let Some(path) = self.g.project.resolve(&guid).cloned() else {
+                self.warn(format!(
+                    "{what}: terrain layer GUID {guid} is not in the project; left out"
+                ));
+                continue;
+            };
+            let rel = self.g.project.rel(&path);
+            match std::fs::read_to_string(&path)
+                .ok()
+                .and_then(|t| layer_asset(&t, &rel))
+            {
+                Some(layer) => layers.push(layer),
+                None => self.warn(format!("{what}: {rel} is not a TerrainLayer; left out")),
+            }
+        }
+        layers
+    }
+
+    /// The soup material of a terrain of `size` with `layers`: the first layer's texture,
+    /// tiled over the terrain as the layer tiles it; Unity's default material without
+    /// layers.
+    fn terrain_material(&mut self, layers: &[Layer], size: Vec3, what: &str, rel: &str) -> u32 {
+        let Some(first) = layers.first() else {
+            return self.default_material();
+        };
+        if layers.len() > 1 {
+            self.warn(format!(
+                "{what}: {} terrain layers; drawn with the first, '{}', alone (splat \
+                 maps are not converted)",
+                layers.len(),
+                first.name
+            ));
+        }
+        let tile = first.tile_size.max(Vec2::splat(1e-3));
+        let scale = Vec2::new(size.x, size.z) / tile;
+        let offset = first.tile_offset / tile;
+        let texture = match &first.texture {
+            Some(guid) => format!(
+                "    - _MainTex:\n        m_Texture: {{fileID: 2800000, guid: {guid}, type: 3}}\n        m_Scale: {{x: {}, y: {}}}\n        m_Offset: {{x: {}, y: {}}}\n",
+                scale.x, scale.y, offset.x, offset.y
+            ),
+            None => String::new(),
+        };
+        // The layer as the Standard material it shades like, so that its texture is
+        // found, imported and tiled as any material's is.
+        let text = format!(
+            "Material:\n  m_SavedProperties:\n    m_TexEnvs:\n{texture}    m_Floats:\n    - _Glossiness: {}\n    - _Metallic: {}\n    m_Colors:\n    - _Color: {{r: 1, g: 1, b: 1, a: 1}}\n",
+            first.smoothness, first.metallic
+        );
+        let source = format!("{rel}#layer:{}", first.name);
+        let doc = crate::yaml::parse(&text);
+        let body = doc.get("Material").cloned().unwrap_or(doc);
+        self.synthetic_material(&body, &first.name, source)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::serialized::tests::{file, ObjSpec, TypeSpec, ALIGN, GUID_TEXT, W};
+
+    /// A TerrainData of `resolution`² heights (`heights`), spacing (2, 50, 4), with one
+    /// layer: a TerrainLayer asset (the only external) when `assets`, else (the layout
+    /// before Unity 2018.3) a splat prototype whose texture is that external.
+    fn terrain_data(version: u32, resolution: i32, heights: &[i16], assets: bool) -> Vec<u8> {
+        let mut n = vec![(0, "TerrainData", "Base", -1, 0, 0)];
+        n.extend([
+            (1, "SplatDatabase", "m_SplatDatabase", -1, 0, 0),
+            (
+                2,
+                "vector",
+                if assets {
+                    "m_TerrainLayers"
+                } else {
+                    "m_Splats"
+                },
+                -1,
+                0,
+                0,
+            ),
+            (3, "Array", "Array", -1, 1, 0),
+            (4, "int", "size", 4, 0, 0),
+        ]);
+        if assets {
+            n.extend([
+                (4, "PPtr<TerrainLayer>", "data", 12, 0, 0),
+                (5, "int", "m_FileID", 4, 0, 0),
+                (5, "SInt64", "m_PathID", 8, 0, 0),
+            ]);
+        } else {
+            n.extend([
+                (4, "SplatPrototype", "data", -1, 0, 0),
+                (5, "PPtr<Texture2D>", "texture", 12, 0, 0),
+                (6, "int", "m_FileID", 4, 0, 0),
+                (6, "SInt64", "m_PathID", 8, 0, 0),
+                (5, "Vector2f", "tileSize", 8, 0, 0),
+                (6, "float", "x", 4, 0, 0),
+                (6, "float", "y", 4, 0, 0),
+                (5, "float", "smoothness", 4, 0, 0),
+            ]);
+        }
+        n.extend([
+            (1, "Heightmap", "m_Heightmap", -1, 0, 0),
+            (2, "vector", "m_Heights", -1, 0, 0),
+            (3, "Array", "Array", -1, 1, ALIGN),
+            (4, "int", "size", 4, 0, 0),
+            (4, "SInt16", "data", 2, 0, 0),
+            (
+                2,
+                "int",
+                if assets { "m_Resolution" } else { "m_Width" },
+                4,
+                0,
+                0,
+            ),
+            (2, "Vector3f", "m_Scale", 12, 0, 0),
+            (3, "float", "x", 4, 0, 0),
+            (3, "float", "y", 4, 0, 0),
+            (3, "float", "z", 4, 0, 0),
+        ]);
+        let mut w = W::new(false);
+        w.i32(1);
+        w.i32(1);
+        w.i64(if assets { 8574412962073106934 } else { 2800000 });
+        if !assets {
+            w.f32(7.0);
+            w.f32(3.0);
+            w.f32(0.25);
+        }
+        w.i32(heights.len() as i32);
+        for &h in heights {
+            w.i16(h);
+        }
+        w.align();
+        w.i32(resolution);
+        for v in [2.0, 50.0, 4.0] {
+            w.f32(v);
+        }
+        let types = [TypeSpec {
+            class_id: TERRAIN_DATA,
+            nodes: n,
+        }];
+        let objects = [ObjSpec {
+            path_id: 15600000,
+            type_index: 0,
+            data: w.buf,
+        }];
+        file(version, false, true, &types, &objects)
+    }
+
+    #[test]
+    fn terrain_data_reads_heights_size_and_layers_in_both_layouts() {
+        let heights = [0, 16383, 32766, -5, 32767, 0, 0, 0, 100];
+        for (version, assets) in [(22, true), (17, true), (17, false)] {
+            let bytes = terrain_data(version, 3, &heights, assets);
+            let file = SerializedFile::parse(bytes, "Assets/T.asset").unwrap();
+            let (field, layers) = read(&file, 15600000).unwrap();
+            assert_eq!(field.resolution, 3);
+            assert_eq!(field.size, Vec3::new(4.0, 50.0, 8.0));
+            let expect = [
+                0.0,
+                16383.0 / 32766.0,
+                1.0,
+                0.0,
+                1.0,
+                0.0,
+                0.0,
+                0.0,
+                100.0 / 32766.0,
+            ];
+            assert_eq!(field.heights, expect);
+            match layers {
+                LayerRefs::Assets(guids) => {
+                    assert!(assets);
+                    assert_eq!(guids, [Some(GUID_TEXT.to_string())]);
+                }
+                LayerRefs::Inline(splats) => {
+                    assert!(!assets);
+                    assert_eq!(splats.len(), 1);
+                    assert_eq!(splats[0].texture.as_deref(), Some(GUID_TEXT));
+                    assert_eq!(splats[0].tile_size, Vec2::new(7.0, 3.0));
+                    assert_eq!(splats[0].smoothness, 0.25);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_heightmap_that_does_not_match_its_resolution_is_refused() {
+        let bytes = terrain_data(22, 4, &[0; 9], true);
+        let file = SerializedFile::parse(bytes, "Assets/T.asset").unwrap();
+        let err = read(&file, 15600000).err().unwrap();
+        assert_eq!(err, "m_Heights holds 9 samples for a resolution of 4");
+    }
+
+    fn field(resolution: usize, size: Vec3, height: impl Fn(usize, usize) -> f32) -> Heightfield {
+        let heights = (0..resolution * resolution)
+            .map(|i| height(i % resolution, i / resolution))
+            .collect();
+        Heightfield {
+            resolution,
+            heights,
+            size,
+        }
+    }
+
+    #[test]
+    fn the_grid_spans_the_terrain_and_faces_up() {
+        // 3×3 samples over 10 m × 20 m, 4 m high, raised along z.
+        let f = field(3, Vec3::new(10.0, 4.0, 20.0), |_, z| z as f32 / 2.0);
+        let m = f.mesh();
+        assert_eq!(m.positions.len(), 9);
+        assert_eq!(m.submeshes[0].len(), 8);
+        assert_eq!(m.positions[0], Vec3::ZERO);
+        assert_eq!(m.positions[2], Vec3::new(10.0, 0.0, 0.0));
+        assert_eq!(m.positions[8], Vec3::new(10.0, 4.0, 20.0));
+        assert_eq!(m.uvs[5], Vec2::new(1.0, 0.5));
+        // Slope 4 m over 20 m along z: the normal leans back toward −z.
+        let expect = Vec3::new(0.0, 1.0, -0.2).normalize();
+        for n in &m.normals {
+            assert!(n.abs_diff_eq(expect, 1e-6), "{n}");
+        }
+        // Unity's front faces (clockwise seen from the front) face the normal: in Unity's
+        // left-handed space cross(b − a, c − a) points out of the front.
+        for t in &m.submeshes[0] {
+            let [a, b, c] = t.map(|i| m.positions[i as usize]);
+            let n = (b - a).cross(c - a).normalize();
+            assert!(n.abs_diff_eq(expect, 1e-6), "{t:?}: {n}");
+        }
+    }
+
+    #[test]
+    fn a_large_heightmap_is_drawn_from_every_kth_sample_to_its_far_edge() {
+        // 2,050 samples a side (2,049 cells): every 3rd sample, 684 cells, the last one
+        // shorter.
+        let res = 2050;
+        let f = field(res, Vec3::new(2049.0, 1.0, 2049.0), |x, z| {
+            ((x + z) % 2) as f32
+        });
+        let m = f.mesh();
+        let n = 2049usize.div_ceil(3) + 1;
+        assert_eq!(m.positions.len(), n * n);
+        assert_eq!(m.submeshes[0].len(), 2 * (n - 1) * (n - 1));
+        assert_eq!(m.positions[1], Vec3::new(3.0, 1.0, 0.0));
+        assert_eq!(m.positions[n - 1].x, 2049.0);
+        assert_eq!(m.positions[n * n - 1], Vec3::new(2049.0, 0.0, 2049.0));
+    }
+
+    #[test]
+    fn a_scene_terrain_lies_along_the_axes_from_its_position_with_its_layer_tiled() {
+        let dir = tempfile::tempdir().unwrap();
+        let assets = dir.path().join("Assets");
+        std::fs::create_dir_all(&assets).unwrap();
+        let put = |name: &str, bytes: &[u8], guid: &str| {
+            std::fs::write(assets.join(name), bytes).unwrap();
+            let meta = format!("fileFormatVersion: 2\nguid: {guid}\n");
+            std::fs::write(assets.join(format!("{name}.meta")), meta).unwrap();
+        };
+        put(
+            "T.asset",
+            &terrain_data(22, 3, &[0, 0, 0, 0, 32766, 0, 0, 0, 0], true),
+            "aaaa0000aaaa0000aaaa0000aaaa0000",
+        );
+        let layer = "%YAML 1.1\n--- !u!1953259897 &8574412962073106934\nTerrainLayer:\n  m_Name: Grass\n  m_DiffuseTexture: {fileID: 2800000, guid: bbbb0000bbbb0000bbbb0000bbbb0000, type: 3}\n  m_TileSize: {x: 2, y: 4}\n  m_TileOffset: {x: 1, y: 0}\n  m_Smoothness: 0.25\n";
+        put("Grass.terrainlayer", layer.as_bytes(), GUID_TEXT);
+        let mut png = std::io::Cursor::new(Vec::new());
+        image::RgbaImage::from_pixel(2, 2, image::Rgba([0, 255, 0, 255]))
+            .write_to(&mut png, image::ImageFormat::Png)
+            .unwrap();
+        put("g.png", png.get_ref(), "bbbb0000bbbb0000bbbb0000bbbb0000");
+        // Turned and scaled, which a terrain ignores.
+        let scene = "%YAML 1.1\n--- !u!1 &10\nGameObject:\n  m_Component:\n  - component: {fileID: 11}\n  m_Name: Ground\n  m_IsActive: 1\n--- !u!4 &11\nTransform:\n  m_GameObject: {fileID: 10}\n  m_LocalRotation: {x: 0, y: 0.7071068, z: 0, w: 0.7071068}\n  m_LocalPosition: {x: 10, y: 1, z: 20}\n  m_LocalScale: {x: 2, y: 2, z: 2}\n  m_Father: {fileID: 0}\n--- !u!218 &12\nTerrain:\n  m_GameObject: {fileID: 10}\n  m_Enabled: 1\n  m_TerrainData: {fileID: 15600000, guid: aaaa0000aaaa0000aaaa0000aaaa0000, type: 2}\n  m_ShadowCastingMode: 0\n";
+        put(
+            "s.unity",
+            scene.as_bytes(),
+            "cccc0000cccc0000cccc0000cccc0000",
+        );
+        let r = crate::convert_report(&assets.join("s.unity"), &crate::Options::default()).unwrap();
+        let soup = &r.soup;
+        assert_eq!(soup.triangles.len(), 8, "{:?}", soup.warnings);
+        assert_eq!(soup.objects[0].name, "Ground");
+        assert_eq!(soup.objects[0].cast_shadows, CastShadows::Off);
+        // Unity x is negated in the soup; 4 m × 8 m from (10, 1, 20), the middle sample
+        // at the full 50 m.
+        let pos = |i: usize| soup.positions[i];
+        let mut xs: Vec<f32> = (0..soup.positions.len()).map(|i| pos(i).x).collect();
+        xs.sort_by(f32::total_cmp);
+        assert_eq!((xs[0], xs[xs.len() - 1]), (-14.0, -10.0));
+        assert!((0..9).any(|i| pos(i) == Vec3::new(-12.0, 51.0, 24.0)));
+        assert!((0..9).any(|i| pos(i) == Vec3::new(-14.0, 1.0, 28.0)));
+        let m = &soup.materials[0];
+        assert_eq!((m.name.as_str(), m.smoothness), ("Grass", 0.25));
+        let map = m.albedo_map.expect("the layer's texture");
+        // 4 m / 2 m and 8 m / 4 m repeats; an offset of 1 m is half a 2 m tile.
+        assert_eq!(map.tiling.scale, [2.0, 2.0]);
+        assert_eq!(map.tiling.offset, [0.5, 0.0]);
+        assert_eq!(soup.textures.len(), 1);
+        assert_eq!(
+            soup.warnings,
+            ["Assets/s.unity: no enabled camera renders to the display; Unity's default camera used"]
+        );
+    }
+}
