@@ -1547,23 +1547,24 @@ pub(crate) mod tests {
         assert_eq!(common_string(u32::MAX), None);
     }
 
+    /// A format 17 file of one type with `nodes` and one object of four zero bytes.
+    fn one_object(nodes: Vec<NodeSpec>) -> Vec<u8> {
+        let types = [TypeSpec {
+            class_id: 1001,
+            nodes,
+        }];
+        let objects = [ObjSpec {
+            path_id: 1,
+            type_index: 0,
+            data: vec![0; 4],
+        }];
+        file(17, false, true, &types, &objects)
+    }
+
     #[test]
     fn unknown_common_string_is_an_error() {
         let nodes = vec![(0, "Thing", "Base", -1, 0, 0), (1, "int", "m_X", 4, 0, 0)];
-        let mut bytes = file(
-            17,
-            false,
-            true,
-            &[TypeSpec {
-                class_id: 1001,
-                nodes,
-            }],
-            &[ObjSpec {
-                path_id: 1,
-                type_index: 0,
-                data: vec![0; 4],
-            }],
-        );
+        let mut bytes = one_object(nodes);
         // The "int" type offset (222 | top bit) becomes 223, the middle of a string.
         let needle = (COMMON_BIT | 222).to_le_bytes();
         let at = bytes.windows(4).position(|w| w == needle).unwrap();
@@ -1645,20 +1646,7 @@ pub(crate) mod tests {
             .map(|(i, &t)| (i as u8, t, "m_Child", -1, 0, 0))
             .collect();
         nodes.push((100, "int", "m_X", 4, 0, 0));
-        let bytes = file(
-            17,
-            false,
-            true,
-            &[TypeSpec {
-                class_id: 1001,
-                nodes,
-            }],
-            &[ObjSpec {
-                path_id: 1,
-                type_index: 0,
-                data: vec![0; 4],
-            }],
-        );
+        let bytes = one_object(nodes);
         let f = SerializedFile::parse(bytes, "d").unwrap();
         let e = f.read(1).unwrap_err();
         assert!(e.to_string().contains("deeper than 64"), "{e}");

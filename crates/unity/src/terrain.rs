@@ -1,13 +1,14 @@
-//! Terrain (class 218): the heightmap of its TerrainData as a grid of triangles, drawn
-//! with the texture of its first terrain layer tiled as the layer tiles it.
+//! Terrain (class 218): the heightmap of its TerrainData as a grid of triangles, each
+//! cell drawn with the texture of the layer its splat maps weigh most at the cell's
+//! centre, tiled as that layer tiles it.
 //!
 //! Unity writes TerrainData assets in its binary format whatever the project's
 //! serialization mode, so they are read through [`crate::serialized`]. A height is a
 //! 16-bit sample where 32766 is the terrain's full height (Unity's terrain tools scale
 //! heights by 32766 / 65535 into a 16-bit texture). A terrain ignores its Transform's
-//! rotation and scale: it lies along the world axes from its position. Splat maps (the
-//! painted blend of several layers), holes, trees and detail grass are not converted; a
-//! warning says so where the terrain has them.
+//! rotation and scale: it lies along the world axes from its position. The smooth blend
+//! between layers, holes, trees and detail grass are not converted; a warning names a
+//! terrain with more than one layer and how much of it each covers.
 
 use crate::emit::{EmitError, Emitter};
 use crate::reference::Ref;
@@ -45,9 +46,58 @@ pub struct Layer {
     pub metallic: f32,
 }
 
-/// Read a TerrainData `id` of a binary asset: its heightfield, and its layers' GUIDs (of
-/// TerrainLayer assets, or with older files the textures of inline splat prototypes).
-pub fn read(file: &SerializedFile, id: i64) -> Result<(Heightfield, LayerRefs), String> {
+/// A TerrainData as read: its heightfield, its layers' GUIDs (of TerrainLayer assets, or
+/// with older files the textures of inline splat prototypes), and its splat maps (None
+/// when they cannot be read).
+pub struct TerrainData {
+    pub field: Heightfield,
+    pub layers: LayerRefs,
+    pub splat: Option<Splat>,
+}
+
+/// The splat maps: RGBA textures over the terrain whose channels R, G, B, A weigh layers
+/// 4k to 4k + 3, row 0 at the terrain's z = 0 edge.
+pub struct Splat {
+    pub maps: Vec<SplatMap>,
+}
+
+pub struct SplatMap {
+    pub width: usize,
+    pub height: usize,
+    /// R, G, B, A per texel, rows from the bottom.
+    pub texels: Vec<[u8; 4]>,
+}
+
+impl Splat {
+    /// Layer `layer`'s weight (0–255) at terrain coordinates `u`, `v` in 0..1, from the
+    /// nearest texel.
+    pub fn weight(&self, layer: usize, u: f32, v: f32) -> u8 {
+        let Some(map) = self.maps.get(layer / 4) else {
+            return 0;
+        };
+        let at = |t: f32, n: usize| ((t * n as f32) as usize).min(n - 1);
+        map.texels[at(v, map.height) * map.width + at(u, map.width)][layer % 4]
+    }
+
+    /// The share of the terrain each layer's weight covers.
+    pub fn coverage(&self) -> Vec<f64> {
+        self.maps
+            .iter()
+            .flat_map(|m| {
+                let mut sums = [0u64; 4];
+                for t in &m.texels {
+                    for (s, &w) in sums.iter_mut().zip(t) {
+                        *s += w as u64;
+                    }
+                }
+                sums.map(|s| s as f64 / (255.0 * m.texels.len() as f64))
+            })
+            .collect()
+    }
+}
+
+/// Read TerrainData `id` of a binary asset.
+pub fn read(file: &SerializedFile, id: i64) -> Result<TerrainData, String> {
     let object = file
         .objects
         .iter()
@@ -92,7 +142,49 @@ pub fn read(file: &SerializedFile, id: i64) -> Result<(Heightfield, LayerRefs), 
         heights,
         size,
     };
-    Ok((field, layer_refs(file, &data)))
+    Ok(TerrainData {
+        field,
+        layers: layer_refs(file, &data),
+        splat: splat(file, &data),
+    })
+}
+
+/// The splat maps of a TerrainData, if every one is in the file as an RGBA32 or ARGB32
+/// texture (Unity writes them so).
+fn splat(file: &SerializedFile, data: &Value) -> Option<Splat> {
+    let Some(Value::Seq(refs)) = data.path(&["m_SplatDatabase", "m_AlphaTextures"]) else {
+        return None;
+    };
+    let mut maps = Vec::new();
+    for r in refs {
+        let texture = file.read(r.get("m_PathID")?.as_i64()?).ok()?;
+        let side = |k: &str| usize::try_from(texture.get(k)?.as_i64()?).ok();
+        let (width, height) = (side("m_Width")?, side("m_Height")?);
+        // Where R, G, B and A are in a texel's bytes.
+        let order = match texture.get("m_TextureFormat")?.as_i64()? {
+            4 => [0, 1, 2, 3],
+            5 => [1, 2, 3, 0],
+            _ => return None,
+        };
+        let Some(Value::Bytes(bytes)) = texture.get("image data") else {
+            return None;
+        };
+        // The first mip level, the full-size map.
+        let level = bytes.get(..width.checked_mul(height)?.checked_mul(4)?)?;
+        if level.is_empty() {
+            return None;
+        }
+        let texels = level
+            .chunks_exact(4)
+            .map(|t| order.map(|at| t[at]))
+            .collect();
+        maps.push(SplatMap {
+            width,
+            height,
+            texels,
+        });
+    }
+    Some(Splat { maps })
 }
 
 /// Where a TerrainData's layers are: TerrainLayer assets (Unity 2018.3 and later) or
@@ -168,8 +260,9 @@ pub fn layer_asset(text: &str, name: &str) -> Option<Layer> {
 
 impl Heightfield {
     /// The grid as a mesh in the terrain's own space (Unity axes, origin at its corner),
-    /// every `step`-th sample a vertex, UVs 0 to 1 across it.
-    pub fn mesh(&self) -> crate::mesh::Mesh {
+    /// every `step`-th sample a vertex, UVs 0 to 1 across it; each cell's two triangles in
+    /// sub-mesh `part(u, v)` of `parts`, (u, v) the cell's centre.
+    pub fn mesh(&self, parts: usize, part: impl Fn(f32, f32) -> usize) -> crate::mesh::Mesh {
         let res = self.resolution;
         let step = (res - 1).div_ceil(MAX_CELLS);
         let n = (res - 1) / step + 1;
@@ -198,18 +291,21 @@ impl Heightfield {
             }
         }
         let v = |x: usize, z: usize| (z * n + x) as u32;
-        let mut triangles = Vec::with_capacity(2 * (n - 1) * (n - 1));
+        let mut submeshes = vec![Vec::new(); parts.max(1)];
         for z in 0..n - 1 {
             for x in 0..n - 1 {
+                let centre = |a: Vec2, b: Vec2| (a + b) / 2.0;
+                let c = centre(uvs[v(x, z) as usize], uvs[v(x + 1, z + 1) as usize]);
+                let tris = &mut submeshes[part(c.x, c.y).min(parts.max(1) - 1)];
                 // Clockwise seen from above: Unity's front faces, facing +y.
-                triangles.push([v(x, z), v(x, z + 1), v(x + 1, z)]);
-                triangles.push([v(x, z + 1), v(x + 1, z + 1), v(x + 1, z)]);
+                tris.push([v(x, z), v(x, z + 1), v(x + 1, z)]);
+                tris.push([v(x, z + 1), v(x + 1, z + 1), v(x + 1, z)]);
             }
         }
         crate::mesh::Mesh {
             positions,
             normals,
-            submeshes: vec![triangles],
+            submeshes,
             uvs,
         }
     }
@@ -244,11 +340,12 @@ impl Emitter<'_, '_> {
                 }
                 SerializedFile::parse(bytes, &rel).map_err(|e| e.to_string())
             })
-            .and_then(|file| {
-                let (field, layers) = read(&file, r.file_id)?;
-                Ok((field, layers))
-            });
-        let (field, layers) = match parsed {
+            .and_then(|file| read(&file, r.file_id));
+        let TerrainData {
+            field,
+            layers,
+            splat,
+        } = match parsed {
             Ok(x) => x,
             Err(why) => {
                 let why = why
@@ -263,7 +360,8 @@ impl Emitter<'_, '_> {
         // A terrain takes its position alone.
         let world = Mat4::from_translation(world.w_axis.truncate());
         let layers = self.terrain_layers(layers, &what);
-        let material = self.terrain_material(&layers, field.size, &what, &rel);
+        let coverage = splat.as_ref().map(Splat::coverage).unwrap_or_default();
+        self.warn_layers(&layers, &coverage, &what);
         if field.resolution - 1 > MAX_CELLS {
             let step = (field.resolution - 1).div_ceil(MAX_CELLS);
             self.warn(format!(
@@ -272,7 +370,27 @@ impl Emitter<'_, '_> {
                 r = field.resolution
             ));
         }
-        let mesh = Arc::new(field.mesh());
+        // Each cell takes the drawn layer that weighs most at its centre (the first of
+        // equals); without splat maps, every cell the first drawn layer.
+        let drawn: Vec<usize> = (0..layers.len()).filter(|&i| layers[i].is_some()).collect();
+        let mesh = Arc::new(field.mesh(drawn.len().max(1), |u, v| {
+            let weight = |i: usize| splat.as_ref().map_or(0, |s| s.weight(drawn[i], u, v));
+            (0..drawn.len())
+                .reduce(|best, i| if weight(i) > weight(best) { i } else { best })
+                .unwrap_or(0)
+        }));
+        // Materials only for the layers that draw a cell: each decodes a texture.
+        let mut parts = Vec::new();
+        for (i, tris) in mesh.submeshes.iter().enumerate() {
+            if tris.is_empty() {
+                continue;
+            }
+            let material = match drawn.get(i).and_then(|&l| layers[l].as_ref()) {
+                Some(layer) => self.layer_material(layer, field.size, &rel),
+                None => self.default_material(),
+            };
+            parts.push((i, material));
+        }
         let object = self.soup.objects.len() as u32;
         self.soup.objects.push(Object {
             name: self.path(go),
@@ -286,10 +404,10 @@ impl Emitter<'_, '_> {
             },
             receive_shadows: true,
         });
+        let origin = format!("terrain layers of {rel}");
         self.material_origins
-            .push(vec![(material, format!("terrain layers of {rel}"))]);
-        self.placements
-            .push(mesh, world, vec![(0, material)], object);
+            .push(parts.iter().map(|&(_, m)| (m, origin.clone())).collect());
+        self.placements.push(mesh, world, parts, object);
         Ok(())
     }
 
@@ -297,52 +415,84 @@ impl Emitter<'_, '_> {
         self.soup.warnings.push(line);
     }
 
-    /// The layers as listed, TerrainLayer assets read; a missing asset is left out with a
-    /// warning.
-    fn terrain_layers(&mut self, refs: LayerRefs, what: &str) -> Vec<Layer> {
+    /// The layers in the splat maps' order, TerrainLayer assets read; a missing asset is
+    /// None, with a warning.
+    fn terrain_layers(&mut self, refs: LayerRefs, what: &str) -> Vec<Option<Layer>> {
         let guids = match refs {
-            LayerRefs::Inline(layers) => return layers,
+            LayerRefs::Inline(layers) => {
+                // A splat prototype has no name of its own: its texture's file names it.
+                let project = self.g.project;
+                let named = |mut l: Layer| {
+                    let file = l.texture.as_deref().and_then(|g| project.resolve(g));
+                    if let Some(stem) = file.and_then(|f| f.file_stem()) {
+                        l.name = stem.to_string_lossy().into_owned();
+                    }
+                    Some(l)
+                };
+                return layers.into_iter().map(named).collect();
+            }
             LayerRefs::Assets(guids) => guids,
         };
         let mut layers = Vec::new();
-        for guid in guids.into_iter().flatten() {
+        for guid in guids {
+            let Some(guid) = guid else {
+                layers.push(None);
+                continue;
+            };
             let Some(path) = self.g.project.resolve(&guid).cloned() else {
                 self.warn(format!(
                     "{what}: terrain layer GUID {guid} is not in the project; left out"
                 ));
+                layers.push(None);
                 continue;
             };
             let rel = self.g.project.rel(&path);
-            match std::fs::read_to_string(&path)
+            let layer = std::fs::read_to_string(&path)
                 .ok()
-                .and_then(|t| layer_asset(&t, &rel))
-            {
-                Some(layer) => layers.push(layer),
-                None => self.warn(format!("{what}: {rel} is not a TerrainLayer; left out")),
+                .and_then(|t| layer_asset(&t, &rel));
+            if layer.is_none() {
+                self.warn(format!("{what}: {rel} is not a TerrainLayer; left out"));
             }
+            layers.push(layer);
         }
         layers
     }
 
-    /// The soup material of a terrain of `size` with `layers`: the first layer's texture,
-    /// tiled over the terrain as the layer tiles it; Unity's default material without
-    /// layers.
-    fn terrain_material(&mut self, layers: &[Layer], size: Vec3, what: &str, rel: &str) -> u32 {
-        let Some(first) = layers.first() else {
-            return self.default_material();
-        };
+    /// A warning naming every layer of a terrain with several, and the share `coverage`
+    /// gives each.
+    fn warn_layers(&mut self, layers: &[Option<Layer>], coverage: &[f64], what: &str) {
         if layers.len() > 1 {
+            let shares: Vec<String> = layers
+                .iter()
+                .enumerate()
+                .map(|(i, l)| {
+                    let name = l.as_ref().map_or("(missing)", |l| l.name.as_str());
+                    match coverage.get(i) {
+                        Some(c) => format!("'{name}' {:.0} %", c * 100.0),
+                        None => format!("'{name}'"),
+                    }
+                })
+                .collect();
+            let rule = if coverage.is_empty() {
+                "its splat maps are not readable, so it is drawn with the first layer"
+            } else {
+                "each cell is drawn with the layer that weighs most at its centre, not blended"
+            };
             self.warn(format!(
-                "{what}: {} terrain layers; drawn with the first, '{}', alone (splat \
-                 maps are not converted)",
+                "{what}: {} terrain layers ({}); {rule}",
                 layers.len(),
-                first.name
+                shares.join(", ")
             ));
         }
-        let tile = first.tile_size.max(Vec2::splat(1e-3));
+    }
+
+    /// Layer `layer` as the Standard material it shades like, its texture tiled over a
+    /// terrain of `size` as the layer tiles it.
+    fn layer_material(&mut self, layer: &Layer, size: Vec3, rel: &str) -> u32 {
+        let tile = layer.tile_size.max(Vec2::splat(1e-3));
         let scale = Vec2::new(size.x, size.z) / tile;
-        let offset = first.tile_offset / tile;
-        let texture = match &first.texture {
+        let offset = layer.tile_offset / tile;
+        let texture = match &layer.texture {
             Some(guid) => format!(
                 "    - _MainTex:\n        m_Texture: {{fileID: 2800000, guid: {guid}, type: 3}}\n        m_Scale: {{x: {}, y: {}}}\n        m_Offset: {{x: {}, y: {}}}\n",
                 scale.x, scale.y, offset.x, offset.y
@@ -353,12 +503,12 @@ impl Emitter<'_, '_> {
         // found, imported and tiled as any material's is.
         let text = format!(
             "Material:\n  m_SavedProperties:\n    m_TexEnvs:\n{texture}    m_Floats:\n    - _Glossiness: {}\n    - _Metallic: {}\n    m_Colors:\n    - _Color: {{r: 1, g: 1, b: 1, a: 1}}\n",
-            first.smoothness, first.metallic
+            layer.smoothness, layer.metallic
         );
-        let source = format!("{rel}#layer:{}", first.name);
+        let source = format!("{rel}#layer:{}", layer.name);
         let doc = crate::yaml::parse(&text);
         let body = doc.get("Material").cloned().unwrap_or(doc);
-        self.synthetic_material(&body, &first.name, source)
+        self.synthetic_material(&body, &layer.name, source)
     }
 }
 
@@ -370,7 +520,16 @@ mod tests {
     /// A TerrainData of `resolution`² heights (`heights`), spacing (2, 50, 4), with one
     /// layer: a TerrainLayer asset (the only external) when `assets`, else (the layout
     /// before Unity 2018.3) a splat prototype whose texture is that external.
-    fn terrain_data(version: u32, resolution: i32, heights: &[i16], assets: bool) -> Vec<u8> {
+    ///
+    /// `alpha`, when given, is one splat map of 2×1 texels: its texture format and image
+    /// data.
+    fn terrain_data(
+        version: u32,
+        resolution: i32,
+        heights: &[i16],
+        assets: bool,
+        alpha: Option<(i32, &[u8])>,
+    ) -> Vec<u8> {
         let mut n = vec![(0, "TerrainData", "Base", -1, 0, 0)];
         n.extend([
             (1, "SplatDatabase", "m_SplatDatabase", -1, 0, 0),
@@ -407,6 +566,16 @@ mod tests {
                 (5, "float", "smoothness", 4, 0, 0),
             ]);
         }
+        if alpha.is_some() {
+            n.extend([
+                (2, "vector", "m_AlphaTextures", -1, 0, 0),
+                (3, "Array", "Array", -1, 1, 0),
+                (4, "int", "size", 4, 0, 0),
+                (4, "PPtr<Texture2D>", "data", 12, 0, 0),
+                (5, "int", "m_FileID", 4, 0, 0),
+                (5, "SInt64", "m_PathID", 8, 0, 0),
+            ]);
+        }
         n.extend([
             (1, "Heightmap", "m_Heightmap", -1, 0, 0),
             (2, "vector", "m_Heights", -1, 0, 0),
@@ -435,6 +604,11 @@ mod tests {
             w.f32(3.0);
             w.f32(0.25);
         }
+        if alpha.is_some() {
+            w.i32(1);
+            w.i32(0);
+            w.i64(2);
+        }
         w.i32(heights.len() as i32);
         for &h in heights {
             w.i16(h);
@@ -444,15 +618,40 @@ mod tests {
         for v in [2.0, 50.0, 4.0] {
             w.f32(v);
         }
-        let types = [TypeSpec {
+        let mut types = vec![TypeSpec {
             class_id: TERRAIN_DATA,
             nodes: n,
         }];
-        let objects = [ObjSpec {
+        let mut objects = vec![ObjSpec {
             path_id: 15600000,
             type_index: 0,
             data: w.buf,
         }];
+        if let Some((format, image)) = alpha {
+            types.push(TypeSpec {
+                class_id: 28,
+                nodes: vec![
+                    (0, "Texture2D", "Base", -1, 0, 0),
+                    (1, "int", "m_Width", 4, 0, 0),
+                    (1, "int", "m_Height", 4, 0, 0),
+                    (1, "int", "m_TextureFormat", 4, 0, 0),
+                    (1, "TypelessData", "image data", -1, 1, ALIGN),
+                    (2, "int", "size", 4, 0, 0),
+                    (2, "UInt8", "data", 1, 0, 0),
+                ],
+            });
+            let mut t = W::new(false);
+            for v in [2, 1, format, image.len() as i32] {
+                t.i32(v);
+            }
+            t.buf.extend_from_slice(image);
+            t.align();
+            objects.push(ObjSpec {
+                path_id: 2,
+                type_index: 1,
+                data: t.buf,
+            });
+        }
         file(version, false, true, &types, &objects)
     }
 
@@ -460,9 +659,14 @@ mod tests {
     fn terrain_data_reads_heights_size_and_layers_in_both_layouts() {
         let heights = [0, 16383, 32766, -5, 32767, 0, 0, 0, 100];
         for (version, assets) in [(22, true), (17, true), (17, false)] {
-            let bytes = terrain_data(version, 3, &heights, assets);
+            let bytes = terrain_data(version, 3, &heights, assets, None);
             let file = SerializedFile::parse(bytes, "Assets/T.asset").unwrap();
-            let (field, layers) = read(&file, 15600000).unwrap();
+            let TerrainData {
+                field,
+                layers,
+                splat,
+            } = read(&file, 15600000).unwrap();
+            assert!(splat.is_none(), "no splat maps");
             assert_eq!(field.resolution, 3);
             assert_eq!(field.size, Vec3::new(4.0, 50.0, 8.0));
             let expect = [
@@ -494,8 +698,29 @@ mod tests {
     }
 
     #[test]
+    fn splat_maps_are_read_in_either_byte_order_from_their_first_mip_level() {
+        // Left texel: layer 0 (R) full; right texel: layer 1 (G) 55, layer 3 (A) 200.
+        // Then a 1×1 mip level that must not count.
+        let argb = [0, 255, 0, 0, 200, 0, 55, 0, 9, 9, 9, 9];
+        let rgba = [255, 0, 0, 0, 0, 55, 0, 200, 9, 9, 9, 9];
+        for (format, image) in [(5, argb), (4, rgba)] {
+            let bytes = terrain_data(22, 3, &[0; 9], true, Some((format, &image)));
+            let file = SerializedFile::parse(bytes, "Assets/T.asset").unwrap();
+            let splat = read(&file, 15600000).unwrap().splat.expect("a splat map");
+            assert_eq!(splat.maps[0].texels, [[255, 0, 0, 0], [0, 55, 0, 200]]);
+            assert_eq!(splat.weight(3, 0.9, 0.5), 200);
+            let c = splat.coverage();
+            assert_eq!(c, [0.5, 55.0 / 510.0, 0.0, 200.0 / 510.0]);
+        }
+        // Another format is not read.
+        let bytes = terrain_data(22, 3, &[0; 9], true, Some((10, &[0; 12])));
+        let file = SerializedFile::parse(bytes, "Assets/T.asset").unwrap();
+        assert!(read(&file, 15600000).unwrap().splat.is_none());
+    }
+
+    #[test]
     fn a_heightmap_that_does_not_match_its_resolution_is_refused() {
-        let bytes = terrain_data(22, 4, &[0; 9], true);
+        let bytes = terrain_data(22, 4, &[0; 9], true, None);
         let file = SerializedFile::parse(bytes, "Assets/T.asset").unwrap();
         let err = read(&file, 15600000).err().unwrap();
         assert_eq!(err, "m_Heights holds 9 samples for a resolution of 4");
@@ -516,7 +741,7 @@ mod tests {
     fn the_grid_spans_the_terrain_and_faces_up() {
         // 3×3 samples over 10 m × 20 m, 4 m high, raised along z.
         let f = field(3, Vec3::new(10.0, 4.0, 20.0), |_, z| z as f32 / 2.0);
-        let m = f.mesh();
+        let m = f.mesh(1, |_, _| 0);
         assert_eq!(m.positions.len(), 9);
         assert_eq!(m.submeshes[0].len(), 8);
         assert_eq!(m.positions[0], Vec3::ZERO);
@@ -538,6 +763,41 @@ mod tests {
     }
 
     #[test]
+    fn each_cell_goes_to_the_part_its_centre_picks_and_splat_weights_come_from_the_nearest_texel() {
+        // 5×5 samples, 4×4 cells; cells whose centre lies left of u = 0.5 go to part 1.
+        let f = field(5, Vec3::new(4.0, 1.0, 4.0), |_, _| 0.0);
+        let m = f.mesh(2, |u, v| {
+            assert!((0.0..1.0).contains(&u) && (0.0..1.0).contains(&v));
+            usize::from(u < 0.5)
+        });
+        assert_eq!((m.submeshes[0].len(), m.submeshes[1].len()), (16, 16));
+        for t in &m.submeshes[1] {
+            assert!(t.iter().all(|&i| m.positions[i as usize].x <= 2.0), "{t:?}");
+        }
+        // A 2×1 map: layer 0 (R) on the left texel, layer 5 (second map's G) on the right.
+        let splat = Splat {
+            maps: vec![
+                SplatMap {
+                    width: 2,
+                    height: 1,
+                    texels: vec![[255, 0, 0, 0], [0, 0, 0, 0]],
+                },
+                SplatMap {
+                    width: 2,
+                    height: 1,
+                    texels: vec![[0, 0, 0, 0], [0, 255, 0, 0]],
+                },
+            ],
+        };
+        assert_eq!(splat.weight(0, 0.2, 0.9), 255);
+        assert_eq!(splat.weight(0, 0.7, 0.9), 0);
+        assert_eq!(splat.weight(5, 0.7, 0.0), 255);
+        assert_eq!(splat.weight(5, 1.0, 1.0), 255);
+        assert_eq!(splat.weight(9, 0.5, 0.5), 0);
+        assert_eq!(splat.coverage(), [0.5, 0.0, 0.0, 0.0, 0.0, 0.5, 0.0, 0.0]);
+    }
+
+    #[test]
     fn a_large_heightmap_is_drawn_from_every_kth_sample_to_its_far_edge() {
         // 2,050 samples a side (2,049 cells): every 3rd sample, 684 cells, the last one
         // shorter.
@@ -545,7 +805,7 @@ mod tests {
         let f = field(res, Vec3::new(2049.0, 1.0, 2049.0), |x, z| {
             ((x + z) % 2) as f32
         });
-        let m = f.mesh();
+        let m = f.mesh(1, |_, _| 0);
         let n = 2049usize.div_ceil(3) + 1;
         assert_eq!(m.positions.len(), n * n);
         assert_eq!(m.submeshes[0].len(), 2 * (n - 1) * (n - 1));
@@ -566,7 +826,7 @@ mod tests {
         };
         put(
             "T.asset",
-            &terrain_data(22, 3, &[0, 0, 0, 0, 32766, 0, 0, 0, 0], true),
+            &terrain_data(22, 3, &[0, 0, 0, 0, 32766, 0, 0, 0, 0], true, None),
             "aaaa0000aaaa0000aaaa0000aaaa0000",
         );
         let layer = "%YAML 1.1\n--- !u!1953259897 &8574412962073106934\nTerrainLayer:\n  m_Name: Grass\n  m_DiffuseTexture: {fileID: 2800000, guid: bbbb0000bbbb0000bbbb0000bbbb0000, type: 3}\n  m_TileSize: {x: 2, y: 4}\n  m_TileOffset: {x: 1, y: 0}\n  m_Smoothness: 0.25\n";
