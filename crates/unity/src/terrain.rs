@@ -53,6 +53,9 @@ pub struct TerrainData {
     pub field: Heightfield,
     pub layers: LayerRefs,
     pub splat: Option<Splat>,
+    /// It has painted holes (`m_Holes`, Unity 2019.3 and later, empty until one is
+    /// painted), which are not cut.
+    pub holes: bool,
 }
 
 /// The splat maps: RGBA textures over the terrain whose channels R, G, B, A weigh layers
@@ -142,7 +145,9 @@ pub fn read(file: &SerializedFile, id: i64) -> Result<TerrainData, String> {
         heights,
         size,
     };
+    let holes = matches!(hm.get("m_Holes"), Some(Value::Bytes(b)) if !b.is_empty());
     Ok(TerrainData {
+        holes,
         field,
         layers: layer_refs(file, &data),
         splat: splat(file, &data),
@@ -345,6 +350,7 @@ impl Emitter<'_, '_> {
             field,
             layers,
             splat,
+            holes,
         } = match parsed {
             Ok(x) => x,
             Err(why) => {
@@ -362,6 +368,11 @@ impl Emitter<'_, '_> {
         let layers = self.terrain_layers(layers, &what);
         let coverage = splat.as_ref().map(Splat::coverage).unwrap_or_default();
         self.warn_layers(&layers, &coverage, &what);
+        if holes {
+            self.warn(format!(
+                "{what}: its holes are not cut: the ground is drawn through them"
+            ));
+        }
         if field.resolution - 1 > MAX_CELLS {
             let step = (field.resolution - 1).div_ceil(MAX_CELLS);
             self.warn(format!(
@@ -665,7 +676,9 @@ mod tests {
                 field,
                 layers,
                 splat,
+                holes,
             } = read(&file, 15600000).unwrap();
+            assert!(!holes);
             assert!(splat.is_none(), "no splat maps");
             assert_eq!(field.resolution, 3);
             assert_eq!(field.size, Vec3::new(4.0, 50.0, 8.0));
