@@ -8,4 +8,5 @@ mod million_rays;
 mod pipeline;
 mod reliability;
 mod slurm;
+mod terrain;
 mod textures;

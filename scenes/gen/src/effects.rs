@@ -72,6 +72,17 @@ impl Builder {
         guid
     }
 
+    /// Add the file `bytes` at `path` with the `.meta` `meta_of` makes; returns its GUID.
+    pub fn asset(&mut self, path: &str, bytes: Vec<u8>, meta_of: fn(&str) -> String) -> String {
+        self.project.add_binary_asset(path, bytes, meta_of)
+    }
+
+    /// Add an object of any kind to the scene.
+    pub fn object(&mut self, object: Object) -> &mut Self {
+        self.objects.push(object);
+        self
+    }
+
     /// The GUID an asset at `path` of this project gets.
     pub fn guid(&self, path: &str) -> String {
         self.project.guid(path)

@@ -1,7 +1,7 @@
 //! Generator of the Unity projects bundled in `scenes/`: the original Haskell ray tracer's
 //! baseline scene (OBJ models at exact triangle counts), one small project per rendering
-//! effect, the textured and alpha-blended Quads of `textures`, and `skybox`'s sky from an
-//! HDR image.
+//! effect, the textured and alpha-blended Quads of `textures`, `skybox`'s sky from an
+//! HDR image, and `terrain`'s Unity Terrain.
 //!
 //! Everything is built in memory first ([`project::Project`]), so the same bytes are
 //! written to disk by the binary and compared with the committed files by the tests.
@@ -17,6 +17,7 @@ pub mod meta;
 pub mod models;
 pub mod project;
 pub mod sky;
+pub mod terrain;
 pub mod textures;
 pub mod unity;
 
@@ -26,5 +27,6 @@ pub fn all_projects() -> Vec<project::Project> {
     v.extend(effects::all());
     v.push(textures::project());
     v.push(sky::project());
+    v.push(terrain::project());
     v
 }

@@ -13,6 +13,20 @@ pub fn material(guid: &str) -> String {
     )
 }
 
+/// A TerrainData `.asset`'s `.meta`: the terrain is object 15600000 of its file.
+pub fn terrain_data(guid: &str) -> String {
+    format!(
+        "fileFormatVersion: 2\nguid: {guid}\nNativeFormatImporter:\n  externalObjects: {{}}\n  mainObjectFileID: 15600000\n{TAIL}"
+    )
+}
+
+/// A `.terrainlayer`'s `.meta`.
+pub fn terrain_layer(guid: &str) -> String {
+    format!(
+        "fileFormatVersion: 2\nguid: {guid}\nNativeFormatImporter:\n  externalObjects: {{}}\n  mainObjectFileID: 8574412962073106934\n{TAIL}"
+    )
+}
+
 /// A scene's `.meta`.
 pub fn scene(guid: &str) -> String {
     format!("fileFormatVersion: 2\nguid: {guid}\nDefaultImporter:\n  externalObjects: {{}}\n{TAIL}")

@@ -130,6 +130,10 @@ pub enum Body {
     ModelPrefab {
         guid: String,
     },
+    /// A Terrain drawing the TerrainData asset with this GUID.
+    Terrain {
+        data: String,
+    },
 }
 
 pub struct Object {
@@ -201,6 +205,7 @@ pub fn write_scene(scene_key: &str, scene: &SceneDesc) -> String {
             Body::Light(_) => 3,
             Body::Camera(_) => 4,
             Body::ModelPrefab { .. } => 1,
+            Body::Terrain { .. } => 3,
         };
         let id = ids.block(&format!("{scene_key}/{k}/{}", obj.name), count);
         if let Body::ModelPrefab { guid } = &obj.body {
@@ -230,6 +235,7 @@ pub fn write_scene(scene_key: &str, scene: &SceneDesc) -> String {
                 docs.push((id[2], camera_doc(id[2], go, cam)));
                 docs.push((id[3], audio_listener(id[3], go)));
             }
+            Body::Terrain { data } => docs.push((id[2], terrain_doc(id[2], go, data))),
             Body::ModelPrefab { .. } => {}
         }
     }
@@ -413,6 +419,45 @@ MeshRenderer:
   m_SortingLayer: 0
   m_SortingOrder: 0
   m_AdditionalVertexStreams: {{fileID: 0}}
+"
+    )
+}
+
+/// A Terrain component as Unity 2022.3 writes it, on the built-in terrain material.
+fn terrain_doc(id: i64, go: i64, data: &str) -> String {
+    format!(
+        "--- !u!218 &{id}
+Terrain:
+{PREFAB_FIELDS}  m_GameObject: {{fileID: {go}}}
+  m_Enabled: 1
+  serializedVersion: 6
+  m_TerrainData: {{fileID: 15600000, guid: {data}, type: 2}}
+  m_TreeDistance: 5000
+  m_TreeBillboardDistance: 50
+  m_TreeCrossFadeLength: 5
+  m_TreeMaximumFullLODCount: 50
+  m_DetailObjectDistance: 80
+  m_DetailObjectDensity: 1
+  m_HeightmapPixelError: 5
+  m_SplatMapDistance: 1000
+  m_HeightmapMinimumLODSimplification: 0
+  m_HeightmapMaximumLOD: 0
+  m_ShadowCastingMode: 2
+  m_DrawHeightmap: 1
+  m_DrawInstanced: 0
+  m_DrawTreesAndFoliage: 1
+  m_StaticShadowCaster: 0
+  m_ReflectionProbeUsage: 1
+  m_MaterialTemplate: {{fileID: 10652, guid: 0000000000000000f000000000000000, type: 0}}
+  m_BakeLightProbesForTrees: 1
+  m_PreserveTreePrototypeLayers: 0
+  m_DeringLightProbesForTrees: 1
+  m_ReceiveGI: 1
+  m_ScaleInLightmap: 0.0256
+  m_LightmapParameters: {{fileID: 15203, guid: 0000000000000000f000000000000000, type: 0}}
+  m_GroupingID: 0
+  m_RenderingLayerMask: 1
+  m_AllowAutoConnect: 1
 "
     )
 }
