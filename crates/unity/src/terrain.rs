@@ -376,8 +376,8 @@ impl Emitter<'_, '_> {
         if field.resolution - 1 > MAX_CELLS {
             let step = (field.resolution - 1).div_ceil(MAX_CELLS);
             self.warn(format!(
-                "{what}: its {r}×{r} heightmap is drawn from every {step}th sample \
-                 ({MAX_CELLS} cells a side at most)",
+                "{what}: its {r}×{r} heightmap is drawn from one sample in {step} along \
+                 each side ({MAX_CELLS} cells a side at most)",
                 r = field.resolution
             ));
         }
