@@ -33,8 +33,12 @@ pub(crate) struct PendingTexture {
 impl Emitter<'_, '_> {
     /// The albedo map of Material `body`; `what` names the material in warnings.
     pub(crate) fn mat_albedo(&mut self, body: &Node, what: &str) -> Option<TextureRef> {
-        let slot = albedo_slot(body)?;
-        let path = self.slot_file(&slot, what, TINT_ALONE)?;
+        self.albedo(&albedo_slot(body)?, what)
+    }
+
+    /// The albedo map `slot` names; `what` names its material in warnings.
+    pub(crate) fn albedo(&mut self, slot: &TextureSlot, what: &str) -> Option<TextureRef> {
+        let path = self.slot_file(slot, what, TINT_ALONE)?;
         self.texture_ref(&path, Import::read(&path), slot.tiling, what, TINT_ALONE)
     }
 

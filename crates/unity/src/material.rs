@@ -281,7 +281,7 @@ impl Emitter<'_, '_> {
     }
 
     /// The soup index of the material under `key`, made on first use.
-    fn add_material(&mut self, key: String, make: impl FnOnce() -> Material) -> u32 {
+    pub(crate) fn add_material(&mut self, key: String, make: impl FnOnce() -> Material) -> u32 {
         if let Some(&i) = self.materials.get(&key) {
             return i;
         }
@@ -371,18 +371,6 @@ impl Emitter<'_, '_> {
             format!("{origin} {}", self.g.project.rel(path))
         };
         (i, origin)
-    }
-
-    /// A material made from Material `body` that no file holds (a terrain layer's),
-    /// named `name`, kept under `source`.
-    pub(crate) fn synthetic_material(&mut self, body: &Node, name: &str, source: String) -> u32 {
-        if let Some(&i) = self.materials.get(&source) {
-            return i;
-        }
-        let (mut m, _notes) = convert(body, &source);
-        m.name = name.to_string();
-        self.mat_maps(&mut m, body, &source);
-        self.add_material(source, || m)
     }
 
     /// The texture maps of material `m`, converted from Material `body` (`what` names it

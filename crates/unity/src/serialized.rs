@@ -8,7 +8,7 @@
 //! type tree walk has a depth limit: a damaged or hostile file is an error, never a panic
 //! or an unbounded allocation.
 
-/// Oldest format version read (the brief layout of Unity 3.5 onwards; Unity 5 writes 14+).
+/// Oldest format version read (Unity 3.5's); Unity 5.0 writes 14, 2022 and 6 write 22.
 const MIN_VERSION: u32 = 9;
 /// Newest format version whose layout is known (Unity 2022 and Unity 6 write 22). A later
 /// version may move fields, and misreading it would only produce confusing errors.
@@ -20,8 +20,8 @@ const ALIGN_BYTES: u32 = 0x4000;
 /// Top bit of a type tree string offset: the offset is into [`COMMON_STRINGS`].
 const COMMON_BIT: u32 = 0x8000_0000;
 
-/// Unity's built-in table of type tree strings (`CommonString` in UnityPy), which a tree
-/// names by byte offset into this concatenation. Order matters: the offsets are fixed.
+/// Unity's built-in table of type tree strings, which a tree names by byte offset into
+/// this concatenation. Order matters: the offsets are fixed.
 const COMMON_STRINGS: &str = "AABB\0AnimationClip\0AnimationCurve\0AnimationState\0Array\0\
 Base\0BitField\0bitset\0bool\0char\0ColorRGBA\0Component\0data\0deque\0double\0\
 dynamic_array\0FastPropertyName\0first\0float\0Font\0GameObject\0Generic Mono\0\
@@ -132,15 +132,6 @@ impl Value {
         match *self {
             Value::Float(f) => Some(f),
             Value::Int(i) => Some(i as f64),
-            _ => None,
-        }
-    }
-
-    /// A `Bool`, or an `Int` as zero / non-zero (flags are often `UInt8`).
-    pub fn as_bool(&self) -> Option<bool> {
-        match *self {
-            Value::Bool(b) => Some(b),
-            Value::Int(i) => Some(i != 0),
             _ => None,
         }
     }

@@ -13,7 +13,9 @@
 use crate::emit::{EmitError, Emitter};
 use crate::reference::Ref;
 use crate::serialized::{SerializedFile, Value};
-use formats::{CastShadows, Object};
+use crate::texture::TextureSlot;
+use formats::texture::Tiling;
+use formats::{CastShadows, Material, Object};
 use glam::{Mat4, Vec2, Vec3};
 use std::sync::Arc;
 
@@ -500,26 +502,42 @@ impl Emitter<'_, '_> {
     /// Layer `layer` as the Standard material it shades like, its texture tiled over a
     /// terrain of `size` as the layer tiles it.
     fn layer_material(&mut self, layer: &Layer, size: Vec3, rel: &str) -> u32 {
+        let source = format!("{rel}#layer:{}", layer.name);
+        if let Some(&i) = self.materials.get(&source) {
+            return i;
+        }
         let tile = layer.tile_size.max(Vec2::splat(1e-3));
         let scale = Vec2::new(size.x, size.z) / tile;
         let offset = layer.tile_offset / tile;
-        let texture = match &layer.texture {
-            Some(guid) => format!(
-                "    - _MainTex:\n        m_Texture: {{fileID: 2800000, guid: {guid}, type: 3}}\n        m_Scale: {{x: {}, y: {}}}\n        m_Offset: {{x: {}, y: {}}}\n",
-                scale.x, scale.y, offset.x, offset.y
-            ),
-            None => String::new(),
+        // Found, imported and tiled as a Standard material's albedo map is.
+        let slot = layer.texture.as_ref().map(|guid| TextureSlot {
+            property: "_MainTex".into(),
+            guid: guid.clone(),
+            tiling: Tiling {
+                scale: scale.to_array(),
+                offset: offset.to_array(),
+            },
+        });
+        let albedo_map = slot.and_then(|slot| self.albedo(&slot, &source));
+        // Unity's defaults stand in for properties that are not numbers.
+        let default = Material::unity_default();
+        let (metallic, smoothness) = if layer.metallic.is_finite() && layer.smoothness.is_finite() {
+            (
+                layer.metallic.clamp(0.0, 1.0),
+                layer.smoothness.clamp(0.0, 1.0),
+            )
+        } else {
+            (default.metallic, default.smoothness)
         };
-        // The layer as the Standard material it shades like, so that its texture is
-        // found, imported and tiled as any material's is.
-        let text = format!(
-            "Material:\n  m_SavedProperties:\n    m_TexEnvs:\n{texture}    m_Floats:\n    - _Glossiness: {}\n    - _Metallic: {}\n    m_Colors:\n    - _Color: {{r: 1, g: 1, b: 1, a: 1}}\n",
-            layer.smoothness, layer.metallic
-        );
-        let source = format!("{rel}#layer:{}", layer.name);
-        let doc = crate::yaml::parse(&text);
-        let body = doc.get("Material").cloned().unwrap_or(doc);
-        self.synthetic_material(&body, &layer.name, source)
+        let m = Material {
+            name: layer.name.clone(),
+            source: source.clone(),
+            metallic,
+            smoothness,
+            albedo_map,
+            ..default
+        };
+        self.add_material(source, || m)
     }
 }
 
