@@ -28,6 +28,9 @@ pub struct Obj {
     pub go: Option<usize>,
     /// Parent Transform (transforms).
     pub father: Option<usize>,
+    /// The root Transform of a tree painted on a terrain: it follows its parent's (the
+    /// terrain's) position alone, as the terrain itself does.
+    pub on_terrain: bool,
     pub removed: bool,
     /// A MeshFilter's `m_Mesh`.
     pub mesh: Ref,
@@ -192,6 +195,7 @@ impl<'p> Graph<'p> {
             file,
             go: None,
             father: None,
+            on_terrain: false,
             removed: false,
             bones: Vec::new(),
         });
@@ -202,6 +206,7 @@ impl<'p> Graph<'p> {
     pub fn load_scene(&mut self, path: &Path, text: String) {
         self.load_file(path, text, true);
         self.break_parent_cycles();
+        self.plant_trees();
     }
 
     /// A Transform whose `m_Father` chain loops back on itself has no place in the

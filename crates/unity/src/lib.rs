@@ -40,6 +40,7 @@ pub mod skybox;
 pub mod terrain;
 pub mod texture;
 pub mod transform;
+pub mod trees;
 mod undrawn;
 pub mod yaml;
 

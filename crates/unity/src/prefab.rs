@@ -45,7 +45,14 @@ impl Graph<'_> {
                 .push(format!("{what}: has no source prefab; skipped"));
             return Default::default();
         };
-        let Some(path) = self.project.resolve(&guid).cloned() else {
+        self.instance_of(&guid, &what)
+    }
+
+    /// The objects of one instance of the prefab or model with GUID `guid`, keyed by their
+    /// fileID in it, and its root transforms; none, with a warning beginning `what`, when
+    /// it cannot be loaded.
+    pub(crate) fn instance_of(&mut self, guid: &str, what: &str) -> (IdMap, Vec<usize>) {
+        let Some(path) = self.project.resolve(guid).cloned() else {
             self.warnings.push(format!("{what}: source GUID {guid} is not in the project (missing asset or package); skipped"));
             return Default::default();
         };
@@ -58,7 +65,7 @@ impl Graph<'_> {
             return Default::default();
         }
         if ext(&path) != "prefab" {
-            return self.model_instance(&path, &guid, &what);
+            return self.model_instance(&path, guid, what);
         }
         if self.stack.contains(&path) || self.stack.len() > MAX_NESTING {
             self.warnings

@@ -58,6 +58,29 @@ pub struct TerrainData {
     /// It has painted holes (`m_Holes`, Unity 2019.3 and later, empty until one is
     /// painted), which are not cut.
     pub holes: bool,
+    pub trees: Trees,
+}
+
+/// The trees painted on a terrain.
+#[derive(Debug, Default, PartialEq)]
+pub struct Trees {
+    /// Per prototype, the GUID of its prefab or model (None: no prefab set).
+    pub prototypes: Vec<Option<String>>,
+    pub instances: Vec<TreeInstance>,
+}
+
+/// One painted tree.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TreeInstance {
+    /// Where it stands, 0 to 1 across the terrain's size on each axis (y of its full
+    /// height), from the terrain's corner.
+    pub position: Vec3,
+    /// Its prototype's scale across (x and z) and up.
+    pub width: f32,
+    pub height: f32,
+    /// Its turn about the vertical axis, radians.
+    pub rotation: f32,
+    pub prototype: usize,
 }
 
 /// The splat maps: RGBA textures over the terrain whose channels R, G, B, A weigh layers
@@ -153,7 +176,59 @@ pub fn read(file: &SerializedFile, id: i64) -> Result<TerrainData, String> {
         field,
         layers: layer_refs(file, &data),
         splat: splat(file, &data),
+        trees: trees(file, &data),
     })
+}
+
+/// TerrainData `id` of the binary asset at `path` (`rel` in messages).
+pub(crate) fn load(path: &std::path::Path, rel: &str, id: i64) -> Result<TerrainData, String> {
+    let bytes = std::fs::read(path).map_err(|e| e.to_string())?;
+    if !SerializedFile::is_serialized_file(&bytes) {
+        return Err("is not a binary Unity asset".into());
+    }
+    let file = SerializedFile::parse(bytes, rel).map_err(|e| e.to_string())?;
+    read(&file, id)
+}
+
+/// The tree prototypes and instances of a TerrainData's detail database; an instance
+/// with a value that is not finite is left out.
+fn trees(file: &SerializedFile, data: &Value) -> Trees {
+    let db = data.get("m_DetailDatabase");
+    let seq = |key: &str| match db.and_then(|d| d.get(key)) {
+        Some(Value::Seq(items)) => items.as_slice(),
+        _ => &[],
+    };
+    let prototypes = seq("m_TreePrototypes")
+        .iter()
+        .map(|p| p.get("prefab").and_then(|r| guid_of(file, r)))
+        .collect();
+    let instances = seq("m_TreeInstances")
+        .iter()
+        .filter_map(|t| {
+            let f = |v: Option<&Value>| v.and_then(Value::as_f64).map(|x| x as f32);
+            let p = |k: &str| f(t.path(&["position", k]));
+            let instance = TreeInstance {
+                position: Vec3::new(p("x")?, p("y")?, p("z")?),
+                width: f(t.get("widthScale"))?,
+                height: f(t.get("heightScale"))?,
+                rotation: f(t.get("rotation")).unwrap_or(0.0),
+                prototype: t
+                    .get("index")
+                    .or(t.get("prototypeIndex"))
+                    .and_then(Value::as_i64)
+                    .and_then(|i| usize::try_from(i).ok())?,
+            };
+            let finite = instance.position.is_finite()
+                && [instance.width, instance.height, instance.rotation]
+                    .iter()
+                    .all(|v| v.is_finite());
+            finite.then_some(instance)
+        })
+        .collect();
+    Trees {
+        prototypes,
+        instances,
+    }
 }
 
 /// The splat maps of a TerrainData, if every one is in the file as an RGBA32 or ARGB32
@@ -339,21 +414,13 @@ impl Emitter<'_, '_> {
             return Ok(());
         };
         let rel = g.project.rel(&path);
-        let parsed = std::fs::read(&path)
-            .map_err(|e| e.to_string())
-            .and_then(|bytes| {
-                if !SerializedFile::is_serialized_file(&bytes) {
-                    return Err("is not a binary Unity asset".into());
-                }
-                SerializedFile::parse(bytes, &rel).map_err(|e| e.to_string())
-            })
-            .and_then(|file| read(&file, r.file_id));
         let TerrainData {
             field,
             layers,
             splat,
             holes,
-        } = match parsed {
+            trees: _, // planted with the scene's objects (`crate::trees`)
+        } = match load(&path, &rel, r.file_id) {
             Ok(x) => x,
             Err(why) => {
                 let why = why
@@ -695,7 +762,9 @@ mod tests {
                 layers,
                 splat,
                 holes,
+                trees,
             } = read(&file, 15600000).unwrap();
+            assert_eq!(trees, Trees::default());
             assert!(!holes);
             assert!(splat.is_none(), "no splat maps");
             assert_eq!(field.resolution, 3);

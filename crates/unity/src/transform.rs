@@ -106,6 +106,9 @@ impl Emitter<'_, '_> {
             .and_then(|f| self.world.get(&f).copied())
             .unwrap_or(Mat4::IDENTITY);
         for &n in chain.iter().rev() {
+            if self.g.objs[n].on_terrain {
+                m = Mat4::from_translation(m.w_axis.truncate());
+            }
             m *= local(&self.g.objs[n].body);
             self.world.insert(n, m);
         }

@@ -27,6 +27,11 @@ pub fn terrain_layer(guid: &str) -> String {
     )
 }
 
+/// A `.prefab`'s `.meta`.
+pub fn prefab(guid: &str) -> String {
+    format!("fileFormatVersion: 2\nguid: {guid}\nPrefabImporter:\n  externalObjects: {{}}\n{TAIL}")
+}
+
 /// A scene's `.meta`.
 pub fn scene(guid: &str) -> String {
     format!("fileFormatVersion: 2\nguid: {guid}\nDefaultImporter:\n  externalObjects: {{}}\n{TAIL}")

@@ -4,9 +4,10 @@
 //! TerrainData and its splat map, each with the type tree Unity embeds in editor files.
 
 use crate::effects::Builder;
+use crate::material::MatDesc;
 use crate::meta::{self, TextureImport};
 use crate::project::Project;
-use crate::unity::{Ambient, Body, CameraDesc, LightDesc, LightType, Object, Xform};
+use crate::unity::{self, Ambient, Body, CameraDesc, LightDesc, LightType, Object, Xform};
 use glam::Vec3;
 
 /// Heightmap samples a side (64 cells), terrain size in metres and its full height.
@@ -19,6 +20,8 @@ pub const SPLAT: usize = 32;
 pub const ROCK_ABOVE: f32 = 0.4;
 /// Where the terrain's corner stands.
 pub const POSITION: Vec3 = Vec3::new(-32.0, 0.0, -20.0);
+/// How many trees stand on the terrain, scattered over the grass below the rock line.
+pub const TREES: usize = 24;
 /// The path ID of the main object of a TerrainData asset and of a TerrainLayer asset.
 const TERRAIN_DATA_ID: i64 = 15600000;
 const TERRAIN_LAYER_ID: i64 = 8574412962073106934;
@@ -31,6 +34,45 @@ pub fn height(u: f32, v: f32) -> f32 {
         h * (-d2 / (2.0 * r * r)).exp()
     };
     0.05 + hill(0.65, 0.6, 0.15, 0.85) + hill(0.3, 0.35, 0.12, 0.3)
+}
+
+/// One painted tree: where it stands (terrain coordinates 0–1, y the ground's share of
+/// the full height), its width and height scales and its turn in radians.
+pub struct Tree {
+    pub position: Vec3,
+    pub width: f32,
+    pub height: f32,
+    pub rotation: f32,
+}
+
+/// The trees: a jittered grid over the front half of the terrain, every place below the
+/// rock line kept until there are `TREES`.
+pub fn trees() -> Vec<Tree> {
+    // A fixed hash of the index: the same forest every time.
+    let hash = |k: u32, salt: u32| {
+        let h = (k ^ salt.wrapping_mul(0x9e37_79b9)).wrapping_mul(0x85eb_ca6b);
+        ((h ^ h >> 13).wrapping_mul(0xc2b2_ae35) >> 8) as f32 / (1u32 << 24) as f32
+    };
+    let mut out = Vec::new();
+    for k in 0..200u32 {
+        let (i, j) = (k % 10, k / 10);
+        let u = 0.05 + (i as f32 + hash(k, 1)) * 0.09;
+        let v = 0.08 + (j as f32 + hash(k, 2)) * 0.05;
+        let ground = height(u, v);
+        if ground > ROCK_ABOVE - 0.1 || u > 0.95 {
+            continue;
+        }
+        out.push(Tree {
+            position: Vec3::new(u, ground, v),
+            width: 0.8 + 0.4 * hash(k, 3),
+            height: 0.8 + 0.5 * hash(k, 4),
+            rotation: std::f32::consts::TAU * hash(k, 5),
+        });
+        if out.len() == TREES {
+            break;
+        }
+    }
+    out
 }
 
 /// A byte buffer in little-endian order with Unity's 4-byte alignment.
@@ -97,6 +139,32 @@ fn terrain_data_tree() -> Vec<Node> {
     n.extend(pptr_vector("m_TerrainLayers", "PPtr<TerrainLayer>"));
     n.extend(pptr_vector("m_AlphaTextures", "PPtr<Texture2D>"));
     n.extend([
+        (1, "DetailDatabase", "m_DetailDatabase", -1, 0, 0),
+        (2, "vector", "m_TreePrototypes", -1, 0, 0),
+        (3, "Array", "Array", -1, 1, 0),
+        (4, "int", "size", 4, 0, 0),
+        (4, "TreePrototype", "data", -1, 0, 0),
+        (5, "PPtr<GameObject>", "prefab", 12, 0, 0),
+        (6, "int", "m_FileID", 4, 0, 0),
+        (6, "SInt64", "m_PathID", 8, 0, 0),
+        (5, "float", "bendFactor", 4, 0, 0),
+        (5, "int", "navMeshLod", 4, 0, 0),
+        (2, "vector", "m_TreeInstances", -1, 0, 0),
+        (3, "Array", "Array", -1, 1, 0),
+        (4, "int", "size", 4, 0, 0),
+        (4, "TreeInstance", "data", 40, 0, 0),
+        (5, "Vector3f", "position", 12, 0, 0),
+        (6, "float", "x", 4, 0, 0),
+        (6, "float", "y", 4, 0, 0),
+        (6, "float", "z", 4, 0, 0),
+        (5, "float", "widthScale", 4, 0, 0),
+        (5, "float", "heightScale", 4, 0, 0),
+        (5, "float", "rotation", 4, 0, 0),
+        (5, "ColorRGBA", "color", 4, 0, 0),
+        (6, "unsigned int", "rgba", 4, 0, 0),
+        (5, "ColorRGBA", "lightmapColor", 4, 0, 0),
+        (6, "unsigned int", "rgba", 4, 0, 0),
+        (5, "int", "index", 4, 0, 0),
         (1, "Heightmap", "m_Heightmap", -1, 0, 0),
         (2, "vector", "m_Heights", -1, 0, 0),
         (3, "Array", "Array", -1, 1, ALIGN),
@@ -159,9 +227,10 @@ fn guid_bytes(guid: &str) -> [u8; 16] {
 }
 
 /// The TerrainData asset: `RESOLUTION`² heights from [`height`], the layers with these
-/// GUIDs, and one RGBA32 splat map weighing the first layer (R) below `ROCK_ABOVE` and
-/// the second (G) above it.
-pub fn terrain_data(layers: &[String]) -> Vec<u8> {
+/// GUIDs, one RGBA32 splat map weighing the first layer (R) below `ROCK_ABOVE` and the
+/// second (G) above it, and [`trees`] of the prefab with GUID `tree` (its root
+/// GameObject `tree_root`).
+pub fn terrain_data(layers: &[String], tree: &str, tree_root: i64) -> Vec<u8> {
     let cells = (RESOLUTION - 1) as f32;
     let mut data = Bytes::default();
     data.string("Hills");
@@ -173,6 +242,23 @@ pub fn terrain_data(layers: &[String]) -> Vec<u8> {
     data.i32(1);
     data.i32(0);
     data.i64(2);
+    // The tree prefab is the external after the layers.
+    data.i32(1);
+    data.i32(layers.len() as i32 + 1);
+    data.i64(tree_root);
+    data.f32(0.0);
+    data.i32(i32::MAX);
+    let trees = trees();
+    data.i32(trees.len() as i32);
+    for t in &trees {
+        let p = t.position;
+        for v in [p.x, p.y, p.z, t.width, t.height, t.rotation] {
+            data.f32(v);
+        }
+        data.i32(-1);
+        data.i32(-1);
+        data.i32(0);
+    }
     data.i32((RESOLUTION * RESOLUTION) as i32);
     for z in 0..RESOLUTION {
         for x in 0..RESOLUTION {
@@ -205,7 +291,7 @@ pub fn terrain_data(layers: &[String]) -> Vec<u8> {
     serialized_file(
         &[(156, terrain_data_tree()), (28, texture_tree())],
         &[(TERRAIN_DATA_ID, 0, data.0), (2, 1, splat.0)],
-        layers,
+        &[layers, &[tree.to_string()]].concat(),
     )
 }
 
@@ -320,7 +406,43 @@ fn checker(colour: [u8; 3]) -> Vec<u8> {
 
 /// The project: the terrain under a low sun, seen from the front.
 pub fn project() -> Project {
-    let mut b = Builder::new("terrain", &[]);
+    let mut b = Builder::new(
+        "terrain",
+        &[
+            MatDesc::matte("Bark", [0.36, 0.24, 0.14]),
+            MatDesc::matte("Leaves", [0.16, 0.42, 0.12]),
+        ],
+    );
+    // A round tree 4.5 m tall: a trunk (Unity's cylinder is 2 m tall and 1 m across) sunk
+    // 0.2 m into the ground, under an ellipsoid crown.
+    let (bark, leaves) = (
+        b.guid("Assets/Materials/Bark.mat"),
+        b.guid("Assets/Materials/Leaves.mat"),
+    );
+    let (prefab, tree_root) = unity::write_prefab(
+        "terrain/Tree",
+        "Tree",
+        &Xform::at(0.0, 0.0, 0.0),
+        &[
+            (
+                "Trunk",
+                unity::CYLINDER,
+                &bark,
+                Xform::at(0.0, 0.8, 0.0).scale(0.3, 1.0, 0.3),
+            ),
+            (
+                "Crown",
+                unity::SPHERE,
+                &leaves,
+                Xform::at(0.0, 3.0, 0.0).scale(2.2, 3.0, 2.2),
+            ),
+        ],
+    );
+    let tree = b.asset(
+        "Assets/Terrain/Tree.prefab",
+        prefab.into_bytes(),
+        meta::prefab,
+    );
     let import = TextureImport {
         filter: 1,
         mipmaps: true,
@@ -345,7 +467,7 @@ pub fn project() -> Project {
     }
     let data = b.asset(
         "Assets/Terrain/Hills.asset",
-        terrain_data(&layers),
+        terrain_data(&layers, &tree, tree_root),
         meta::terrain_data,
     );
     b.object(Object {

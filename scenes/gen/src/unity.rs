@@ -10,6 +10,7 @@ const SCENE_ROOTS_ID: i64 = i64::MAX;
 /// Built-in meshes live in this "library" GUID with `type: 0`.
 pub const BUILTIN_EXTRA: &str = "0000000000000000e000000000000000";
 pub const CUBE: i64 = 10202;
+pub const CYLINDER: i64 = 10206;
 pub const SPHERE: i64 = 10207;
 pub const PLANE: i64 = 10209;
 pub const QUAD: i64 = 10210;
@@ -286,6 +287,18 @@ fn game_object(id: i64, name: &str, tag: &str, components: &[i64]) -> String {
 }
 
 fn transform(id: i64, go: i64, x: &Xform) -> String {
+    transform_in(id, go, x, &[], 0)
+}
+
+/// A Transform with children and a parent (`father` 0: a root).
+fn transform_in(id: i64, go: i64, x: &Xform, children: &[i64], father: i64) -> String {
+    let kids = if children.is_empty() {
+        " []\n".to_string()
+    } else {
+        children.iter().fold("\n".to_string(), |s, c| {
+            s + &format!("  - {{fileID: {c}}}\n")
+        })
+    };
     let q = x.rotation();
     format!(
         "--- !u!4 &{id}
@@ -296,8 +309,7 @@ Transform:
   m_LocalPosition: {}
   m_LocalScale: {}
   m_ConstrainProportionsScale: 0
-  m_Children: []
-  m_Father: {{fileID: 0}}
+  m_Children:{kids}  m_Father: {{fileID: {father}}}
   m_LocalEulerAnglesHint: {}
 ",
         num(q.x),
@@ -308,6 +320,42 @@ Transform:
         v3(x.scale),
         v3(x.euler)
     )
+}
+
+/// A prefab as Unity 2022 writes it: a root GameObject `name` at `root` and under it one
+/// child per part, each a built-in mesh drawn with one material (by GUID); and the root
+/// GameObject's fileID.
+pub fn write_prefab(
+    key: &str,
+    name: &str,
+    root: &Xform,
+    parts: &[(&str, i64, &str, Xform)],
+) -> (String, i64) {
+    let mut ids = FileIds::default();
+    let [go, tr] = ids.block(&format!("{key}/{name}"), 2)[..] else {
+        unreachable!("a block of two ids")
+    };
+    let blocks: Vec<Vec<i64>> = parts
+        .iter()
+        .map(|(part, ..)| ids.block(&format!("{key}/{name}/{part}"), 4))
+        .collect();
+    let children: Vec<i64> = blocks.iter().map(|b| b[1]).collect();
+    let mut docs = vec![
+        (go, game_object(go, name, "Untagged", &[tr])),
+        (tr, transform_in(tr, go, root, &children, 0)),
+    ];
+    for ((part, mesh, material, x), id) in parts.iter().zip(&blocks) {
+        docs.push((id[0], game_object(id[0], part, "Untagged", &id[1..])));
+        docs.push((id[1], transform_in(id[1], id[0], x, &[], tr)));
+        docs.push((id[2], mesh_filter(id[2], id[0], &MeshRef::Builtin(*mesh))));
+        docs.push((id[3], mesh_renderer(id[3], id[0], &[material.to_string()])));
+    }
+    docs.sort_by_key(|(id, _)| *id);
+    let text = docs.into_iter().fold(
+        String::from("%YAML 1.1\n%TAG !u! tag:unity3d.com,2011:\n"),
+        |s, (_, d)| s + &d,
+    );
+    (text, go)
 }
 
 /// A model placed as Unity 2022 writes it: the root's name and local transform as
