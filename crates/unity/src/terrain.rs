@@ -6,9 +6,10 @@
 //! serialization mode, so they are read through [`crate::serialized`]. A height is a
 //! 16-bit sample where 32766 is the terrain's full height (Unity's terrain tools scale
 //! heights by 32766 / 65535 into a 16-bit texture). A terrain ignores its Transform's
-//! rotation and scale: it lies along the world axes from its position. The smooth blend
-//! between layers, holes, trees and detail grass are not converted; a warning names a
-//! terrain with more than one layer and how much of it each covers.
+//! rotation and scale: it lies along the world axes from its position. Its painted trees
+//! are read here and planted with the scene's objects ([`crate::trees`]). The smooth blend
+//! between layers, holes and detail grass are not converted; a warning names a terrain
+//! with more than one layer and how much of it each covers.
 
 use crate::emit::{EmitError, Emitter};
 use crate::reference::Ref;
