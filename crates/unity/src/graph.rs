@@ -15,6 +15,7 @@ use crate::reference::Ref;
 use crate::yaml::{self, Node};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 pub use crate::reference::fref;
 
@@ -43,7 +44,9 @@ pub struct Obj {
 
 pub struct FileCtx {
     pub path: PathBuf,
-    pub text: String,
+    /// Shared by every instance of the same prefab (a forest of trees loads one prefab
+    /// thousands of times).
+    pub text: Arc<str>,
 }
 
 impl FileCtx {
@@ -150,6 +153,8 @@ pub struct Graph<'p> {
     pub render_settings: Option<Node>,
     /// Prefabs being loaded, outermost first (a prefab that nests itself is refused).
     pub(crate) stack: Vec<PathBuf>,
+    /// The text of every prefab loaded so far.
+    pub(crate) prefab_texts: HashMap<PathBuf, Arc<str>>,
 }
 
 /// A file's objects: source fileID → arena index.
@@ -182,6 +187,7 @@ impl<'p> Graph<'p> {
             warnings: Vec::new(),
             render_settings: None,
             stack: Vec::new(),
+            prefab_texts: HashMap::new(),
         }
     }
 
@@ -204,7 +210,7 @@ impl<'p> Graph<'p> {
 
     /// Load the top-level scene, whose `text` the caller has read with [`read_text`].
     pub fn load_scene(&mut self, path: &Path, text: String) {
-        self.load_file(path, text, true);
+        self.load_file(path, text.into(), true);
         self.break_parent_cycles();
         self.plant_trees();
     }
@@ -267,11 +273,11 @@ impl<'p> Graph<'p> {
 
     /// Load a scene or prefab file; returns fileID → arena index for its objects
     /// (including those of its prefab instances under Unity's combined ids).
-    pub(crate) fn load_file(&mut self, path: &Path, text: String, top: bool) -> IdMap {
+    pub(crate) fn load_file(&mut self, path: &Path, text: Arc<str>, top: bool) -> IdMap {
         let file = self.files.len();
         self.files.push(FileCtx {
             path: path.to_path_buf(),
-            text: String::new(),
+            text: text.clone(),
         });
         let mut f = FileLoad {
             file,
@@ -283,7 +289,6 @@ impl<'p> Graph<'p> {
         self.place_stand_ins(&docs, &mut f);
         self.read_own_objects(&docs, &text, top, &mut f);
         self.link(&mut f);
-        self.files[file].text = text;
         f.map
     }
 

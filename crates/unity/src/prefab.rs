@@ -72,12 +72,19 @@ impl Graph<'_> {
                 .push(format!("{what}: {src} nests itself; skipped"));
             return Default::default();
         }
-        let text = match read_text(self.project, &path) {
-            Ok(t) => t,
-            Err(e) => {
-                self.warnings.push(format!("{what}: {e}; skipped"));
-                return Default::default();
-            }
+        let text = match self.prefab_texts.get(&path) {
+            Some(t) => t.clone(),
+            None => match read_text(self.project, &path) {
+                Ok(t) => {
+                    let t: std::sync::Arc<str> = t.into();
+                    self.prefab_texts.insert(path.clone(), t.clone());
+                    t
+                }
+                Err(e) => {
+                    self.warnings.push(format!("{what}: {e}; skipped"));
+                    return Default::default();
+                }
+            },
         };
         self.stack.push(path.clone());
         let map = self.load_file(&path, text, false);

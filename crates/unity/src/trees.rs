@@ -72,6 +72,17 @@ impl Graph<'_> {
             self.objs[go].file_id
         );
         let size = data.field.size;
+        // A place beyond f32's range (a damaged file) would make the tree's transform
+        // infinite.
+        let (instances, far): (Vec<TreeInstance>, Vec<TreeInstance>) = instances
+            .into_iter()
+            .partition(|t| (t.position * size).is_finite());
+        if !far.is_empty() {
+            self.warnings.push(format!(
+                "{who}: {} not drawn: placed beyond the range of 32-bit floats",
+                count(far.len())
+            ));
+        }
         for (p, guid) in prototypes.iter().enumerate() {
             let mine: Vec<&TreeInstance> = instances.iter().filter(|t| t.prototype == p).collect();
             if mine.is_empty() {
@@ -80,8 +91,8 @@ impl Graph<'_> {
             let what = format!("{who}: tree prototype {p}");
             let Some(guid) = guid else {
                 self.warnings.push(format!(
-                    "{what} has no prefab; its {} trees are not drawn",
-                    mine.len()
+                    "{what} has no prefab: {} not drawn",
+                    count(mine.len())
                 ));
                 continue;
             };
@@ -108,13 +119,10 @@ impl Graph<'_> {
             .filter(|t| t.prototype >= prototypes.len())
             .count();
         if unknown > 0 {
-            let names = if unknown == 1 {
-                "tree names"
-            } else {
-                "trees name"
-            };
             self.warnings.push(format!(
-                "{who}: {unknown} {names} a prototype the TerrainData does not have; not drawn"
+                "{who}: {} not drawn: no such prototype in the TerrainData (it has {})",
+                count(unknown),
+                prototypes.len()
             ));
         }
     }
@@ -154,6 +162,15 @@ impl Graph<'_> {
         ));
         kv.push(("m_LocalRotation".into(), vector(&rotation.to_array())));
         kv.push(("m_LocalScale".into(), vector(&scale.to_array())));
+    }
+}
+
+/// "1 tree", "3 trees".
+fn count(n: usize) -> String {
+    if n == 1 {
+        "1 tree".into()
+    } else {
+        format!("{n} trees")
     }
 }
 
@@ -343,6 +360,7 @@ MeshRenderer:
                 0,
             ),
             (Vec3::new(0.1, 0.0, 0.1), 1.0, 1.0, 0.0, 3),
+            (Vec3::new(1e38, 0.0, 0.1), 1.0, 1.0, 0.0, 0),
         ];
         let soup = convert(&trees, true, &scene(""));
         assert_eq!(soup.objects.len(), 2, "{:?}", soup.warnings);
@@ -359,7 +377,8 @@ MeshRenderer:
         assert_eq!(
             soup.warnings,
             [
-                "Assets/s.unity: terrain 'Ground' (fileID 10): 1 tree names a prototype the TerrainData does not have; not drawn",
+                "Assets/s.unity: terrain 'Ground' (fileID 10): 1 tree not drawn: placed beyond the range of 32-bit floats",
+                "Assets/s.unity: terrain 'Ground' (fileID 10): 1 tree not drawn: no such prototype in the TerrainData (it has 1)",
                 "Assets/s.unity: no enabled camera renders to the display; Unity's default camera used",
             ]
         );
