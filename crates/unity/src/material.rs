@@ -195,6 +195,11 @@ const UNLIT_TRANSPARENT_CUTOUT: i64 = 10751;
 const SPRITES_DEFAULT: i64 = 10753;
 const UNLIT_TEXTURE: i64 = 10752;
 const UNLIT_COLOR: i64 = 10755;
+/// The two leaf shaders of Unity's Tree Creator (its Leaves Optimized and Leaves Fast
+/// Optimized: the shader of every "Optimized Leaf Material" it writes into a tree
+/// prefab), both alpha-tested at `_Cutoff`.
+const TREE_LEAVES: i64 = 10601;
+const TREE_LEAVES_FAST: i64 = 10605;
 
 /// Scriptable pipelines' Lit shaders.
 const URP_LIT: &str = "933532a4fcc9baf4fa0491de14d08ed7";
@@ -245,8 +250,8 @@ pub(crate) fn unlit_shader(body: &Node) -> Option<Unlit> {
 /// How the material's shader uses alpha, from the properties its inspector writes:
 /// Standard's `_Mode` (0 Opaque, 1 Cutout, 2 Fade, 3 Transparent), URP Lit's `_Surface`
 /// (1 Transparent) and `_AlphaClip`, HDRP Lit's `_SurfaceType` and `_AlphaCutoffEnable`,
-/// and the fixed modes of the built-in Unlit and Sprite shaders. Other shaders are opaque:
-/// their properties mean what their author chose.
+/// and the fixed modes of the built-in Unlit, Sprite and Tree Creator leaf shaders. Other
+/// shaders are opaque: their properties mean what their author chose.
 pub fn alpha_mode(body: &Node, float: &dyn Fn(&str) -> Option<f32>) -> Alpha {
     let on = |n: &str| float(n).is_some_and(|x| x.round() as i64 == 1);
     let cutout = |key: &str| {
@@ -265,6 +270,7 @@ pub fn alpha_mode(body: &Node, float: &dyn Fn(&str) -> Option<f32>) -> Alpha {
         }
         (Some(BUILTIN_EXTRA_GUID), Some(UNLIT_TRANSPARENT | SPRITES_DEFAULT)) => Alpha::Blend,
         (Some(BUILTIN_EXTRA_GUID), Some(UNLIT_TRANSPARENT_CUTOUT)) => cutout("_Cutoff"),
+        (Some(BUILTIN_EXTRA_GUID), Some(TREE_LEAVES | TREE_LEAVES_FAST)) => cutout("_Cutoff"),
         // A transparent surface that also clips is drawn as blended: below the cutoff its
         // alpha lets most light through anyway.
         (Some(URP_LIT | URP_UNLIT), _) if on("_Surface") => Alpha::Blend,
@@ -385,14 +391,15 @@ impl Emitter<'_, '_> {
         }
     }
 
-    /// A Material document of file `file` (guid-less reference).
+    /// A Material document of file `file` (guid-less reference): one soup material for
+    /// every instance of the prefab that holds it.
     fn embedded_material(&mut self, id: i64, file: usize, what: &str) -> (u32, String) {
-        let key = format!("local:{file}:{id}");
         let project = self.g.project;
         let Some(f) = self.g.files.get(file) else {
             let why = format!("local material {id} not found");
             return (self.warn_default(what, why), "default".into());
         };
+        let key = format!("local:{}:{id}", f.path.display());
         let src = format!("{}#{id}", project.rel(&f.path));
         if let Some(&i) = self.materials.get(&key) {
             return (i, format!("override {src}"));
@@ -793,6 +800,15 @@ mod tests {
         assert_eq!(alpha_of(&unlit(10750)).0, Alpha::Blend);
         assert_eq!(alpha_of(&unlit(10751)).0, Alpha::Cutout { cutoff: 0.5 });
         assert_eq!(alpha_of(&unlit(10752)).0, Alpha::Opaque);
+        // Tree Creator's leaves are cut out, its bark is not.
+        for (id, alpha) in [
+            (10601, Alpha::Cutout { cutoff: 0.3 }),
+            (10605, Alpha::Cutout { cutoff: 0.3 }),
+            (10604, Alpha::Opaque),
+        ] {
+            let floats = "  m_SavedProperties:\n    m_Floats:\n    - _Cutoff: 0.3\n";
+            assert_eq!(alpha_of(&(unlit(id) + floats)).0, alpha, "{id}");
+        }
         // A custom shader's _Mode means what its author chose.
         let custom = "Material:\n  m_Shader: {fileID: 4800000, guid: 1234, type: 3}\n  m_SavedProperties:\n    m_Floats:\n    - _Mode: 1\n";
         assert_eq!(alpha_of(custom).0, Alpha::Opaque);

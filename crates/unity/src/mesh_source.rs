@@ -24,7 +24,7 @@ impl Emitter<'_, '_> {
         }
         let key = format!("{id}:{}:{}", r.guid.as_deref().unwrap_or(""), r.file);
         match r.guid.as_deref() {
-            None => self.embedded_mesh(id, r.file, key),
+            None => self.embedded_mesh(id, r.file),
             Some(BUILTIN_MESH_GUID) => {
                 let name = primitives::name(id)
                     .ok_or_else(|| format!("unknown built-in mesh fileID {id}"))?;
@@ -40,11 +40,13 @@ impl Emitter<'_, '_> {
         }
     }
 
-    /// A Mesh document of file `file` (guid-less reference).
-    fn embedded_mesh(&mut self, id: i64, file: usize, key: String) -> Resolved {
+    /// A Mesh document of file `file` (guid-less reference), decoded once for every
+    /// instance of the prefab that holds it.
+    fn embedded_mesh(&mut self, id: i64, file: usize) -> Resolved {
         let Some(f) = self.g.files.get(file) else {
             return Err(format!("local mesh fileID {id} has no file"));
         };
+        let key = format!("local:{}:{id}", f.path.display());
         let rel = self.g.project.rel(&f.path);
         let source = format!("{rel}#Mesh{id}");
         if let Some(Some(m)) = self.meshes.get(&key) {
