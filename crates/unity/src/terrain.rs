@@ -6,10 +6,11 @@
 //! serialization mode, so they are read through [`crate::serialized`]. A height is a
 //! 16-bit sample where 32766 is the terrain's full height (Unity's terrain tools scale
 //! heights by 32766 / 65535 into a 16-bit texture). A terrain ignores its Transform's
-//! rotation and scale: it lies along the world axes from its position. Its painted trees
-//! are read here and planted with the scene's objects ([`crate::trees`]). The smooth blend
-//! between layers, holes and detail grass are not converted; a warning names a terrain
-//! with more than one layer and how much of it each covers.
+//! rotation and scale: it lies along the world axes from its position. Painted holes are
+//! cut out cell by cell. Its painted trees are read here and planted with the scene's
+//! objects ([`crate::trees`]). The smooth blend between layers and detail grass are not
+//! converted; a warning names a terrain with more than one layer and how much of it each
+//! covers.
 
 use crate::emit::{EmitError, Emitter};
 use crate::reference::Ref;
@@ -56,9 +57,10 @@ pub struct TerrainData {
     pub field: Heightfield,
     pub layers: LayerRefs,
     pub splat: Option<Splat>,
-    /// It has painted holes (`m_Holes`, Unity 2019.3 and later, empty until one is
-    /// painted), which are not cut.
-    pub holes: bool,
+    /// Painted holes (`m_Holes`, called `m_SurfaceMask` in the first versions to paint
+    /// them, Unity 2019.3): one byte per cell, rows along z, 0 where the surface is cut
+    /// away; empty until a hole is painted.
+    pub holes: Vec<u8>,
     pub trees: Trees,
 }
 
@@ -171,7 +173,10 @@ pub fn read(file: &SerializedFile, id: i64) -> Result<TerrainData, String> {
         heights,
         size,
     };
-    let holes = matches!(hm.get("m_Holes"), Some(Value::Bytes(b)) if !b.is_empty());
+    let holes = match hm.get("m_Holes").or(hm.get("m_SurfaceMask")) {
+        Some(Value::Bytes(b)) => b.clone(),
+        _ => Vec::new(),
+    };
     Ok(TerrainData {
         holes,
         field,
@@ -344,8 +349,13 @@ pub fn layer_asset(text: &str, name: &str) -> Option<Layer> {
 impl Heightfield {
     /// The grid as a mesh in the terrain's own space (Unity axes, origin at its corner),
     /// every `step`-th sample a vertex, UVs 0 to 1 across it; each cell's two triangles in
-    /// sub-mesh `part(u, v)` of `parts`, (u, v) the cell's centre.
-    pub fn mesh(&self, parts: usize, part: impl Fn(f32, f32) -> usize) -> crate::mesh::Mesh {
+    /// sub-mesh `part(u, v)` of `parts`, (u, v) the cell's centre, or none where `part`
+    /// says None (a hole).
+    pub fn mesh(
+        &self,
+        parts: usize,
+        part: impl Fn(f32, f32) -> Option<usize>,
+    ) -> crate::mesh::Mesh {
         let res = self.resolution;
         let step = (res - 1).div_ceil(MAX_CELLS);
         let n = (res - 1) / step + 1;
@@ -379,7 +389,8 @@ impl Heightfield {
             for x in 0..n - 1 {
                 let centre = |a: Vec2, b: Vec2| (a + b) / 2.0;
                 let c = centre(uvs[v(x, z) as usize], uvs[v(x + 1, z + 1) as usize]);
-                let tris = &mut submeshes[part(c.x, c.y).min(parts.max(1) - 1)];
+                let Some(p) = part(c.x, c.y) else { continue };
+                let tris = &mut submeshes[p.min(parts.max(1) - 1)];
                 // Clockwise seen from above: Unity's front faces, facing +y.
                 tris.push([v(x, z), v(x, z + 1), v(x + 1, z)]);
                 tris.push([v(x, z + 1), v(x + 1, z + 1), v(x + 1, z)]);
@@ -438,11 +449,19 @@ impl Emitter<'_, '_> {
         let layers = self.terrain_layers(layers, &what);
         let coverage = splat.as_ref().map(Splat::coverage).unwrap_or_default();
         self.warn_layers(&layers, &coverage, &what);
-        if holes {
+        let cells = field.resolution - 1;
+        let holes = if holes.is_empty() || holes.len() == cells * cells {
+            holes
+        } else {
             self.warn(format!(
-                "{what}: its holes are not cut: the ground is drawn through them"
+                "{what}: its holes are not cut: m_Holes holds {} bytes for {cells}×{cells} cells",
+                holes.len()
             ));
-        }
+            Vec::new()
+        };
+        // The cell under a point, as the holes texture is sampled.
+        let cell = |t: f32| ((t * cells as f32) as usize).min(cells - 1);
+        let hole = |u: f32, v: f32| holes.get(cell(v) * cells + cell(u)) == Some(&0);
         if field.resolution - 1 > MAX_CELLS {
             let step = (field.resolution - 1).div_ceil(MAX_CELLS);
             self.warn(format!(
@@ -452,13 +471,17 @@ impl Emitter<'_, '_> {
             ));
         }
         // Each cell takes the drawn layer that weighs most at its centre (the first of
-        // equals); without splat maps, every cell the first drawn layer.
+        // equals); without splat maps, every cell the first drawn layer. A cell whose
+        // centre is in a hole is not drawn (a sub-sampled cell is one of its centre's).
         let drawn: Vec<usize> = (0..layers.len()).filter(|&i| layers[i].is_some()).collect();
         let mesh = Arc::new(field.mesh(drawn.len().max(1), |u, v| {
+            if hole(u, v) {
+                return None;
+            }
             let weight = |i: usize| splat.as_ref().map_or(0, |s| s.weight(drawn[i], u, v));
             (0..drawn.len())
                 .reduce(|best, i| if weight(i) > weight(best) { i } else { best })
-                .unwrap_or(0)
+                .or(Some(0))
         }));
         // Materials only for the layers that draw a cell: each decodes a texture.
         let mut parts = Vec::new();
@@ -619,13 +642,14 @@ mod tests {
     /// before Unity 2018.3) a splat prototype whose texture is that external.
     ///
     /// `alpha`, when given, is one splat map of 2×1 texels: its texture format and image
-    /// data.
+    /// data. `holes`, when not empty, is the heightmap's `m_Holes`.
     fn terrain_data(
         version: u32,
         resolution: i32,
         heights: &[i16],
         assets: bool,
         alpha: Option<(i32, &[u8])>,
+        holes: &[u8],
     ) -> Vec<u8> {
         let mut n = vec![(0, "TerrainData", "Base", -1, 0, 0)];
         n.extend([
@@ -679,6 +703,16 @@ mod tests {
             (3, "Array", "Array", -1, 1, ALIGN),
             (4, "int", "size", 4, 0, 0),
             (4, "SInt16", "data", 2, 0, 0),
+        ]);
+        if !holes.is_empty() {
+            n.extend([
+                (2, "vector", "m_Holes", -1, 0, 0),
+                (3, "Array", "Array", -1, 1, ALIGN),
+                (4, "int", "size", 4, 0, 0),
+                (4, "UInt8", "data", 1, 0, 0),
+            ]);
+        }
+        n.extend([
             (
                 2,
                 "int",
@@ -711,6 +745,13 @@ mod tests {
             w.i16(h);
         }
         w.align();
+        if !holes.is_empty() {
+            w.i32(holes.len() as i32);
+            for &b in holes {
+                w.u8(b);
+            }
+            w.align();
+        }
         w.i32(resolution);
         for v in [2.0, 50.0, 4.0] {
             w.f32(v);
@@ -756,7 +797,7 @@ mod tests {
     fn terrain_data_reads_heights_size_and_layers_in_both_layouts() {
         let heights = [0, 16383, 32766, -5, 32767, 0, 0, 0, 100];
         for (version, assets) in [(22, true), (17, true), (17, false)] {
-            let bytes = terrain_data(version, 3, &heights, assets, None);
+            let bytes = terrain_data(version, 3, &heights, assets, None, &[]);
             let file = SerializedFile::parse(bytes, "Assets/T.asset").unwrap();
             let TerrainData {
                 field,
@@ -766,7 +807,7 @@ mod tests {
                 trees,
             } = read(&file, 15600000).unwrap();
             assert_eq!(trees, Trees::default());
-            assert!(!holes);
+            assert!(holes.is_empty());
             assert!(splat.is_none(), "no splat maps");
             assert_eq!(field.resolution, 3);
             assert_eq!(field.size, Vec3::new(4.0, 50.0, 8.0));
@@ -805,7 +846,7 @@ mod tests {
         let argb = [0, 255, 0, 0, 200, 0, 55, 0, 9, 9, 9, 9];
         let rgba = [255, 0, 0, 0, 0, 55, 0, 200, 9, 9, 9, 9];
         for (format, image) in [(5, argb), (4, rgba)] {
-            let bytes = terrain_data(22, 3, &[0; 9], true, Some((format, &image)));
+            let bytes = terrain_data(22, 3, &[0; 9], true, Some((format, &image)), &[]);
             let file = SerializedFile::parse(bytes, "Assets/T.asset").unwrap();
             let splat = read(&file, 15600000).unwrap().splat.expect("a splat map");
             assert_eq!(splat.maps[0].texels, [[255, 0, 0, 0], [0, 55, 0, 200]]);
@@ -814,14 +855,14 @@ mod tests {
             assert_eq!(c, [0.5, 55.0 / 510.0, 0.0, 200.0 / 510.0]);
         }
         // Another format is not read.
-        let bytes = terrain_data(22, 3, &[0; 9], true, Some((10, &[0; 12])));
+        let bytes = terrain_data(22, 3, &[0; 9], true, Some((10, &[0; 12])), &[]);
         let file = SerializedFile::parse(bytes, "Assets/T.asset").unwrap();
         assert!(read(&file, 15600000).unwrap().splat.is_none());
     }
 
     #[test]
     fn a_heightmap_that_does_not_match_its_resolution_is_refused() {
-        let bytes = terrain_data(22, 4, &[0; 9], true, None);
+        let bytes = terrain_data(22, 4, &[0; 9], true, None, &[]);
         let file = SerializedFile::parse(bytes, "Assets/T.asset").unwrap();
         let err = read(&file, 15600000).err().unwrap();
         assert_eq!(err, "m_Heights holds 9 samples for a resolution of 4");
@@ -842,7 +883,7 @@ mod tests {
     fn the_grid_spans_the_terrain_and_faces_up() {
         // 3×3 samples over 10 m × 20 m, 4 m high, raised along z.
         let f = field(3, Vec3::new(10.0, 4.0, 20.0), |_, z| z as f32 / 2.0);
-        let m = f.mesh(1, |_, _| 0);
+        let m = f.mesh(1, |_, _| Some(0));
         assert_eq!(m.positions.len(), 9);
         assert_eq!(m.submeshes[0].len(), 8);
         assert_eq!(m.positions[0], Vec3::ZERO);
@@ -869,12 +910,18 @@ mod tests {
         let f = field(5, Vec3::new(4.0, 1.0, 4.0), |_, _| 0.0);
         let m = f.mesh(2, |u, v| {
             assert!((0.0..1.0).contains(&u) && (0.0..1.0).contains(&v));
-            usize::from(u < 0.5)
+            // The far right corner cell is a hole.
+            (u < 0.75 || v < 0.75).then_some(usize::from(u < 0.5))
         });
-        assert_eq!((m.submeshes[0].len(), m.submeshes[1].len()), (16, 16));
+        assert_eq!((m.submeshes[0].len(), m.submeshes[1].len()), (14, 16));
         for t in &m.submeshes[1] {
             assert!(t.iter().all(|&i| m.positions[i as usize].x <= 2.0), "{t:?}");
         }
+        let corner = |t: &[u32; 3]| {
+            t.iter()
+                .all(|&i| m.positions[i as usize].x.min(m.positions[i as usize].z) >= 3.0)
+        };
+        assert!(!m.submeshes[0].iter().any(corner));
         // A 2×1 map: layer 0 (R) on the left texel, layer 5 (second map's G) on the right.
         let splat = Splat {
             maps: vec![
@@ -906,7 +953,7 @@ mod tests {
         let f = field(res, Vec3::new(2049.0, 1.0, 2049.0), |x, z| {
             ((x + z) % 2) as f32
         });
-        let m = f.mesh(1, |_, _| 0);
+        let m = f.mesh(1, |_, _| Some(0));
         let n = 2049usize.div_ceil(3) + 1;
         assert_eq!(m.positions.len(), n * n);
         assert_eq!(m.submeshes[0].len(), 2 * (n - 1) * (n - 1));
@@ -915,8 +962,10 @@ mod tests {
         assert_eq!(m.positions[n * n - 1], Vec3::new(2049.0, 0.0, 2049.0));
     }
 
-    #[test]
-    fn a_scene_terrain_lies_along_the_axes_from_its_position_with_its_layer_tiled() {
+    /// A scene of one terrain of TerrainData `data` at (10, 1, 20), turned and scaled
+    /// (which a terrain ignores), with one layer 'Grass' tiled 2 m × 4 m from 1 m, its
+    /// shadows off.
+    fn convert_terrain(data: &[u8]) -> formats::Soup {
         let dir = tempfile::tempdir().unwrap();
         let assets = dir.path().join("Assets");
         std::fs::create_dir_all(&assets).unwrap();
@@ -925,11 +974,7 @@ mod tests {
             let meta = format!("fileFormatVersion: 2\nguid: {guid}\n");
             std::fs::write(assets.join(format!("{name}.meta")), meta).unwrap();
         };
-        put(
-            "T.asset",
-            &terrain_data(22, 3, &[0, 0, 0, 0, 32766, 0, 0, 0, 0], true, None),
-            "aaaa0000aaaa0000aaaa0000aaaa0000",
-        );
+        put("T.asset", data, "aaaa0000aaaa0000aaaa0000aaaa0000");
         let layer = "%YAML 1.1\n--- !u!1953259897 &8574412962073106934\nTerrainLayer:\n  m_Name: Grass\n  m_DiffuseTexture: {fileID: 2800000, guid: bbbb0000bbbb0000bbbb0000bbbb0000, type: 3}\n  m_TileSize: {x: 2, y: 4}\n  m_TileOffset: {x: 1, y: 0}\n  m_Smoothness: 0.25\n";
         put("Grass.terrainlayer", layer.as_bytes(), GUID_TEXT);
         let mut png = std::io::Cursor::new(Vec::new());
@@ -937,15 +982,21 @@ mod tests {
             .write_to(&mut png, image::ImageFormat::Png)
             .unwrap();
         put("g.png", png.get_ref(), "bbbb0000bbbb0000bbbb0000bbbb0000");
-        // Turned and scaled, which a terrain ignores.
         let scene = "%YAML 1.1\n--- !u!1 &10\nGameObject:\n  m_Component:\n  - component: {fileID: 11}\n  m_Name: Ground\n  m_IsActive: 1\n--- !u!4 &11\nTransform:\n  m_GameObject: {fileID: 10}\n  m_LocalRotation: {x: 0, y: 0.7071068, z: 0, w: 0.7071068}\n  m_LocalPosition: {x: 10, y: 1, z: 20}\n  m_LocalScale: {x: 2, y: 2, z: 2}\n  m_Father: {fileID: 0}\n--- !u!218 &12\nTerrain:\n  m_GameObject: {fileID: 10}\n  m_Enabled: 1\n  m_TerrainData: {fileID: 15600000, guid: aaaa0000aaaa0000aaaa0000aaaa0000, type: 2}\n  m_ShadowCastingMode: 0\n";
         put(
             "s.unity",
             scene.as_bytes(),
             "cccc0000cccc0000cccc0000cccc0000",
         );
-        let r = crate::convert_report(&assets.join("s.unity"), &crate::Options::default()).unwrap();
-        let soup = &r.soup;
+        crate::convert_report(&assets.join("s.unity"), &crate::Options::default())
+            .unwrap()
+            .soup
+    }
+
+    #[test]
+    fn a_scene_terrain_lies_along_the_axes_from_its_position_with_its_layer_tiled() {
+        let heights = [0, 0, 0, 0, 32766, 0, 0, 0, 0];
+        let soup = &convert_terrain(&terrain_data(22, 3, &heights, true, None, &[]));
         assert_eq!(soup.triangles.len(), 8, "{:?}", soup.warnings);
         assert_eq!(soup.objects[0].name, "Ground");
         assert_eq!(soup.objects[0].cast_shadows, CastShadows::Off);
@@ -967,6 +1018,26 @@ mod tests {
         assert_eq!(
             soup.warnings,
             ["Assets/s.unity: no enabled camera renders to the display; Unity's default camera used"]
+        );
+    }
+    #[test]
+    fn painted_holes_cut_their_cells_and_a_mask_of_the_wrong_size_is_said() {
+        // 2×2 cells; the hole is the cell at x 1, z 0: 2–4 m along x (−2 to −4 in the
+        // soup), 0–4 m along z, from (10, 1, 20).
+        let data = terrain_data(22, 3, &[0; 9], true, None, &[255, 0, 255, 255]);
+        let soup = convert_terrain(&data);
+        assert_eq!(soup.triangles.len(), 6, "{:?}", soup.warnings);
+        for t in &soup.triangles {
+            let centre = t.iter().map(|&i| soup.positions[i as usize]).sum::<Vec3>() / 3.0;
+            let in_hole = (-14.0..-12.0).contains(&centre.x) && (20.0..24.0).contains(&centre.z);
+            assert!(!in_hole, "{centre}");
+        }
+        assert_eq!(soup.warnings.len(), 1, "{:?}", soup.warnings);
+        let soup = convert_terrain(&terrain_data(22, 3, &[0; 9], true, None, &[0; 3]));
+        assert_eq!(soup.triangles.len(), 8);
+        assert_eq!(
+            soup.warnings[0],
+            "Assets/s.unity: object 'Ground' (fileID 10): its holes are not cut: m_Holes holds 3 bytes for 2×2 cells"
         );
     }
 }
