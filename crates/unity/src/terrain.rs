@@ -635,7 +635,7 @@ impl Emitter<'_, '_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::serialized::tests::{file, ObjSpec, TypeSpec, ALIGN, GUID_TEXT, W};
+    use crate::serialized::tests::{check_fuzz_seed, file, ObjSpec, TypeSpec, ALIGN, GUID_TEXT, W};
 
     /// A TerrainData of `resolution`² heights (`heights`), spacing (2, 50, 4), with one
     /// layer: a TerrainLayer asset (the only external) when `assets`, else (the layout
@@ -1039,5 +1039,14 @@ mod tests {
             soup.warnings[0],
             "Assets/s.unity: object 'Ground' (fileID 10): its holes are not cut: m_Holes holds 3 bytes for 2×2 cells"
         );
+    }
+
+    /// A TerrainData with a splat map and holes seeds the `unity_serialized` fuzz target.
+    #[test]
+    fn fuzz_seed_with_splat_map_and_holes_is_current() {
+        let image = [255, 0, 0, 0, 0, 255, 0, 0];
+        let holes = [255, 0, 255, 255];
+        let data = terrain_data(22, 3, &[0; 9], true, Some((4, &image)), &holes);
+        check_fuzz_seed("seed-terrain-holes.bin", &data);
     }
 }

@@ -176,7 +176,7 @@ fn count(n: usize) -> String {
 
 #[cfg(test)]
 mod tests {
-    use crate::serialized::tests::{file, ObjSpec, TypeSpec, ALIGN, GUID_TEXT, W};
+    use crate::serialized::tests::{check_fuzz_seed, file, ObjSpec, TypeSpec, ALIGN, GUID_TEXT, W};
     use glam::Vec3;
 
     /// A flat TerrainData 8 m × 40 m × 16 m (2² samples) with one tree prototype (the
@@ -402,5 +402,13 @@ MeshRenderer:
                 format!("{what}: 3 of its 3 trees are not drawn"),
             ]
         );
+    }
+
+    /// A TerrainData with trees seeds the `unity_serialized` fuzz target, which reads
+    /// every TerrainData it finds.
+    #[test]
+    fn fuzz_seed_with_trees_is_current() {
+        let tree = (Vec3::new(0.5, 0.25, 0.25), 1.5, 0.5, 1.0, 0);
+        check_fuzz_seed("seed-terrain-trees.bin", &terrain_data(&[tree; 2]));
     }
 }
