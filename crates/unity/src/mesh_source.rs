@@ -22,10 +22,12 @@ impl Emitter<'_, '_> {
         if id == 0 {
             return Err("MeshFilter has no mesh".into());
         }
-        let key = format!("{id}:{}:{}", r.guid.as_deref().unwrap_or(""), r.file);
-        match r.guid.as_deref() {
-            None => self.embedded_mesh(id, r.file),
-            Some(BUILTIN_MESH_GUID) => {
+        let Some(guid) = r.guid.as_deref() else {
+            return self.embedded_mesh(id, r.file);
+        };
+        let key = format!("{id}:{guid}:{}", r.file);
+        match guid {
+            BUILTIN_MESH_GUID => {
                 let name = primitives::name(id)
                     .ok_or_else(|| format!("unknown built-in mesh fileID {id}"))?;
                 let m = self
@@ -36,7 +38,7 @@ impl Emitter<'_, '_> {
                     .ok_or("built-in mesh missing")?;
                 Ok((m, format!("builtin:{name}")))
             }
-            Some(guid) => self.model_mesh(id, guid, go, key),
+            _ => self.model_mesh(id, guid, go, key),
         }
     }
 

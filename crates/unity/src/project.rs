@@ -45,6 +45,9 @@ pub type FileResult = Arc<std::io::Result<Vec<u8>>>;
 /// read error's message.
 pub type MatResult = Arc<Result<Option<Node>, String>>;
 
+/// A TerrainData asset as read, or why it could not be (without the file's name).
+pub type TerrainResult = Arc<Result<crate::terrain::TerrainData, String>>;
+
 pub struct Project {
     pub root: PathBuf,
     pub assets: PathBuf,
@@ -56,6 +59,7 @@ pub struct Project {
     files: Mutex<HashMap<PathBuf, FileResult>>,
     models: Mutex<HashMap<PathBuf, ModelResult>>,
     mats: Mutex<HashMap<PathBuf, MatResult>>,
+    terrains: Mutex<HashMap<PathBuf, TerrainResult>>,
     by_name: OnceLock<HashMap<String, PathBuf>>,
 }
 
@@ -105,6 +109,7 @@ impl Project {
             files: Mutex::default(),
             models: Mutex::default(),
             mats: Mutex::default(),
+            terrains: Mutex::default(),
             by_name: OnceLock::new(),
         }
     }
@@ -151,6 +156,20 @@ impl Project {
                 Ok(text) => Ok(docs::first(&text, docs::MATERIAL)),
                 Err(e) => Err(e.to_string()),
             })
+        })
+    }
+
+    /// TerrainData `id` of the asset at `path` (read once: its trees are planted with the
+    /// scene's objects, its heightmap drawn later).
+    pub fn terrain_data(&self, path: &Path, id: i64) -> TerrainResult {
+        let key = PathBuf::from(format!("{}#{id}", path.display()));
+        cached(&self.terrains, &key, || {
+            let rel = self.rel(path);
+            Arc::new(crate::terrain::load(path, &rel, id).map_err(|why| {
+                why.strip_prefix(&format!("{rel}: "))
+                    .unwrap_or(&why)
+                    .to_string()
+            }))
         })
     }
 

@@ -41,6 +41,7 @@ pub struct Heightfield {
 }
 
 /// One terrain layer: its albedo texture by GUID and how it tiles.
+#[derive(Clone)]
 pub struct Layer {
     pub name: String,
     pub texture: Option<String>,
@@ -426,19 +427,16 @@ impl Emitter<'_, '_> {
             return Ok(());
         };
         let rel = g.project.rel(&path);
+        let parsed = g.project.terrain_data(&path, r.file_id);
         let TerrainData {
             field,
             layers,
             splat,
             holes,
             trees: _, // planted with the scene's objects (`crate::trees`)
-        } = match load(&path, &rel, r.file_id) {
+        } = match parsed.as_ref() {
             Ok(x) => x,
             Err(why) => {
-                let why = why
-                    .strip_prefix(&format!("{rel}: "))
-                    .unwrap_or(&why)
-                    .to_string();
                 self.warn(format!("{what}: TerrainData {rel}: {why}; skipped"));
                 return Ok(());
             }
@@ -450,14 +448,14 @@ impl Emitter<'_, '_> {
         let coverage = splat.as_ref().map(Splat::coverage).unwrap_or_default();
         self.warn_layers(&layers, &coverage, &what);
         let cells = field.resolution - 1;
-        let holes = if holes.is_empty() || holes.len() == cells * cells {
+        let holes: &[u8] = if holes.is_empty() || holes.len() == cells * cells {
             holes
         } else {
             self.warn(format!(
                 "{what}: its holes are not cut: m_Holes holds {} bytes for {cells}×{cells} cells",
                 holes.len()
             ));
-            Vec::new()
+            &[]
         };
         // The cell under a point, as the holes texture is sampled.
         let cell = |t: f32| ((t * cells as f32) as usize).min(cells - 1);
@@ -521,7 +519,7 @@ impl Emitter<'_, '_> {
 
     /// The layers in the splat maps' order, TerrainLayer assets read; a missing asset is
     /// None, with a warning.
-    fn terrain_layers(&mut self, refs: LayerRefs, what: &str) -> Vec<Option<Layer>> {
+    fn terrain_layers(&mut self, refs: &LayerRefs, what: &str) -> Vec<Option<Layer>> {
         let guids = match refs {
             LayerRefs::Inline(layers) => {
                 // A splat prototype has no name of its own: its texture's file names it.
@@ -533,7 +531,7 @@ impl Emitter<'_, '_> {
                     }
                     Some(l)
                 };
-                return layers.into_iter().map(named).collect();
+                return layers.iter().cloned().map(named).collect();
             }
             LayerRefs::Assets(guids) => guids,
         };
@@ -543,7 +541,7 @@ impl Emitter<'_, '_> {
                 layers.push(None);
                 continue;
             };
-            let Some(path) = self.g.project.resolve(&guid).cloned() else {
+            let Some(path) = self.g.project.resolve(guid).cloned() else {
                 self.warn(format!(
                     "{what}: terrain layer GUID {guid} is not in the project; left out"
                 ));

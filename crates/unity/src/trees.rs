@@ -53,14 +53,14 @@ impl Graph<'_> {
         else {
             return;
         };
-        let rel = self.project.rel(&path);
-        let Ok(data) = crate::terrain::load(&path, &rel, r.file_id) else {
+        let parsed = self.project.terrain_data(&path, r.file_id);
+        let Ok(data) = parsed.as_ref() else {
             return;
         };
         let Trees {
             prototypes,
             instances,
-        } = data.trees;
+        } = &data.trees;
         let scene = self
             .files
             .get(o.file)
@@ -74,8 +74,8 @@ impl Graph<'_> {
         let size = data.field.size;
         // A place beyond f32's range (a damaged file) would make the tree's transform
         // infinite.
-        let (instances, far): (Vec<TreeInstance>, Vec<TreeInstance>) = instances
-            .into_iter()
+        let (instances, far): (Vec<&TreeInstance>, Vec<&TreeInstance>) = instances
+            .iter()
             .partition(|t| (t.position * size).is_finite());
         if !far.is_empty() {
             self.warnings.push(format!(
@@ -84,7 +84,11 @@ impl Graph<'_> {
             ));
         }
         for (p, guid) in prototypes.iter().enumerate() {
-            let mine: Vec<&TreeInstance> = instances.iter().filter(|t| t.prototype == p).collect();
+            let mine: Vec<&TreeInstance> = instances
+                .iter()
+                .copied()
+                .filter(|t| t.prototype == p)
+                .collect();
             if mine.is_empty() {
                 continue;
             }
