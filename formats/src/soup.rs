@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 pub const MAGIC: &[u8; 8] = b"UTSOUP\0\0";
-pub const VERSION: u32 = 11;
+pub const VERSION: u32 = 12;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Soup {
@@ -123,6 +123,9 @@ pub struct Material {
     pub metallic: f32,
     /// `_Glossiness` / `_Smoothness`, 0–1.
     pub smoothness: f32,
+    /// The lights leave highlights on the surface: its shader has the Standard or Lit
+    /// shaders' specular lobe (a smoothness property) and `_SpecularHighlights` is on.
+    pub highlights: bool,
     /// `_Reflectivity` when the material sets it: overrides metallic·smoothness.
     pub reflectivity: Option<f32>,
     /// `_EmissionColor` when emission is enabled, linear RGB (HDR, may exceed 1).
@@ -220,6 +223,7 @@ impl Material {
             color: Vec3::ONE,
             metallic: 0.0,
             smoothness: 0.5,
+            highlights: true,
             reflectivity: None,
             emission: Vec3::ZERO,
             cull: Cull::Back,

@@ -2,12 +2,15 @@
 //!
 //! ```text
 //! L = emission + ambient(n)·albedo
-//!   + Σ_lights visible · falloff · intensity·colour · max(0, n·l) · albedo
+//!   + Σ_lights visible · falloff · intensity·colour · (max(0, n·l) · albedo + highlight)
 //!   + reflectance · L(mirror ray)        while bounce < depth and weight ≥ cutoff
 //! ```
 //!
 //! n is the interpolated shading normal turned to face the incoming ray; the geometric
 //! normal decides which side a secondary ray leaves from (see [`crate::offset`]).
+//!
+//! The highlight is the specular term of the scene's pipeline's shader for a punctual light
+//! (see [`crate::specular`]).
 //!
 //! Albedo is colour·texel·(1 − metallic) where the material has a map and the plan turns
 //! textures on: the texel is looked up at the hit's interpolated UV through the material's
@@ -40,6 +43,7 @@ use crate::plan::{colour_mapped, Plan, ShadowMode};
 use crate::sampling::{DiscSpiral, Rng};
 use crate::sky::{SkyAmbient, Skybox};
 use crate::soft::{probe_asked, probe_fits, SoftCone};
+use crate::specular::{Brdf, Gloss};
 use crate::tangents::Tangents;
 use crate::texture::{cone_footprint, Sampler};
 use crate::RenderOptions;
@@ -115,7 +119,9 @@ struct Lit {
     /// The surface's α.
     a: f32,
     albedo: Vec3,
-    /// The albedo is not black, so lights can show.
+    /// The glossy side of the surface, where it reflects the lights' highlights.
+    gloss: Option<Gloss>,
+    /// The albedo or the gloss is not black, so lights can show.
     lit: bool,
     surf: Surface,
     /// Unit shading normal, facing the ray.
@@ -140,7 +146,11 @@ impl Lit {
             visible
         };
         if visible > 0.0 {
-            self.l += inc.radiance * (cos * visible) * self.albedo;
+            let mut reflected = self.albedo * cos;
+            if let Some(g) = &self.gloss {
+                reflected += g.highlight(self.ns, inc.dir, cos);
+            }
+            self.l += inc.radiance * visible * reflected;
         }
     }
 }
@@ -321,6 +331,8 @@ pub struct Integrator<'a> {
     tangents: Option<Tangents<'a>>,
     /// How shadows fade out with distance from the camera, where the pipeline limits it.
     shadow_fade: Option<ShadowFade>,
+    /// The pipeline's specular formula, where some light is on.
+    brdf: Option<Brdf>,
 }
 
 /// [`Integrator::sides`] bits: camera and reflection rays that meet the triangle's front
@@ -396,6 +408,9 @@ impl<'a> Integrator<'a> {
             })
             .collect();
         let shadow_fade = ShadowFade::of(soup, &lights);
+        let brdf = lights
+            .first()
+            .map(|al| Brdf::of(al.light.attenuation, soup.environment.color_space));
         let textures = plan.textures.enabled;
         let alpha = plan.alpha.enabled;
         let read = &plan.textures.read;
@@ -490,6 +505,7 @@ impl<'a> Integrator<'a> {
             sky_ambient: sky_ambient(soup, plan).map(Box::new),
             tangents,
             shadow_fade,
+            brdf,
         }
     }
 

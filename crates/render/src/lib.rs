@@ -40,6 +40,7 @@ pub mod sampling;
 pub mod sky;
 pub mod sky_image;
 mod soft;
+pub mod specular;
 pub mod tangents;
 pub mod texture;
 

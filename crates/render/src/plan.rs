@@ -3,6 +3,7 @@
 //! never traced; it is printed, stored in the EXR header and returned in `--json`.
 
 use crate::alpha::{alpha_use, min_alphas, AlphaUse};
+use crate::specular::shows_light;
 use crate::{RenderOptions, TextureFilter};
 use formats::{
     AmbientMode, Attenuation, CastShadows, ClearFlags, Cull, Fog, FogMode, LightKind, Material,
@@ -133,7 +134,8 @@ pub struct AlphaPlan {
 
 #[derive(Clone, Debug, Serialize)]
 pub struct Plan {
-    /// Direct lighting: on when some light is on and some material has a diffuse albedo.
+    /// Direct lighting: on when some light is on and some material shows light (a diffuse
+    /// albedo or a highlight).
     pub direct: Effect,
     pub lights: Vec<LightPlan>,
     pub culling: CullPlan,
@@ -196,11 +198,12 @@ impl Plan {
         let diffuse = mats
             .iter()
             .any(|m| !m.unlit && m.albedo().max_element() > 0.0);
+        let glossy_or_diffuse = mats.iter().any(|m| shows_light(m));
 
         let lights: Vec<LightPlan> = soup
             .lights
             .iter()
-            .map(|l| light_plan(l, diffuse, opts))
+            .map(|l| light_plan(l, glossy_or_diffuse, opts))
             .map(|mut l| {
                 if let (Some(reach), true) = (shadow_reach(soup), l.shadows != ShadowMode::None) {
                     l.reason += &reach;
@@ -213,8 +216,8 @@ impl Plan {
             enabled: lit > 0,
             reason: if soup.lights.is_empty() {
                 "the scene has no lights".into()
-            } else if !diffuse {
-                "no material has a diffuse albedo".into()
+            } else if !glossy_or_diffuse {
+                "no material shows light (each is unlit, or black and fully metallic)".into()
             } else if lit == 0 {
                 "no light delivers any light".into()
             } else {
@@ -348,16 +351,17 @@ impl Plan {
             },
         };
 
-        // The shading normal shows through diffuse light (direct, or an ambient that
-        // depends on it), a mirror's direction, or the normal AOV.
-        let diffuse_normal = direct.enabled
-            || (ambient.enabled && soup.environment.ambient.mode != AmbientMode::Flat);
+        // The shading normal shows through direct light, an ambient that depends on it,
+        // a mirror's direction, or the normal AOV.
+        let diffuse_normal =
+            ambient.enabled && soup.environment.ambient.mode != AmbientMode::Flat;
         let normal_mapped: Vec<&Material> = mats
             .iter()
             .filter(|m| {
                 m.normal_map.is_some()
                     && !m.unlit
                     && (opts.aovs.normal
+                        || (direct.enabled && shows_light(m))
                         || (diffuse_normal && m.albedo().max_element() > 0.0)
                         || (reflections.enabled && mirror(m)))
             })
@@ -555,9 +559,10 @@ fn fog_plan(fog: Option<&Fog>) -> Effect {
 }
 
 /// Whether material `m` reads its albedo map for colour: it has one and a colour the map
-/// can show in (a black tint stays black whatever the texel).
+/// can show in, diffuse or a metal's highlight (a black tint stays black whatever the
+/// texel).
 pub fn colour_mapped(m: &Material) -> bool {
-    m.albedo_map.is_some() && m.albedo().max_element() > 0.0
+    m.albedo_map.is_some() && m.color.max_element() > 0.0
 }
 
 /// The texture and alpha effects the used materials `mats` call for; the textures
@@ -780,7 +785,7 @@ fn shadow_reach(soup: &Soup) -> Option<String> {
     })
 }
 
-fn light_plan(l: &formats::Light, diffuse: bool, opts: &RenderOptions) -> LightPlan {
+fn light_plan(l: &formats::Light, shown: bool, opts: &RenderOptions) -> LightPlan {
     // A point or spot light names the pipeline whose falloff it follows when it is not
     // the built-in one.
     let kind = match (l.kind, l.attenuation) {
@@ -814,8 +819,8 @@ fn light_plan(l: &formats::Light, diffuse: bool, opts: &RenderOptions) -> LightP
         }
         _ => {}
     }
-    if !diffuse {
-        return off("no material has a diffuse albedo to light".into());
+    if !shown {
+        return off("no material shows light (each is unlit, or black and fully metallic)".into());
     }
     let (shadows, shadow_rays, reason) = match l.shadows {
         Shadows::None => (ShadowMode::None, 0, "m_Shadows is none".to_string()),

@@ -62,6 +62,8 @@ fn material(name: &str, color: Vec3, metallic: f32, smoothness: f32) -> Material
         color,
         metallic,
         smoothness,
+        // The analytic references are diffuse.
+        highlights: false,
         reflectivity: None,
         emission: Vec3::ZERO,
         // Two-sided: the analytic references draw both faces.

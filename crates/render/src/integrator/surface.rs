@@ -21,6 +21,8 @@ impl Integrator<'_> {
         let mat_index = self.soup.tri_material[prim] as usize;
         let mat = &self.soup.materials[mat_index];
         let mut albedo = mat.albedo();
+        // The colour a metal's highlight takes: colour times texel, before metallic.
+        let mut base = mat.color;
         let mut a = 1.0f32;
         let surfacing = self.surfacing.get(mat_index);
         // Every map of the surface is read at one UV and footprint, found at the first.
@@ -37,6 +39,7 @@ impl Integrator<'_> {
                     if s.colour {
                         counts.texture_lookups += 1;
                         albedo *= texel.truncate();
+                        base *= texel.truncate();
                     } else {
                         counts.alpha_lookups += 1;
                     }
@@ -117,7 +120,12 @@ impl Integrator<'_> {
         if mat.unlit {
             l += albedo;
         }
-        let lit = !mat.unlit && albedo.max_element() > 0.0;
+        let gloss = self
+            .brdf
+            .filter(|_| mat.highlights && !mat.unlit)
+            .map(|brdf| brdf.gloss(mat, base, -ray.dir))
+            .filter(Gloss::any);
+        let lit = !mat.unlit && (albedo.max_element() > 0.0 || gloss.is_some());
         let mut reflectance = mat.reflectance();
         // The share of ambient light and reflection the occlusion map leaves (1 without
         // one: a product with 1 leaves every other pixel's bits as they were).
@@ -144,6 +152,7 @@ impl Integrator<'_> {
             l,
             a,
             albedo,
+            gloss,
             lit,
             surf,
             ns,

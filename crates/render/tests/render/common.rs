@@ -135,7 +135,8 @@ impl SceneBuilder {
 }
 
 /// Test materials are two-sided (`Cull::None`) so a scene sees both faces unless a test asks
-/// for culling.
+/// for culling, and have Specular Highlights off, so that a lit point shows the diffuse
+/// formula alone (highlights have tests of their own).
 pub fn diffuse(c: Vec3) -> Material {
     Material {
         name: "diffuse".into(),
@@ -143,6 +144,7 @@ pub fn diffuse(c: Vec3) -> Material {
         color: c,
         metallic: 0.0,
         smoothness: 0.0,
+        highlights: false,
         reflectivity: None,
         emission: Vec3::ZERO,
         cull: Cull::None,
@@ -163,6 +165,7 @@ pub fn mirror(reflectivity: f32) -> Material {
         color: Vec3::ONE,
         metallic: 1.0,
         smoothness: 1.0,
+        highlights: false,
         reflectivity: Some(reflectivity),
         emission: Vec3::ZERO,
         cull: Cull::None,
@@ -183,6 +186,7 @@ pub fn emissive(e: Vec3) -> Material {
         color: Vec3::ZERO,
         metallic: 0.0,
         smoothness: 0.0,
+        highlights: false,
         reflectivity: None,
         emission: e,
         cull: Cull::None,

@@ -7,6 +7,7 @@ mod common;
 mod draw_rules;
 mod exr;
 mod fog;
+mod highlights;
 mod lighting;
 mod plan;
 mod robustness;

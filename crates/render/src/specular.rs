@@ -1,0 +1,272 @@
+//! The highlight a light leaves on a glossy surface: the specular half of Unity's
+//! physically based shaders (Standard, URP Lit) for a punctual light, in each pipeline's
+//! own formula, so a highlight has the size and brightness it has in the editor.
+//!
+//! Both pipelines fold π into the light's intensity, as the diffuse term does (albedo ·
+//! cosine, no 1/π), and both work in the metallic workflow: a surface reflects
+//! f0 = lerp(dielectric, colour, metallic) at normal incidence, and the roughness that
+//! shapes the GGX lobe is (1 − smoothness)².
+
+use formats::{Attenuation, ColorSpace, Material};
+use glam::Vec3;
+use std::f32::consts::PI;
+
+/// Unity's reflectance of a dielectric at normal incidence (`unity_ColorSpaceDielectricSpec`,
+/// URP's `kDielectricSpec`): 4 % of linear light.
+pub const DIELECTRIC: f32 = 0.04;
+/// The built-in pipeline's dielectric reflectance in a gamma-space project, where its
+/// shaders work on gamma-encoded values (0.04 encoded).
+pub const DIELECTRIC_GAMMA: f32 = 0.220_916_3;
+
+/// Which of Unity's specular formulas a scene's lights are shaded with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Brdf {
+    /// The built-in pipeline's `BRDF1_Unity_PBS`: GGX, the Smith-joint visibility
+    /// approximation and Schlick's Fresnel; in a gamma project the square root of the
+    /// specular term, as its gamma-space shaders take it.
+    BuiltIn { gamma: bool },
+    /// URP's `DirectBRDFSpecular`: GGX with a combined visibility and Fresnel
+    /// approximation, without Fresnel's change with angle.
+    Universal,
+}
+
+impl Brdf {
+    /// The formula for a scene's pipeline (its lights' attenuation says which) and colour
+    /// space.
+    pub fn of(pipeline: Attenuation, space: ColorSpace) -> Brdf {
+        match pipeline {
+            Attenuation::Universal => Brdf::Universal,
+            Attenuation::BuiltIn => Brdf::BuiltIn {
+                gamma: space == ColorSpace::Gamma,
+            },
+        }
+    }
+
+    fn dielectric(self) -> f32 {
+        match self {
+            Brdf::BuiltIn { gamma: true } => DIELECTRIC_GAMMA,
+            _ => DIELECTRIC,
+        }
+    }
+
+    /// The glossy side of a surface of `material` whose colour (times its texel) is
+    /// `base`, seen along unit `view` (from the point towards the eye).
+    pub fn gloss(self, material: &Material, base: Vec3, view: Vec3) -> Gloss {
+        let metallic = material.metallic.clamp(0.0, 1.0);
+        let smoothness = material.smoothness.clamp(0.0, 1.0);
+        Gloss {
+            f0: Vec3::splat(self.dielectric()).lerp(base, metallic),
+            perceptual_roughness: 1.0 - smoothness,
+            view,
+            brdf: self,
+        }
+    }
+}
+
+/// Whether lights can show on a material at all: its diffuse albedo is not black, or it
+/// has highlights and its specular reflectance is not black (dielectrics reflect 4 %; only
+/// a black, fully metallic surface reflects nothing). Unlit shaders take no light.
+pub fn shows_light(m: &Material) -> bool {
+    !m.unlit
+        && (m.albedo().max_element() > 0.0
+            || (m.highlights && (m.metallic < 1.0 || m.color.max_element() > 0.0)))
+}
+
+/// A shaded point's glossy reflection of the lights.
+#[derive(Clone, Copy, Debug)]
+pub struct Gloss {
+    /// Reflectance at normal incidence.
+    pub f0: Vec3,
+    /// 1 − smoothness.
+    pub perceptual_roughness: f32,
+    /// Unit direction from the point towards the eye.
+    pub view: Vec3,
+    pub brdf: Brdf,
+}
+
+impl Gloss {
+    /// Whether the surface reflects any light specularly (Unity's shaders drop the term
+    /// where f0 is black).
+    pub fn any(&self) -> bool {
+        self.f0.max_element() > 0.0
+    }
+
+    /// The light reflected towards the eye per unit of a light's radiance arriving from
+    /// unit direction `l` at cosine `nl` > 0 with the unit shading normal `n`, the cosine
+    /// included.
+    pub fn highlight(&self, n: Vec3, l: Vec3, nl: f32) -> Vec3 {
+        let v = self.view;
+        // Unity's `SafeNormalize`: a light straight behind the eye gives no half vector.
+        let sum = l + v;
+        let h = sum * sum.length_squared().max(0.001).sqrt().recip();
+        let nh = n.dot(h).clamp(0.0, 1.0);
+        let lh = l.dot(h).clamp(0.0, 1.0);
+        let pr = self.perceptual_roughness;
+        match self.brdf {
+            Brdf::BuiltIn { gamma } => {
+                let a = (pr * pr).max(0.002);
+                let nv = n.dot(v).abs();
+                let lambda_v = nl * (nv * (1.0 - a) + a);
+                let lambda_l = nv * (nl * (1.0 - a) + a);
+                let visibility = 0.5 / (lambda_v + lambda_l + 1e-5);
+                let a2 = a * a;
+                let d = (nh * a2 - nh) * nh + 1.0;
+                let ggx = a2 / (PI * (d * d + 1e-7));
+                let mut term = visibility * ggx * PI;
+                if gamma {
+                    term = term.max(1e-4).sqrt();
+                }
+                let term = (term * nl).max(0.0);
+                let schlick = (1.0 - lh).powi(5);
+                (self.f0 + (Vec3::ONE - self.f0) * schlick) * term
+            }
+            Brdf::Universal => {
+                // URP keeps its roughness above half precision's smallest normal values.
+                let r = (pr * pr).max(0.007_812_5);
+                let r2 = (r * r).max(6.103_515_6e-5);
+                let d = nh * nh * (r2 - 1.0) + 1.00001;
+                let term = r2 / ((d * d) * (lh * lh).max(0.1) * (r * 4.0 + 2.0));
+                self.f0 * (term * nl)
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn gloss(brdf: Brdf, f0: f32, smoothness: f32, view: Vec3) -> Gloss {
+        Gloss {
+            f0: Vec3::splat(f0),
+            perceptual_roughness: 1.0 - smoothness,
+            view: view.normalize(),
+            brdf,
+        }
+    }
+
+    const BUILT_IN: Brdf = Brdf::BuiltIn { gamma: false };
+
+    /// Light, normal and eye in one line: n·h = l·h = n·v = 1, where each formula reduces
+    /// to a closed form.
+    #[test]
+    fn head_on_peaks_match_the_closed_forms() {
+        let n = Vec3::Y;
+        for smoothness in [0.0f32, 0.5, 0.9] {
+            let a = (1.0 - smoothness).powi(2);
+            // Built-in: D = 1/(π a²), V = 0.5/(2 + 1e-5), F = f0, times π.
+            let g = gloss(BUILT_IN, 0.04, smoothness, n);
+            let want = 0.04 * PI * (0.5 / (2.0 + 1e-5)) * (a * a / (PI * (a.powi(4) + 1e-7)));
+            let got = g.highlight(n, n, 1.0).x;
+            assert!((got - want).abs() <= 1e-4 * want, "{smoothness}: {got} vs {want}");
+            // URP: r²/(d²·1·(4r + 2)) with d = r² + 0.00001.
+            let g = gloss(Brdf::Universal, 0.04, smoothness, n);
+            let r2 = a * a;
+            let d = r2 + 0.00001;
+            let want = 0.04 * r2 / (d * d * (4.0 * a + 2.0));
+            let got = g.highlight(n, n, 1.0).x;
+            // 1.00001 + (r² − 1) loses the low digits of r² in f32.
+            assert!((got - want).abs() <= 1e-3 * want, "{smoothness}: {got} vs {want}");
+        }
+        // Smoothness 0.5 on a dielectric: about a fifth of the diffuse white's light.
+        let urp = gloss(Brdf::Universal, 0.04, 0.5, n).highlight(n, n, 1.0).x;
+        assert!((urp - 0.2123).abs() < 1e-3, "{urp}");
+    }
+
+    /// The two pipelines approximate one lobe differently: URP's combined visibility and
+    /// Fresnel term, 1/((4r + 2)·(l·h)²), is brighter at the peak than the built-in's
+    /// Smith-joint visibility (1/4 head-on), by 4/3 at smoothness 0.5 and towards twice as
+    /// the surface grows smooth.
+    #[test]
+    fn pipelines_differ_as_their_formulas_say() {
+        let n = Vec3::Y;
+        let l = Vec3::new(0.3, 1.0, 0.0).normalize();
+        let mirror = Vec3::new(-0.3, 1.0, 0.0);
+        for (view, smoothness, low, high) in [
+            (mirror, 0.5, 1.25, 1.45),
+            (mirror, 0.8, 1.75, 1.95),
+            (Vec3::new(-0.5, 1.0, 0.4), 0.5, 1.2, 1.45),
+        ] {
+            let b = gloss(BUILT_IN, 0.04, smoothness, view).highlight(n, l, n.dot(l));
+            let u = gloss(Brdf::Universal, 0.04, smoothness, view).highlight(n, l, n.dot(l));
+            let ratio = u.x / b.x;
+            assert!((low..high).contains(&ratio), "{view} {smoothness}: {ratio}");
+        }
+    }
+
+    /// Away from the mirror direction a smooth surface's highlight falls off; a rough one
+    /// spreads it.
+    #[test]
+    fn smooth_lobes_are_narrow() {
+        let n = Vec3::Y;
+        let l = Vec3::new(1.0, 1.0, 0.0).normalize();
+        let mirror = Vec3::new(-1.0, 1.0, 0.0);
+        let off = Vec3::new(-1.0, 1.0, 0.6);
+        for brdf in [BUILT_IN, Brdf::Universal] {
+            let peak = gloss(brdf, 0.04, 0.9, mirror).highlight(n, l, n.dot(l)).x;
+            let side = gloss(brdf, 0.04, 0.9, off).highlight(n, l, n.dot(l)).x;
+            assert!(side < peak * 0.05, "{brdf:?}: {side} vs {peak}");
+            let peak = gloss(brdf, 0.04, 0.0, mirror).highlight(n, l, n.dot(l)).x;
+            let side = gloss(brdf, 0.04, 0.0, off).highlight(n, l, n.dot(l)).x;
+            assert!(side > peak * 0.5, "{brdf:?}: {side} vs {peak}");
+        }
+    }
+
+    /// A perfectly smooth metal lit and seen from the mirror direction stays finite, and
+    /// grazing or opposite directions give no NaN.
+    #[test]
+    fn extremes_stay_finite() {
+        let n = Vec3::Y;
+        for brdf in [BUILT_IN, Brdf::BuiltIn { gamma: true }, Brdf::Universal] {
+            for (l, v) in [
+                (Vec3::Y, Vec3::Y),
+                (Vec3::new(1.0, 1e-6, 0.0), Vec3::new(-1.0, 1e-6, 0.0)),
+                (Vec3::new(1.0, 1e-3, 0.0), Vec3::new(1.0, 1e-3, 0.0)),
+                (Vec3::new(1.0, 1e-7, 0.0), Vec3::new(-1.0, -1e-7, 0.0)),
+            ] {
+                let l = l.normalize();
+                let h = gloss(brdf, 1.0, 1.0, v).highlight(n, l, n.dot(l).max(1e-7));
+                assert!(h.is_finite() && h.min_element() >= 0.0, "{brdf:?} {l} {v}: {h}");
+            }
+        }
+    }
+
+    /// Schlick's Fresnel brightens a built-in dielectric towards grazing light; URP's
+    /// formula has no such term.
+    #[test]
+    fn built_in_fresnel_rises_at_grazing() {
+        let n = Vec3::Y;
+        let l = Vec3::new(1.0, 0.05, 0.0).normalize();
+        let v = Vec3::new(-1.0, 0.05, 0.0);
+        let dielectric = gloss(BUILT_IN, 0.04, 0.5, v).highlight(n, l, n.dot(l));
+        let metal = gloss(BUILT_IN, 1.0, 0.5, v).highlight(n, l, n.dot(l));
+        // l·h = cos 87° ≈ 0.05: F = 0.04 + 0.96 · 0.95⁵ ≈ 0.78 of the metal's.
+        let ratio = dielectric.x / metal.x;
+        assert!((ratio - 0.783).abs() < 0.01, "{ratio}");
+    }
+
+    #[test]
+    fn gloss_mixes_dielectric_and_colour_by_metallic() {
+        let mut m = Material::unity_default();
+        m.metallic = 0.5;
+        m.smoothness = 0.75;
+        let g = Brdf::of(Attenuation::BuiltIn, ColorSpace::Linear).gloss(
+            &m,
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::Y,
+        );
+        assert_eq!(g.f0, Vec3::new(0.52, 0.02, 0.02));
+        assert_eq!(g.perceptual_roughness, 0.25);
+        let gamma = Brdf::of(Attenuation::BuiltIn, ColorSpace::Gamma);
+        assert_eq!(gamma.gloss(&m, Vec3::ZERO, Vec3::Y).f0.x, DIELECTRIC_GAMMA * 0.5);
+        let urp = Brdf::of(Attenuation::Universal, ColorSpace::Gamma);
+        assert_eq!(urp.gloss(&m, Vec3::ZERO, Vec3::Y).f0.x, 0.02);
+        m.metallic = 1.0;
+        m.color = Vec3::ZERO;
+        assert!(!shows_light(&m));
+        m.metallic = 0.99;
+        assert!(shows_light(&m));
+        m.highlights = false;
+        assert!(!shows_light(&m));
+    }
+}
