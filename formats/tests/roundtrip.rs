@@ -139,7 +139,7 @@ fn soup_round_trips_through_a_file() {
     assert_eq!(Soup::read(&path).unwrap(), s);
     let bytes = std::fs::read(&path).unwrap();
     assert_eq!(&bytes[..8], b"UTSOUP\0\0");
-    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 11);
+    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 12);
     // Nothing but the artifact is left in the folder (the temp file was renamed).
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     // A gamma-space project's soup says so.
@@ -827,13 +827,13 @@ fn atomic_outputs_get_the_umask_permissions_not_the_temporary_files() {
 }
 
 #[test]
-fn a_version_10_soup_is_refused_with_the_versions_named() {
+fn a_version_11_soup_is_refused_with_the_versions_named() {
     let p = Path::new("old.soup");
     let mut b = sample_soup().to_bytes(p).unwrap();
-    b[8..12].copy_from_slice(&10u32.to_le_bytes());
+    b[8..12].copy_from_slice(&11u32.to_le_bytes());
     let msg = Soup::from_bytes(&b, p).unwrap_err().to_string();
     assert!(
-        msg.contains("soup format version 10, this build reads version 11"),
+        msg.contains("soup format version 11, this build reads version 12"),
         "{msg}"
     );
     assert!(msg.contains("re-run the stage that made it"), "{msg}");
@@ -867,9 +867,11 @@ fn draw_rule_fields_are_encoded_in_unitys_numbering() {
     assert_eq!(payload[o], 7);
     assert_eq!(&payload[o + 1..o + 5], &2u32.to_le_bytes(), "TwoSided is 2");
     assert_eq!(payload[o + 5], 0);
-    // Material ends with cull (u32 variant) after the 12-byte emission.
+    // Material: colour, metallic, smoothness, highlights (a bool byte), reflectivity
+    // (None: one byte), the 12-byte emission, then cull (u32 variant).
     let m = find(b"builtin:Default-Material") + "builtin:Default-Material".len();
-    let cull = m + 12 + 4 + 4 + 1 + 12;
+    assert_eq!(payload[m + 12 + 4 + 4], 1, "highlights on");
+    let cull = m + 12 + 4 + 4 + 1 + 1 + 12;
     assert_eq!(&payload[cull..cull + 4], &1u32.to_le_bytes(), "Front is 1");
     assert_eq!(Soup::from_bytes(&b, p).unwrap(), s);
 }

@@ -12,6 +12,7 @@ use glam::Vec3;
 use scenegen::effects::Builder;
 use scenegen::material::MatDesc;
 use scenegen::unity::{Ambient, CameraDesc, LightDesc, Xform, PLANE, QUAD};
+use std::f32::consts::PI;
 use std::path::Path;
 use unitrace::{run_ok, Rgba};
 
@@ -23,6 +24,7 @@ fn write_project(root: &Path) -> std::path::PathBuf {
         color: [0.0, 0.0, 0.0],
         metallic: 0.0,
         glossiness: 0.0,
+        highlights: true,
         reflectivity: None,
         emission: Some([1.0, 0.1, 0.05]),
     };
@@ -76,6 +78,20 @@ fn unity_falloff(d: f32, range: f32) -> f32 {
     }
     let fade = if x <= 0.8 { 1.0 } else { (1.0 - x) / 0.2 };
     fade / (1.0 + 25.0 * x * x)
+}
+
+/// The built-in Standard shader's highlight from a punctual light per unit of its radiance,
+/// the cosine included (`BRDF1_Unity_PBS`: GGX, Smith-joint visibility, Schlick's Fresnel),
+/// written out again here from Unity's shader source; unit vectors towards the light `l`
+/// and the eye `v`, normal `n`, a dielectric (f0 = 0.04).
+fn unity_highlight(n: Vec3, l: Vec3, v: Vec3, smoothness: f32) -> f32 {
+    let h = (l + v).normalize();
+    let (nl, nv, nh, lh) = (n.dot(l), n.dot(v), n.dot(h), l.dot(h));
+    let a = (1.0 - smoothness).powi(2).max(0.002);
+    let visibility = 0.5 / (nl * (nv * (1.0 - a) + a) + nv * (nl * (1.0 - a) + a));
+    let ggx = a * a / (PI * ((nh * nh) * (a * a - 1.0) + 1.0).powi(2));
+    let fresnel = 0.04 + 0.96 * (1.0 - lh).powi(5);
+    visibility * ggx * PI * nl * fresnel
 }
 
 /// Centre of pixel (px, py) in Unity coordinates on the floor, from the project's numbers.
@@ -162,10 +178,15 @@ fn unity_scene_through_the_three_binaries_gives_the_known_pixels() {
     let light = &soup.lights[0];
     // The soup is right-handed: Unity's X is negated, so Unity (x, y, z) is (−x, y, z) there.
     assert_eq!(light.position, Vec3::new(2.0, 2.0, 0.0));
+    assert!(grey.highlights, "the Standard shader draws highlights");
+    // The orthographic camera looks straight down: every floor point is seen from above.
     let lit = |ux: f32, uz: f32| {
         let to = light.position - Vec3::new(-ux, 0.0, uz);
         let d = to.length();
-        grey.albedo() * light.color * light.intensity * unity_falloff(d, light.range) * (to.y / d)
+        let l = to / d;
+        let reflected = grey.albedo() * l.y
+            + Vec3::splat(unity_highlight(Vec3::Y, l, Vec3::Y, grey.smoothness));
+        reflected * light.color * light.intensity * unity_falloff(d, light.range)
     };
 
     // 1. A floor pixel in the light's reach matches the formula within 1 %.

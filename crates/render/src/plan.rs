@@ -353,8 +353,7 @@ impl Plan {
 
         // The shading normal shows through direct light, an ambient that depends on it,
         // a mirror's direction, or the normal AOV.
-        let diffuse_normal =
-            ambient.enabled && soup.environment.ambient.mode != AmbientMode::Flat;
+        let diffuse_normal = ambient.enabled && soup.environment.ambient.mode != AmbientMode::Flat;
         let normal_mapped: Vec<&Material> = mats
             .iter()
             .filter(|m| {

@@ -158,7 +158,10 @@ mod tests {
             let g = gloss(BUILT_IN, 0.04, smoothness, n);
             let want = 0.04 * PI * (0.5 / (2.0 + 1e-5)) * (a * a / (PI * (a.powi(4) + 1e-7)));
             let got = g.highlight(n, n, 1.0).x;
-            assert!((got - want).abs() <= 1e-4 * want, "{smoothness}: {got} vs {want}");
+            assert!(
+                (got - want).abs() <= 1e-4 * want,
+                "{smoothness}: {got} vs {want}"
+            );
             // URP: r²/(d²·1·(4r + 2)) with d = r² + 0.00001.
             let g = gloss(Brdf::Universal, 0.04, smoothness, n);
             let r2 = a * a;
@@ -166,7 +169,10 @@ mod tests {
             let want = 0.04 * r2 / (d * d * (4.0 * a + 2.0));
             let got = g.highlight(n, n, 1.0).x;
             // 1.00001 + (r² − 1) loses the low digits of r² in f32.
-            assert!((got - want).abs() <= 1e-3 * want, "{smoothness}: {got} vs {want}");
+            assert!(
+                (got - want).abs() <= 1e-3 * want,
+                "{smoothness}: {got} vs {want}"
+            );
         }
         // Smoothness 0.5 on a dielectric: about a fifth of the diffuse white's light.
         let urp = gloss(Brdf::Universal, 0.04, 0.5, n).highlight(n, n, 1.0).x;
@@ -226,7 +232,10 @@ mod tests {
             ] {
                 let l = l.normalize();
                 let h = gloss(brdf, 1.0, 1.0, v).highlight(n, l, n.dot(l).max(1e-7));
-                assert!(h.is_finite() && h.min_element() >= 0.0, "{brdf:?} {l} {v}: {h}");
+                assert!(
+                    h.is_finite() && h.min_element() >= 0.0,
+                    "{brdf:?} {l} {v}: {h}"
+                );
             }
         }
     }
@@ -258,7 +267,10 @@ mod tests {
         assert_eq!(g.f0, Vec3::new(0.52, 0.02, 0.02));
         assert_eq!(g.perceptual_roughness, 0.25);
         let gamma = Brdf::of(Attenuation::BuiltIn, ColorSpace::Gamma);
-        assert_eq!(gamma.gloss(&m, Vec3::ZERO, Vec3::Y).f0.x, DIELECTRIC_GAMMA * 0.5);
+        assert_eq!(
+            gamma.gloss(&m, Vec3::ZERO, Vec3::Y).f0.x,
+            DIELECTRIC_GAMMA * 0.5
+        );
         let urp = Brdf::of(Attenuation::Universal, ColorSpace::Gamma);
         assert_eq!(urp.gloss(&m, Vec3::ZERO, Vec3::Y).f0.x, 0.02);
         m.metallic = 1.0;

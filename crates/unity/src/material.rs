@@ -780,15 +780,25 @@ mod tests {
     fn highlights_follow_the_shader_and_its_switch() {
         let mat = |shader: i64, keywords: &str, floats: &str| {
             let text = format!("Material:\n  m_Shader: {{fileID: {shader}, guid: 0000000000000000f000000000000000, type: 0}}\n{keywords}  m_SavedProperties:\n    m_Floats:\n{floats}    m_Colors: []\n");
-            convert(parse(&text).get("Material").unwrap(), "a.mat").0.highlights
+            convert(parse(&text).get("Material").unwrap(), "a.mat")
+                .0
+                .highlights
         };
         let glossy = "    - _Glossiness: 0.5\n";
         // Standard and Standard (Specular setup), with their switch on, off by keyword, and
         // off by the float where the file lists no keywords.
         assert!(mat(46, "  m_ShaderKeywords: \n", glossy));
         assert!(mat(45, "", glossy));
-        assert!(!mat(46, "  m_ShaderKeywords: _SPECULARHIGHLIGHTS_OFF\n", glossy));
-        assert!(!mat(46, "  m_ValidKeywords:\n  - _SPECULARHIGHLIGHTS_OFF\n", glossy));
+        assert!(!mat(
+            46,
+            "  m_ShaderKeywords: _SPECULARHIGHLIGHTS_OFF\n",
+            glossy
+        ));
+        assert!(!mat(
+            46,
+            "  m_ValidKeywords:\n  - _SPECULARHIGHLIGHTS_OFF\n",
+            glossy
+        ));
         let off = "    - _Glossiness: 0.5\n    - _SpecularHighlights: 0\n";
         assert!(!mat(46, "", off));
         // The keyword list is what the shader compiles by: a stale float does not count.

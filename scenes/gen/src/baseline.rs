@@ -23,6 +23,7 @@ fn looks() -> Vec<MatDesc> {
             color: [0.2, 0.35, 0.9],
             metallic: 0.6,
             glossiness: 1.0,
+            highlights: true,
             reflectivity: Some(0.8),
             emission: None,
         },

@@ -10,6 +10,9 @@ pub struct MatDesc {
     pub color: [f32; 3],
     pub metallic: f32,
     pub glossiness: f32,
+    /// The inspector's Specular Highlights switch (`_SpecularHighlights`; off also writes
+    /// the `_SPECULARHIGHLIGHTS_OFF` keyword).
+    pub highlights: bool,
     /// unitrace's own `_Reflectivity` float: overrides metallic·smoothness when present.
     pub reflectivity: Option<f32>,
     /// `_EmissionColor` (HDR, sRGB-encoded); `Some` also turns on the `_EMISSION` keyword.
@@ -110,6 +113,7 @@ impl MatDesc {
             color,
             metallic: 0.0,
             glossiness: 0.2,
+            highlights: true,
             reflectivity: None,
             emission: None,
         }
@@ -122,6 +126,7 @@ impl MatDesc {
             color: [1.0, 1.0, 1.0],
             metallic: 1.0,
             glossiness: 1.0,
+            highlights: true,
             reflectivity: None,
             emission: None,
         }
@@ -155,6 +160,9 @@ pub fn write_surface(m: &MatDesc, surface: &Surface) -> String {
     }
     if surface.bump_map.is_some() {
         keywords.push("_NORMALMAP");
+    }
+    if !m.highlights {
+        keywords.push("_SPECULARHIGHLIGHTS_OFF");
     }
     keywords.sort();
     let keywords = if keywords.is_empty() {
@@ -248,7 +256,7 @@ pub fn write_surface(m: &MatDesc, surface: &Surface) -> String {
         ("_OcclusionStrength", 1.0),
         ("_Parallax", 0.02),
         ("_SmoothnessTextureChannel", 0.0),
-        ("_SpecularHighlights", 1.0),
+        ("_SpecularHighlights", if m.highlights { 1.0 } else { 0.0 }),
         ("_SrcBlend", src),
         ("_UVSec", 0.0),
         ("_ZWrite", zwrite),
@@ -285,6 +293,7 @@ mod tests {
             color: [0.1, 0.2, 0.9],
             metallic: 0.6,
             glossiness: 1.0,
+            highlights: true,
             reflectivity: Some(0.8),
             emission: None,
         };

@@ -57,9 +57,12 @@ const CRISP: TextureImport = TextureImport {
 /// green 128 one of 1/255 towards increasing v; blue is not read.
 pub const BENT: [u8; 4] = [204, 128, 255, 255];
 
+/// A white matte look. The texture scenes' looks have Specular Highlights off, as the
+/// inspector turns them off, so each pixel is its texel's diffuse light alone.
 fn white(name: &'static str) -> MatDesc {
     MatDesc {
         glossiness: 0.0,
+        highlights: false,
         ..MatDesc::matte(name, [1.0, 1.0, 1.0])
     }
 }
@@ -84,6 +87,7 @@ pub fn project() -> Project {
         "textures",
         &[MatDesc {
             glossiness: 0.0,
+            highlights: false,
             ..MatDesc::matte("Wall", [0.75, 0.75, 0.75])
         }],
     );
@@ -173,6 +177,7 @@ pub fn project() -> Project {
     b.look(
         &MatDesc {
             glossiness: 0.0,
+            highlights: false,
             ..MatDesc::matte("HalfRed", [1.0, 0.0, 0.0])
         },
         &Surface {

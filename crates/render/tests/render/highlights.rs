@@ -61,7 +61,12 @@ fn a_dielectric_shows_its_diffuse_light_and_a_four_percent_highlight() {
             ColorSpace::Linear,
         );
         let want = 2.0 * (COLOUR + Vec3::splat(0.04 * built_in_peak(smoothness)));
-        assert_close(got, want, 2e-4, &format!("built-in, smoothness {smoothness}"));
+        assert_close(
+            got,
+            want,
+            2e-4,
+            &format!("built-in, smoothness {smoothness}"),
+        );
         let got = overhead(
             glossy(0.0, smoothness),
             Attenuation::Universal,
@@ -170,7 +175,12 @@ fn grazing_light_on_a_smooth_metal_stays_finite() {
         near: 0.01,
         far: 1000.0,
     });
-    s.light(point_light(Vec3::new(0.0, 0.001, 40.0), 5.0, 100.0, Shadows::Hard));
+    s.light(point_light(
+        Vec3::new(0.0, 0.001, 40.0),
+        5.0,
+        100.0,
+        Shadows::Hard,
+    ));
     s.light(directional_light(
         Vec3::new(0.0, -1e-4, -1.0),
         1.0,
