@@ -148,7 +148,7 @@ impl Lit {
         if visible > 0.0 {
             let mut reflected = self.albedo * cos;
             if let Some(g) = &self.gloss {
-                reflected += g.highlight(self.ns, inc.dir, cos);
+                reflected += g.highlight(inc.dir, cos);
             }
             self.l += inc.radiance * visible * reflected;
         }

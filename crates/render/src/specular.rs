@@ -9,7 +9,6 @@
 
 use formats::{Attenuation, ColorSpace, Material};
 use glam::Vec3;
-use std::f32::consts::PI;
 
 /// Unity's reflectance of a dielectric at normal incidence (`unity_ColorSpaceDielectricSpec`,
 /// URP's `kDielectricSpec`): 4 % of linear light.
@@ -50,16 +49,12 @@ impl Brdf {
     }
 
     /// The glossy side of a surface of `material` whose colour (times its texel) is
-    /// `base`, seen along unit `view` (from the point towards the eye).
-    pub fn gloss(self, material: &Material, base: Vec3, view: Vec3) -> Gloss {
+    /// `base`, with unit shading normal `n`, seen along unit `view` (from the point
+    /// towards the eye).
+    pub fn gloss(self, material: &Material, base: Vec3, n: Vec3, view: Vec3) -> Gloss {
         let metallic = material.metallic.clamp(0.0, 1.0);
-        let smoothness = material.smoothness.clamp(0.0, 1.0);
-        Gloss {
-            f0: Vec3::splat(self.dielectric()).lerp(base, metallic),
-            perceptual_roughness: 1.0 - smoothness,
-            view,
-            brdf: self,
-        }
+        let f0 = Vec3::splat(self.dielectric()).lerp(base, metallic);
+        Gloss::new(self, f0, 1.0 - material.smoothness.clamp(0.0, 1.0), n, view)
     }
 }
 
@@ -72,19 +67,62 @@ pub fn shows_light(m: &Material) -> bool {
             || (m.highlights && (m.metallic < 1.0 || m.color.max_element() > 0.0)))
 }
 
-/// A shaded point's glossy reflection of the lights.
+/// A shaded point's glossy reflection of the lights, with what its lobe's formula needs
+/// of the point alone worked out once for all its lights.
 #[derive(Clone, Copy, Debug)]
 pub struct Gloss {
     /// Reflectance at normal incidence.
     pub f0: Vec3,
-    /// 1 − smoothness.
-    pub perceptual_roughness: f32,
+    /// Unit shading normal.
+    n: Vec3,
     /// Unit direction from the point towards the eye.
-    pub view: Vec3,
-    pub brdf: Brdf,
+    view: Vec3,
+    lobe: Lobe,
+}
+
+#[derive(Clone, Copy, Debug)]
+enum Lobe {
+    /// Roughness a (at least 0.002), a², n·v and n·v·(1 − a) + a, the eye's share of the
+    /// Smith-joint visibility's denominator.
+    BuiltIn {
+        a: f32,
+        a2: f32,
+        nv: f32,
+        view_term: f32,
+        gamma: bool,
+    },
+    /// Roughness² and URP's normalisation term 4r + 2.
+    Universal { r2: f32, normalization: f32 },
 }
 
 impl Gloss {
+    /// The gloss of `brdf` with reflectance `f0` and perceptual roughness (1 − smoothness)
+    /// `pr`, at unit normal `n` seen along unit `view`.
+    pub fn new(brdf: Brdf, f0: Vec3, pr: f32, n: Vec3, view: Vec3) -> Gloss {
+        let lobe = match brdf {
+            Brdf::BuiltIn { gamma } => {
+                let a = (pr * pr).max(0.002);
+                let nv = n.dot(view).abs();
+                Lobe::BuiltIn {
+                    a,
+                    a2: a * a,
+                    nv,
+                    view_term: nv * (1.0 - a) + a,
+                    gamma,
+                }
+            }
+            Brdf::Universal => {
+                // URP keeps its roughness above half precision's smallest normal values.
+                let r = (pr * pr).max(0.007_812_5);
+                Lobe::Universal {
+                    r2: (r * r).max(6.103_515_6e-5),
+                    normalization: r * 4.0 + 2.0,
+                }
+            }
+        };
+        Gloss { f0, n, view, lobe }
+    }
+
     /// Whether the surface reflects any light specularly (Unity's shaders drop the term
     /// where f0 is black).
     pub fn any(&self) -> bool {
@@ -92,27 +130,28 @@ impl Gloss {
     }
 
     /// The light reflected towards the eye per unit of a light's radiance arriving from
-    /// unit direction `l` at cosine `nl` > 0 with the unit shading normal `n`, the cosine
-    /// included.
-    pub fn highlight(&self, n: Vec3, l: Vec3, nl: f32) -> Vec3 {
-        let v = self.view;
+    /// unit direction `l` at cosine `nl` > 0 with the normal, the cosine included.
+    #[inline(always)]
+    pub fn highlight(&self, l: Vec3, nl: f32) -> Vec3 {
         // Unity's `SafeNormalize`: a light straight behind the eye gives no half vector.
-        let sum = l + v;
-        let h = sum * sum.length_squared().max(0.001).sqrt().recip();
-        let nh = n.dot(h).clamp(0.0, 1.0);
-        let lh = l.dot(h).clamp(0.0, 1.0);
-        let pr = self.perceptual_roughness;
-        match self.brdf {
-            Brdf::BuiltIn { gamma } => {
-                let a = (pr * pr).max(0.002);
-                let nv = n.dot(v).abs();
-                let lambda_v = nl * (nv * (1.0 - a) + a);
+        // The half vector is never formed: n·h and l·h are scaled dot products.
+        let sum = l + self.view;
+        let inv = sum.length_squared().max(0.001).sqrt().recip();
+        let nh = (self.n.dot(sum) * inv).clamp(0.0, 1.0);
+        let lh = (l.dot(sum) * inv).clamp(0.0, 1.0);
+        match self.lobe {
+            Lobe::BuiltIn {
+                a,
+                a2,
+                nv,
+                view_term,
+                gamma,
+            } => {
+                // V·D·π = 0.5/(λv + λl + 1e-5) · a²/(π(d² + 1e-7)) · π, in one division.
+                let lambda_v = nl * view_term;
                 let lambda_l = nv * (nl * (1.0 - a) + a);
-                let visibility = 0.5 / (lambda_v + lambda_l + 1e-5);
-                let a2 = a * a;
                 let d = (nh * a2 - nh) * nh + 1.0;
-                let ggx = a2 / (PI * (d * d + 1e-7));
-                let mut term = visibility * ggx * PI;
+                let mut term = 0.5 * a2 / ((lambda_v + lambda_l + 1e-5) * (d * d + 1e-7));
                 if gamma {
                     term = term.max(1e-4).sqrt();
                 }
@@ -120,12 +159,9 @@ impl Gloss {
                 let schlick = (1.0 - lh).powi(5);
                 (self.f0 + (Vec3::ONE - self.f0) * schlick) * term
             }
-            Brdf::Universal => {
-                // URP keeps its roughness above half precision's smallest normal values.
-                let r = (pr * pr).max(0.007_812_5);
-                let r2 = (r * r).max(6.103_515_6e-5);
+            Lobe::Universal { r2, normalization } => {
                 let d = nh * nh * (r2 - 1.0) + 1.00001;
-                let term = r2 / ((d * d) * (lh * lh).max(0.1) * (r * 4.0 + 2.0));
+                let term = r2 / ((d * d) * (lh * lh).max(0.1) * normalization);
                 self.f0 * (term * nl)
             }
         }
@@ -135,14 +171,17 @@ impl Gloss {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f32::consts::PI;
 
+    /// A gloss on a floor facing +Y.
     fn gloss(brdf: Brdf, f0: f32, smoothness: f32, view: Vec3) -> Gloss {
-        Gloss {
-            f0: Vec3::splat(f0),
-            perceptual_roughness: 1.0 - smoothness,
-            view: view.normalize(),
+        Gloss::new(
             brdf,
-        }
+            Vec3::splat(f0),
+            1.0 - smoothness,
+            Vec3::Y,
+            view.normalize(),
+        )
     }
 
     const BUILT_IN: Brdf = Brdf::BuiltIn { gamma: false };
@@ -157,7 +196,7 @@ mod tests {
             // Built-in: D = 1/(π a²), V = 0.5/(2 + 1e-5), F = f0, times π.
             let g = gloss(BUILT_IN, 0.04, smoothness, n);
             let want = 0.04 * PI * (0.5 / (2.0 + 1e-5)) * (a * a / (PI * (a.powi(4) + 1e-7)));
-            let got = g.highlight(n, n, 1.0).x;
+            let got = g.highlight(n, 1.0).x;
             assert!(
                 (got - want).abs() <= 1e-4 * want,
                 "{smoothness}: {got} vs {want}"
@@ -167,7 +206,7 @@ mod tests {
             let r2 = a * a;
             let d = r2 + 0.00001;
             let want = 0.04 * r2 / (d * d * (4.0 * a + 2.0));
-            let got = g.highlight(n, n, 1.0).x;
+            let got = g.highlight(n, 1.0).x;
             // 1.00001 + (r² − 1) loses the low digits of r² in f32.
             assert!(
                 (got - want).abs() <= 1e-3 * want,
@@ -175,7 +214,7 @@ mod tests {
             );
         }
         // Smoothness 0.5 on a dielectric: about a fifth of the diffuse white's light.
-        let urp = gloss(Brdf::Universal, 0.04, 0.5, n).highlight(n, n, 1.0).x;
+        let urp = gloss(Brdf::Universal, 0.04, 0.5, n).highlight(n, 1.0).x;
         assert!((urp - 0.2123).abs() < 1e-3, "{urp}");
     }
 
@@ -193,8 +232,8 @@ mod tests {
             (mirror, 0.8, 1.75, 1.95),
             (Vec3::new(-0.5, 1.0, 0.4), 0.5, 1.2, 1.45),
         ] {
-            let b = gloss(BUILT_IN, 0.04, smoothness, view).highlight(n, l, n.dot(l));
-            let u = gloss(Brdf::Universal, 0.04, smoothness, view).highlight(n, l, n.dot(l));
+            let b = gloss(BUILT_IN, 0.04, smoothness, view).highlight(l, n.dot(l));
+            let u = gloss(Brdf::Universal, 0.04, smoothness, view).highlight(l, n.dot(l));
             let ratio = u.x / b.x;
             assert!((low..high).contains(&ratio), "{view} {smoothness}: {ratio}");
         }
@@ -209,11 +248,11 @@ mod tests {
         let mirror = Vec3::new(-1.0, 1.0, 0.0);
         let off = Vec3::new(-1.0, 1.0, 0.6);
         for brdf in [BUILT_IN, Brdf::Universal] {
-            let peak = gloss(brdf, 0.04, 0.9, mirror).highlight(n, l, n.dot(l)).x;
-            let side = gloss(brdf, 0.04, 0.9, off).highlight(n, l, n.dot(l)).x;
+            let peak = gloss(brdf, 0.04, 0.9, mirror).highlight(l, n.dot(l)).x;
+            let side = gloss(brdf, 0.04, 0.9, off).highlight(l, n.dot(l)).x;
             assert!(side < peak * 0.05, "{brdf:?}: {side} vs {peak}");
-            let peak = gloss(brdf, 0.04, 0.0, mirror).highlight(n, l, n.dot(l)).x;
-            let side = gloss(brdf, 0.04, 0.0, off).highlight(n, l, n.dot(l)).x;
+            let peak = gloss(brdf, 0.04, 0.0, mirror).highlight(l, n.dot(l)).x;
+            let side = gloss(brdf, 0.04, 0.0, off).highlight(l, n.dot(l)).x;
             assert!(side > peak * 0.5, "{brdf:?}: {side} vs {peak}");
         }
     }
@@ -231,7 +270,7 @@ mod tests {
                 (Vec3::new(1.0, 1e-7, 0.0), Vec3::new(-1.0, -1e-7, 0.0)),
             ] {
                 let l = l.normalize();
-                let h = gloss(brdf, 1.0, 1.0, v).highlight(n, l, n.dot(l).max(1e-7));
+                let h = gloss(brdf, 1.0, 1.0, v).highlight(l, n.dot(l).max(1e-7));
                 assert!(
                     h.is_finite() && h.min_element() >= 0.0,
                     "{brdf:?} {l} {v}: {h}"
@@ -247,8 +286,8 @@ mod tests {
         let n = Vec3::Y;
         let l = Vec3::new(1.0, 0.05, 0.0).normalize();
         let v = Vec3::new(-1.0, 0.05, 0.0);
-        let dielectric = gloss(BUILT_IN, 0.04, 0.5, v).highlight(n, l, n.dot(l));
-        let metal = gloss(BUILT_IN, 1.0, 0.5, v).highlight(n, l, n.dot(l));
+        let dielectric = gloss(BUILT_IN, 0.04, 0.5, v).highlight(l, n.dot(l));
+        let metal = gloss(BUILT_IN, 1.0, 0.5, v).highlight(l, n.dot(l));
         // l·h = cos 87° ≈ 0.05: F = 0.04 + 0.96 · 0.95⁵ ≈ 0.78 of the metal's.
         let ratio = dielectric.x / metal.x;
         assert!((ratio - 0.783).abs() < 0.01, "{ratio}");
@@ -259,20 +298,20 @@ mod tests {
         let mut m = Material::unity_default();
         m.metallic = 0.5;
         m.smoothness = 0.75;
-        let g = Brdf::of(Attenuation::BuiltIn, ColorSpace::Linear).gloss(
-            &m,
-            Vec3::new(1.0, 0.0, 0.0),
-            Vec3::Y,
-        );
+        let built_in = Brdf::of(Attenuation::BuiltIn, ColorSpace::Linear);
+        let g = built_in.gloss(&m, Vec3::new(1.0, 0.0, 0.0), Vec3::Y, Vec3::Y);
         assert_eq!(g.f0, Vec3::new(0.52, 0.02, 0.02));
-        assert_eq!(g.perceptual_roughness, 0.25);
+        // Roughness (1 − 0.75)² = 1/16, so a² = 1/256 and, head-on, d = a².
+        let a2 = 1.0f32 / 256.0;
+        let want = 0.5 * a2 / ((2.0 + 1e-5) * (a2 * a2 + 1e-7));
+        let peak = g.highlight(Vec3::Y, 1.0).x / 0.52;
+        assert!((peak - want).abs() < 1e-4 * want, "{peak} vs {want}");
         let gamma = Brdf::of(Attenuation::BuiltIn, ColorSpace::Gamma);
-        assert_eq!(
-            gamma.gloss(&m, Vec3::ZERO, Vec3::Y).f0.x,
-            DIELECTRIC_GAMMA * 0.5
-        );
+        let zero = Vec3::ZERO;
+        let f0 = gamma.gloss(&m, zero, Vec3::Y, Vec3::Y).f0.x;
+        assert_eq!(f0, DIELECTRIC_GAMMA * 0.5);
         let urp = Brdf::of(Attenuation::Universal, ColorSpace::Gamma);
-        assert_eq!(urp.gloss(&m, Vec3::ZERO, Vec3::Y).f0.x, 0.02);
+        assert_eq!(urp.gloss(&m, zero, Vec3::Y, Vec3::Y).f0.x, 0.02);
         m.metallic = 1.0;
         m.color = Vec3::ZERO;
         assert!(!shows_light(&m));

@@ -123,7 +123,7 @@ impl Integrator<'_> {
         let gloss = self
             .brdf
             .filter(|_| mat.highlights && !mat.unlit)
-            .map(|brdf| brdf.gloss(mat, base, -ray.dir))
+            .map(|brdf| brdf.gloss(mat, base, ns, -ray.dir))
             .filter(Gloss::any);
         let lit = !mat.unlit && (albedo.max_element() > 0.0 || gloss.is_some());
         let mut reflectance = mat.reflectance();
