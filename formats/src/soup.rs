@@ -121,8 +121,12 @@ pub struct Material {
     pub color: Vec3,
     /// `_Metallic`, 0–1.
     pub metallic: f32,
-    /// `_Glossiness` / `_Smoothness`, 0–1.
+    /// `_Glossiness` / `_Smoothness`, 0–1; where `smoothness_in_alpha`, the scale of the
+    /// albedo map's alpha instead (`_GlossMapScale`, URP Lit's `_Smoothness`).
     pub smoothness: f32,
+    /// Smoothness is the albedo map's alpha times `smoothness` at each point (Smoothness
+    /// Source: Albedo Alpha, the `_SMOOTHNESS_TEXTURE_ALBEDO_CHANNEL_A` keyword).
+    pub smoothness_in_alpha: bool,
     /// The lights leave highlights on the surface: its shader has the Standard or Lit
     /// shaders' specular lobe (a smoothness property) and `_SpecularHighlights` is on.
     pub highlights: bool,
@@ -223,6 +227,7 @@ impl Material {
             color: Vec3::ONE,
             metallic: 0.0,
             smoothness: 0.5,
+            smoothness_in_alpha: false,
             highlights: true,
             reflectivity: None,
             emission: Vec3::ZERO,
@@ -248,13 +253,19 @@ impl Material {
 
     /// Mirror reflectance, tinted by the colour: `_Reflectivity` if set, else
     /// metallic·smoothness, so only smooth metals mirror unless a material says otherwise.
+    /// Where smoothness comes from the albedo map's alpha, this is its largest value.
     pub fn reflectance(&self) -> Vec3 {
+        self.reflectance_at(self.smoothness)
+    }
+
+    /// [`Material::reflectance`] at a point whose smoothness is `smoothness`.
+    pub fn reflectance_at(&self, smoothness: f32) -> Vec3 {
         if self.unlit {
             return Vec3::ZERO;
         }
         let r = self
             .reflectivity
-            .unwrap_or(self.metallic * self.smoothness)
+            .unwrap_or(self.metallic * smoothness)
             .clamp(0.0, 1.0);
         if self.reflectivity.is_some() {
             Vec3::splat(r)

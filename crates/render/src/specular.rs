@@ -48,13 +48,20 @@ impl Brdf {
         }
     }
 
-    /// The glossy side of a surface of `material` whose colour (times its texel) is
-    /// `base`, with unit shading normal `n`, seen along unit `view` (from the point
-    /// towards the eye).
-    pub fn gloss(self, material: &Material, base: Vec3, n: Vec3, view: Vec3) -> Gloss {
+    /// The glossy side of a point of `material` whose colour (times its texel) is `base`
+    /// and whose smoothness is `smoothness`, with unit shading normal `n`, seen along unit
+    /// `view` (from the point towards the eye).
+    pub fn gloss(
+        self,
+        material: &Material,
+        base: Vec3,
+        smoothness: f32,
+        n: Vec3,
+        view: Vec3,
+    ) -> Gloss {
         let metallic = material.metallic.clamp(0.0, 1.0);
         let f0 = Vec3::splat(self.dielectric()).lerp(base, metallic);
-        Gloss::new(self, f0, 1.0 - material.smoothness.clamp(0.0, 1.0), n, view)
+        Gloss::new(self, f0, 1.0 - smoothness.clamp(0.0, 1.0), n, view)
     }
 }
 
@@ -299,7 +306,7 @@ mod tests {
         m.metallic = 0.5;
         m.smoothness = 0.75;
         let built_in = Brdf::of(Attenuation::BuiltIn, ColorSpace::Linear);
-        let g = built_in.gloss(&m, Vec3::new(1.0, 0.0, 0.0), Vec3::Y, Vec3::Y);
+        let g = built_in.gloss(&m, Vec3::new(1.0, 0.0, 0.0), 0.75, Vec3::Y, Vec3::Y);
         assert_eq!(g.f0, Vec3::new(0.52, 0.02, 0.02));
         // Roughness (1 − 0.75)² = 1/16, so a² = 1/256 and, head-on, d = a².
         let a2 = 1.0f32 / 256.0;
@@ -308,10 +315,10 @@ mod tests {
         assert!((peak - want).abs() < 1e-4 * want, "{peak} vs {want}");
         let gamma = Brdf::of(Attenuation::BuiltIn, ColorSpace::Gamma);
         let zero = Vec3::ZERO;
-        let f0 = gamma.gloss(&m, zero, Vec3::Y, Vec3::Y).f0.x;
+        let f0 = gamma.gloss(&m, zero, 0.75, Vec3::Y, Vec3::Y).f0.x;
         assert_eq!(f0, DIELECTRIC_GAMMA * 0.5);
         let urp = Brdf::of(Attenuation::Universal, ColorSpace::Gamma);
-        assert_eq!(urp.gloss(&m, zero, Vec3::Y, Vec3::Y).f0.x, 0.02);
+        assert_eq!(urp.gloss(&m, zero, 0.75, Vec3::Y, Vec3::Y).f0.x, 0.02);
         m.metallic = 1.0;
         m.color = Vec3::ZERO;
         assert!(!shows_light(&m));

@@ -144,6 +144,10 @@ pub fn convert(body: &Node, source: &str) -> (Material, Vec<String>) {
     if let Some(x) = float("_Smoothness").or_else(|| float("_Glossiness")) {
         m.smoothness = x.clamp(0.0, 1.0);
     }
+    if let Some(scale) = smoothness_in_alpha(body, &float) {
+        m.smoothness = scale.clamp(0.0, 1.0);
+        m.smoothness_in_alpha = true;
+    }
     // Unity's Standard and Lit shaders cull back faces unless `_Cull` says otherwise.
     match float("_Cull").map(|c| c.round() as i64) {
         Some(0) => m.cull = Cull::None,
@@ -268,6 +272,22 @@ fn highlights(body: &Node, float: &dyn Fn(&str) -> Option<f32>) -> bool {
         Some(off) => !off,
         None => float("_SpecularHighlights") != Some(0.0),
     }
+}
+
+/// Where Standard or URP Lit takes smoothness from the albedo map's alpha (Smoothness
+/// Source: Albedo Alpha; the `_SMOOTHNESS_TEXTURE_ALBEDO_CHANNEL_A` keyword, or
+/// `_SmoothnessTextureChannel` 1 in a file without keywords), the scale the shader
+/// multiplies it by: Standard's `_GlossMapScale`, URP Lit's `_Smoothness` (1 where unset).
+/// A material without an albedo map reads white, alpha 1: the scale itself.
+fn smoothness_in_alpha(body: &Node, float: &dyn Fn(&str) -> Option<f32>) -> Option<f32> {
+    let scale = match shader_of(body) {
+        (Some(BUILTIN_EXTRA_GUID), Some(STANDARD | STANDARD_SPECULAR)) => "_GlossMapScale",
+        (Some(URP_LIT), _) => "_Smoothness",
+        _ => return None,
+    };
+    let on = keyword_on(body, "_SMOOTHNESS_TEXTURE_ALBEDO_CHANNEL_A")
+        .unwrap_or_else(|| float("_SmoothnessTextureChannel") == Some(1.0));
+    on.then(|| float(scale).filter(|x| x.is_finite()).unwrap_or(1.0))
 }
 
 /// How the material's shader uses alpha, from the properties its inspector writes:
@@ -774,6 +794,33 @@ mod tests {
         let (m, _) = convert(legacy.get("Material").unwrap(), "c.mat");
         assert_eq!(m.metallic, 1.0);
         assert!((m.color.x - srgb_to_linear(0.2)).abs() < 1e-7);
+    }
+
+    #[test]
+    fn smoothness_can_come_from_the_albedo_alpha() {
+        let mat = |shader: &str, keywords: &str, floats: &str| {
+            let text = format!("Material:\n  m_Shader: {shader}\n{keywords}  m_SavedProperties:\n    m_Floats:\n{floats}    m_Colors: []\n");
+            let m = convert(parse(&text).get("Material").unwrap(), "a.mat").0;
+            (m.smoothness_in_alpha, m.smoothness)
+        };
+        let standard = "{fileID: 46, guid: 0000000000000000f000000000000000, type: 0}";
+        let floats =
+            "    - _GlossMapScale: 0.5\n    - _Glossiness: 1\n    - _SmoothnessTextureChannel: 1\n";
+        let keyword = "  m_ShaderKeywords: _SMOOTHNESS_TEXTURE_ALBEDO_CHANNEL_A\n";
+        assert_eq!(mat(standard, keyword, floats), (true, 0.5));
+        // Without keyword lists the float decides; a keyword list without it says no.
+        assert_eq!(mat(standard, "", floats), (true, 0.5));
+        assert_eq!(
+            mat(standard, "  m_ShaderKeywords: _EMISSION\n", floats),
+            (false, 1.0)
+        );
+        // URP Lit scales the alpha by its _Smoothness.
+        let urp = "{fileID: 4800000, guid: 933532a4fcc9baf4fa0491de14d08ed7, type: 3}";
+        let lit = "  m_ValidKeywords:\n  - _SMOOTHNESS_TEXTURE_ALBEDO_CHANNEL_A\n";
+        assert_eq!(mat(urp, lit, "    - _Smoothness: 0.25\n"), (true, 0.25));
+        // A custom shader's keyword means what its author chose.
+        let custom = "{fileID: 4800000, guid: 0123456789abcdef0123456789abcdef, type: 3}";
+        assert_eq!(mat(custom, keyword, floats), (false, 1.0));
     }
 
     #[test]

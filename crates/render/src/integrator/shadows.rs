@@ -320,6 +320,7 @@ mod tests {
             color: Vec3::splat(0.5),
             metallic: 0.0,
             smoothness: 0.0,
+            smoothness_in_alpha: false,
             highlights: false,
             reflectivity: None,
             emission: Vec3::ZERO,

@@ -23,6 +23,7 @@ impl Integrator<'_> {
         let mut albedo = mat.albedo();
         // The colour a metal's highlight takes: colour times texel, before metallic.
         let mut base = mat.color;
+        let mut smoothness = mat.smoothness;
         let mut a = 1.0f32;
         let surfacing = self.surfacing.get(mat_index);
         // Every map of the surface is read at one UV and footprint, found at the first.
@@ -40,6 +41,9 @@ impl Integrator<'_> {
                         counts.texture_lookups += 1;
                         albedo *= texel.truncate();
                         base *= texel.truncate();
+                        if mat.smoothness_in_alpha {
+                            smoothness *= texel.w;
+                        }
                     } else {
                         counts.alpha_lookups += 1;
                     }
@@ -123,10 +127,10 @@ impl Integrator<'_> {
         let gloss = self
             .brdf
             .filter(|_| mat.highlights && !mat.unlit)
-            .map(|brdf| brdf.gloss(mat, base, ns, -ray.dir))
+            .map(|brdf| brdf.gloss(mat, base, smoothness, ns, -ray.dir))
             .filter(Gloss::any);
         let lit = !mat.unlit && (albedo.max_element() > 0.0 || gloss.is_some());
-        let mut reflectance = mat.reflectance();
+        let mut reflectance = mat.reflectance_at(smoothness);
         // The share of ambient light and reflection the occlusion map leaves (1 without
         // one: a product with 1 leaves every other pixel's bits as they were).
         let occlusion = match surfacing.and_then(|s| s.occlusion) {

@@ -194,3 +194,38 @@ fn grazing_light_on_a_smooth_metal_stays_finite() {
         .count();
     assert!(lit > 0, "the metal floor shows its highlights");
 }
+
+/// Smoothness from the albedo map's alpha (Smoothness Source: Albedo Alpha): a texel of
+/// alpha 128/255 under a scale of 1 gives the highlight of smoothness 128/255.
+#[test]
+fn smoothness_can_come_from_the_albedo_alpha() {
+    let pixel = |in_alpha: bool| {
+        let mut s = SceneBuilder::new();
+        let t = s.texture(texture(
+            1,
+            1,
+            &[[255, 255, 255, 128]],
+            formats::texture::Wrap::Repeat,
+        ));
+        let m = s.material(Material {
+            smoothness: 1.0,
+            smoothness_in_alpha: in_alpha,
+            albedo_map: Some(formats::texture::TextureRef {
+                texture: t,
+                tiling: formats::texture::Tiling::default(),
+            }),
+            ..glossy(0.0, 1.0)
+        });
+        s.floor(0.0, 0.0, 0.0, 20.0, m);
+        s.camera(top_down_camera(Vec3::new(0.0, 10.0, 0.0), 5.0));
+        s.light(directional_light(-Vec3::Y, 2.0, Shadows::Hard));
+        let (soup, kd) = s.build();
+        render(&soup, &kd, &opts(8, 8)).0.frame.pixel(4, 4)
+    };
+    let want = |smoothness: f32| 2.0 * (COLOUR + Vec3::splat(0.04 * built_in_peak(smoothness)));
+    assert_close(pixel(true), want(128.0 / 255.0), 2e-4, "alpha 128");
+    // The same material reading its smoothness of 1 as it is: Unity's floor on the
+    // roughness caps a perfect mirror's head-on peak at 10.
+    assert_close(pixel(false), want(1.0), 2e-4, "smoothness 1");
+    assert!((0.04 * built_in_peak(1.0) - 0.4).abs() < 0.01);
+}
