@@ -1018,6 +1018,7 @@ mod tests {
             ["Assets/s.unity: no enabled camera renders to the display; Unity's default camera used"]
         );
     }
+
     #[test]
     fn painted_holes_cut_their_cells_and_a_mask_of_the_wrong_size_is_said() {
         // 2×2 cells; the hole is the cell at x 1, z 0: 2–4 m along x (−2 to −4 in the

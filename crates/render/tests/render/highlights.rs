@@ -112,23 +112,15 @@ fn a_gamma_project_takes_the_square_root_of_the_specular_term() {
 
 #[test]
 fn highlights_off_leave_the_diffuse_light() {
-    let got = overhead(
-        Material {
+    let off = |metallic: f32| {
+        let m = Material {
             highlights: false,
-            ..glossy(0.0, 0.8)
-        },
-        Attenuation::BuiltIn,
-        ColorSpace::Linear,
-    );
-    assert_close(got, 2.0 * COLOUR, 1e-5, "highlights off");
-    let got = overhead(
-        Material {
-            highlights: false,
-            ..glossy(1.0, 0.8)
-        },
-        Attenuation::BuiltIn,
-        ColorSpace::Linear,
-    );
+            ..glossy(metallic, 0.8)
+        };
+        overhead(m, Attenuation::BuiltIn, ColorSpace::Linear)
+    };
+    assert_close(off(0.0), 2.0 * COLOUR, 1e-5, "highlights off");
+    let got = off(1.0);
     assert_eq!(got, Vec3::ZERO, "a metal without highlights takes no light");
 }
 
