@@ -23,8 +23,8 @@ pub use rays::{Hit, RayRecord};
 pub use sky::{Panorama, ProceduralSky, Sky, SkyImage, SkyLayout, SunDisk, TexturedSky};
 pub use soup::{
     Alpha, Ambient, AmbientMode, Attenuation, CastShadows, ClearFlags, ColorSpace, Cull,
-    Environment, Fog, FogMode, Light, LightKind, Material, NormalMap, Object, OcclusionMap,
-    ShadowDistance, Shadows, Soup, SoupGeometry, SoupKey,
+    Environment, Fog, FogMode, Light, LightKind, Material, MetallicMap, NormalMap, Object,
+    OcclusionMap, ShadowDistance, Shadows, Soup, SoupGeometry, SoupKey,
 };
 pub use texture::{Texture, TextureRef, Tiling};
 

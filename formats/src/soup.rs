@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 pub const MAGIC: &[u8; 8] = b"UTSOUP\0\0";
-pub const VERSION: u32 = 12;
+pub const VERSION: u32 = 13;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Soup {
@@ -119,7 +119,7 @@ pub struct Material {
     pub source: String,
     /// `_Color` / `_BaseColor`, linear RGB.
     pub color: Vec3,
-    /// `_Metallic`, 0–1.
+    /// `_Metallic`, 0–1 (where `metallic_map` is set, its texel's red channel instead).
     pub metallic: f32,
     /// `_Glossiness` / `_Smoothness`, 0–1; where `smoothness_in_alpha`, the scale of the
     /// albedo map's alpha instead (`_GlossMapScale`, URP Lit's `_Smoothness`).
@@ -154,6 +154,10 @@ pub struct Material {
     /// The occlusion map (`_OcclusionMap`), darkening the ambient light and the mirror
     /// reflection, tiled as the albedo map.
     pub occlusion_map: Option<OcclusionMap>,
+    /// The metallic map (`_MetallicGlossMap`), tiled as the albedo map: where set, metallic
+    /// is its texel's red channel and smoothness its alpha times the map's scale (unless
+    /// smoothness is in the albedo map's alpha), as the Standard and URP Lit shaders read it.
+    pub metallic_map: Option<MetallicMap>,
     /// An unlit shader's material (the built-in Unlit and Sprites shaders, URP Unlit): its
     /// surface shows colour·map as it is, whatever the lights and ambient, mirrors nothing
     /// and casts no shadow (those shaders have no lighting and no shadow-caster pass).
@@ -175,6 +179,16 @@ impl OcclusionMap {
     pub fn left(&self, g: f32) -> f32 {
         1.0 + (g - 1.0) * self.strength
     }
+}
+
+/// A material's metallic map: metallic is the red channel r of its texel, smoothness its
+/// alpha a times `smoothness` (the shaders' `_GlossMapScale`, URP Lit's `_Smoothness`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MetallicMap {
+    pub map: TextureRef,
+    /// The scale of the texel's alpha, 0–1; unused where smoothness is in the albedo map's
+    /// alpha, whose scale is the material's `smoothness`.
+    pub smoothness: f32,
 }
 
 /// A material's normal map: a linear texture whose red and green channels hold the
@@ -208,13 +222,23 @@ impl Material {
         self.alpha != Alpha::Opaque
     }
 
-    /// Whether the material looks anything up by UV (an albedo, normal, emission or
-    /// occlusion map).
+    /// Whether the material looks anything up by UV (an albedo, normal, emission,
+    /// occlusion or metallic map).
     pub fn reads_uvs(&self) -> bool {
         self.albedo_map.is_some()
             || self.normal_map.is_some()
             || self.emission_map.is_some()
             || self.occlusion_map.is_some()
+            || self.metallic_map.is_some()
+    }
+
+    /// The smallest metallic value anywhere on the surface: a metallic map may hold 0.
+    pub fn least_metallic(&self) -> f32 {
+        if self.metallic_map.is_some() {
+            0.0
+        } else {
+            self.metallic.clamp(0.0, 1.0)
+        }
     }
 }
 
@@ -238,34 +262,47 @@ impl Material {
             normal_map: None,
             emission_map: None,
             occlusion_map: None,
+            metallic_map: None,
             unlit: false,
         }
     }
 
     /// Lambert albedo: colour·(1 − metallic), because a metal's colour shows in its
-    /// reflection, not in diffuse light. An unlit material's is its colour: what it shows.
+    /// reflection, not in diffuse light; with a metallic map, its largest value. An unlit
+    /// material's is its colour: what it shows.
     pub fn albedo(&self) -> Vec3 {
+        self.albedo_at(self.least_metallic())
+    }
+
+    /// [`Material::albedo`] at a point whose metallic value is `metallic`.
+    pub fn albedo_at(&self, metallic: f32) -> Vec3 {
         if self.unlit {
             return self.color;
         }
-        self.color * (1.0 - self.metallic.clamp(0.0, 1.0))
+        self.color * (1.0 - metallic.clamp(0.0, 1.0))
     }
 
     /// Mirror reflectance, tinted by the colour: `_Reflectivity` if set, else
     /// metallic·smoothness, so only smooth metals mirror unless a material says otherwise.
-    /// Where smoothness comes from the albedo map's alpha, this is its largest value.
+    /// Where a map or the albedo map's alpha gives metallic or smoothness, this is its
+    /// largest value.
     pub fn reflectance(&self) -> Vec3 {
-        self.reflectance_at(self.smoothness)
+        match &self.metallic_map {
+            Some(map) if !self.smoothness_in_alpha => self.reflectance_at(1.0, map.smoothness),
+            Some(_) => self.reflectance_at(1.0, self.smoothness),
+            None => self.reflectance_at(self.metallic, self.smoothness),
+        }
     }
 
-    /// [`Material::reflectance`] at a point whose smoothness is `smoothness`.
-    pub fn reflectance_at(&self, smoothness: f32) -> Vec3 {
+    /// [`Material::reflectance`] at a point whose metallic value and smoothness are
+    /// `metallic` and `smoothness`.
+    pub fn reflectance_at(&self, metallic: f32, smoothness: f32) -> Vec3 {
         if self.unlit {
             return Vec3::ZERO;
         }
         let r = self
             .reflectivity
-            .unwrap_or(self.metallic * smoothness)
+            .unwrap_or(metallic * smoothness)
             .clamp(0.0, 1.0);
         if self.reflectivity.is_some() {
             Vec3::splat(r)
@@ -723,6 +760,14 @@ impl Soup {
                     return Err(format!("material {i} has normal map scale {}", n.scale));
                 }
             }
+            if let Some(g) = &m.metallic_map {
+                if !(0.0..=1.0).contains(&g.smoothness) {
+                    return Err(format!(
+                        "material {i} has metallic map smoothness {}",
+                        g.smoothness
+                    ));
+                }
+            }
             if let Some(o) = &m.occlusion_map {
                 if !(0.0..=1.0).contains(&o.strength) {
                     return Err(format!(
@@ -736,6 +781,7 @@ impl Soup {
                 m.normal_map.as_ref().map(|n| &n.map),
                 m.emission_map.as_ref(),
                 m.occlusion_map.as_ref().map(|o| &o.map),
+                m.metallic_map.as_ref().map(|g| &g.map),
             ];
             for r in maps.into_iter().flatten() {
                 if r.texture as usize >= self.textures.len() {

@@ -40,6 +40,13 @@ fn sample_soup() -> Soup {
             },
             strength: 0.6,
         }),
+        metallic_map: Some(MetallicMap {
+            map: TextureRef {
+                texture: 0,
+                tiling: Tiling::default(),
+            },
+            smoothness: 0.8,
+        }),
         emission_map: Some(TextureRef {
             texture: 0,
             tiling: Tiling {
@@ -139,7 +146,7 @@ fn soup_round_trips_through_a_file() {
     assert_eq!(Soup::read(&path).unwrap(), s);
     let bytes = std::fs::read(&path).unwrap();
     assert_eq!(&bytes[..8], b"UTSOUP\0\0");
-    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 12);
+    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 13);
     // Nothing but the artifact is left in the folder (the temp file was renamed).
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     // A gamma-space project's soup says so.
@@ -827,13 +834,13 @@ fn atomic_outputs_get_the_umask_permissions_not_the_temporary_files() {
 }
 
 #[test]
-fn a_version_11_soup_is_refused_with_the_versions_named() {
+fn a_version_12_soup_is_refused_with_the_versions_named() {
     let p = Path::new("old.soup");
     let mut b = sample_soup().to_bytes(p).unwrap();
-    b[8..12].copy_from_slice(&11u32.to_le_bytes());
+    b[8..12].copy_from_slice(&12u32.to_le_bytes());
     let msg = Soup::from_bytes(&b, p).unwrap_err().to_string();
     assert!(
-        msg.contains("soup format version 11, this build reads version 12"),
+        msg.contains("soup format version 12, this build reads version 13"),
         "{msg}"
     );
     assert!(msg.contains("re-run the stage that made it"), "{msg}");
@@ -916,6 +923,36 @@ fn an_unlit_material_shows_its_colour_mirrors_nothing_and_round_trips() {
     let mut s = Soup::empty();
     s.materials = vec![lit, unlit];
     assert_eq!(Soup::from_bytes(&s.to_bytes(p).unwrap(), p).unwrap(), s);
+}
+
+/// With a metallic map, metallic lies anywhere in 0–1 across the surface: the albedo's
+/// largest value is the full colour, the reflectance's is the map's smoothness scale (or,
+/// with smoothness in the albedo's alpha, the material's).
+#[test]
+fn a_metallic_map_bounds_albedo_and_reflectance_by_its_extremes() {
+    let mut m = Material {
+        color: Vec3::new(0.8, 0.4, 0.2),
+        metallic: 0.25,
+        smoothness: 0.5,
+        metallic_map: Some(MetallicMap {
+            map: TextureRef {
+                texture: 0,
+                tiling: Tiling::default(),
+            },
+            smoothness: 0.75,
+        }),
+        ..Material::unity_default()
+    };
+    assert_eq!(m.least_metallic(), 0.0);
+    assert_eq!(m.albedo(), Vec3::new(0.8, 0.4, 0.2));
+    assert_eq!(m.albedo_at(0.5), Vec3::new(0.4, 0.2, 0.1));
+    assert_eq!(m.reflectance(), Vec3::new(0.8, 0.4, 0.2) * 0.75);
+    m.smoothness_in_alpha = true;
+    assert_eq!(m.reflectance(), Vec3::new(0.4, 0.2, 0.1));
+    assert_eq!(m.reflectance_at(0.5, 0.5), Vec3::new(0.2, 0.1, 0.05));
+    m.metallic_map = None;
+    assert_eq!(m.least_metallic(), 0.25);
+    assert_eq!(m.albedo(), Vec3::new(0.6, 0.3, 0.15));
 }
 
 #[test]
@@ -1049,6 +1086,25 @@ fn an_occlusion_strength_outside_0_to_1_or_a_missing_map_is_corrupt() {
 }
 
 #[test]
+fn a_metallic_map_smoothness_outside_0_to_1_or_a_missing_map_is_corrupt() {
+    fn metal(s: &mut Soup) -> &mut MetallicMap {
+        s.materials[0].metallic_map.as_mut().unwrap()
+    }
+    refused(
+        &|s| metal(s).smoothness = -0.5,
+        "material 0 has metallic map smoothness -0.5",
+    );
+    refused(
+        &|s| metal(s).smoothness = f32::NAN,
+        "material 0 has metallic map smoothness NaN",
+    );
+    refused(
+        &|s| metal(s).map.texture = 3,
+        "material 0 names texture 3 of 1",
+    );
+}
+
+#[test]
 fn a_shadow_strength_outside_0_to_1_is_corrupt() {
     refused(
         &|s| s.lights[0].shadow_strength = 1.5,
@@ -1120,6 +1176,7 @@ fn bad_texture_references_are_corrupt() {
     s.materials[0].normal_map = None;
     s.materials[0].emission_map = None;
     s.materials[0].occlusion_map = None;
+    s.materials[0].metallic_map = None;
     s.uvs.clear();
     let p = Path::new("tex.soup");
     assert_eq!(Soup::from_bytes(&s.to_bytes(p).unwrap(), p).unwrap(), s);

@@ -36,6 +36,8 @@ pub struct RayCounts {
     pub emission_lookups: u64,
     /// Occlusion map texels read.
     pub occlusion_lookups: u64,
+    /// Metallic map texels read.
+    pub metallic_lookups: u64,
     /// Alpha lookups: cut-out tests inside the traversals and blended surfaces' alpha where
     /// no albedo lookup gave it.
     pub alpha_lookups: u64,
@@ -62,6 +64,7 @@ impl RayCounts {
         self.normal_lookups += o.normal_lookups;
         self.emission_lookups += o.emission_lookups;
         self.occlusion_lookups += o.occlusion_lookups;
+        self.metallic_lookups += o.metallic_lookups;
         self.alpha_lookups += o.alpha_lookups;
         self.fogged += o.fogged;
         self.sanitized += o.sanitized;
@@ -88,6 +91,7 @@ pub struct SharedCounts {
     normal_lookups: AtomicU64,
     emission_lookups: AtomicU64,
     occlusion_lookups: AtomicU64,
+    metallic_lookups: AtomicU64,
     alpha_lookups: AtomicU64,
     fogged: AtomicU64,
     sanitized: AtomicU64,
@@ -112,6 +116,7 @@ impl SharedCounts {
         self.emission_lookups.fetch_add(c.emission_lookups, Relaxed);
         self.occlusion_lookups
             .fetch_add(c.occlusion_lookups, Relaxed);
+        self.metallic_lookups.fetch_add(c.metallic_lookups, Relaxed);
         self.alpha_lookups.fetch_add(c.alpha_lookups, Relaxed);
         self.fogged.fetch_add(c.fogged, Relaxed);
         self.sanitized.fetch_add(c.sanitized, Relaxed);
@@ -132,6 +137,7 @@ impl SharedCounts {
             normal_lookups: self.normal_lookups.load(Relaxed),
             emission_lookups: self.emission_lookups.load(Relaxed),
             occlusion_lookups: self.occlusion_lookups.load(Relaxed),
+            metallic_lookups: self.metallic_lookups.load(Relaxed),
             alpha_lookups: self.alpha_lookups.load(Relaxed),
             fogged: self.fogged.load(Relaxed),
             sanitized: self.sanitized.load(Relaxed),

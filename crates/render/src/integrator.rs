@@ -218,6 +218,8 @@ struct Surfacing {
     emission: Option<(usize, Tiling)>,
     /// The occlusion map's sampler, tiling and strength, where the plan reads it.
     occlusion: Option<(usize, Tiling, f32)>,
+    /// The metallic map's sampler, tiling and smoothness scale, where the plan reads it.
+    metallic: Option<(usize, Tiling, f32)>,
     alpha: AlphaUse,
     opacity: f32,
 }
@@ -440,6 +442,10 @@ impl<'a> Integrator<'a> {
                         .occlusion_map
                         .filter(|o| read[o.map.texture as usize])
                         .map(|o| (o.map.texture as usize, o.map.tiling, o.strength)),
+                    metallic: m
+                        .metallic_map
+                        .filter(|g| read[g.map.texture as usize])
+                        .map(|g| (g.map.texture as usize, g.map.tiling, g.smoothness)),
                     alpha: if alpha {
                         alpha_use(m, &plan.alpha.min_alpha)
                     } else {

@@ -401,9 +401,25 @@ impl Plan {
             );
         }
 
+        // Metallic maps set how much of a surface's light is diffuse, glossy or mirrored:
+        // they show wherever it is lit or mirrors at all, and in the albedo AOV.
+        let metal_mapped: Vec<&Material> = mats
+            .iter()
+            .filter(|m| {
+                m.metallic_map.is_some()
+                    && !m.unlit
+                    && (opts.aovs.albedo
+                        || (direct.enabled && shows_light(m))
+                        || (ambient.enabled && m.albedo().max_element() > 0.0)
+                        || (reflections.enabled && mirror(m)))
+            })
+            .copied()
+            .collect();
+
         let (culling, shadow_casting) = draw_rules(soup, &used, &lights);
         // Maps read besides the albedo maps: normal maps that show, the emission maps of
-        // glowing materials, and occlusion maps where ambient light or a mirror shows them.
+        // glowing materials, occlusion maps where ambient light or a mirror shows them, and
+        // metallic maps where the surface shows light.
         let other_maps: Vec<u32> = normal_mapped
             .iter()
             .filter_map(|m| m.normal_map.map(|n| n.map.texture))
@@ -417,8 +433,19 @@ impl Plan {
                     .iter()
                     .filter_map(|m| m.occlusion_map.map(|o| o.map.texture)),
             )
+            .chain(
+                metal_mapped
+                    .iter()
+                    .filter_map(|m| m.metallic_map.map(|g| g.map.texture)),
+            )
             .collect();
-        let (textures, alpha) = texturing(soup, &mats, &other_maps, opts.texture_filter);
+        let (mut textures, alpha) = texturing(soup, &mats, &other_maps, opts.texture_filter);
+        if !metal_mapped.is_empty() {
+            textures.reason += &format!(
+                "; {} materials take metallic and smoothness from metallic maps",
+                metal_mapped.len()
+            );
+        }
 
         Plan {
             direct,

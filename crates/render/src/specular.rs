@@ -48,18 +48,11 @@ impl Brdf {
         }
     }
 
-    /// The glossy side of a point of `material` whose colour (times its texel) is `base`
-    /// and whose smoothness is `smoothness`, with unit shading normal `n`, seen along unit
-    /// `view` (from the point towards the eye).
-    pub fn gloss(
-        self,
-        material: &Material,
-        base: Vec3,
-        smoothness: f32,
-        n: Vec3,
-        view: Vec3,
-    ) -> Gloss {
-        let metallic = material.metallic.clamp(0.0, 1.0);
+    /// The glossy side of a point whose colour (times its texel) is `base` and whose
+    /// metallic value and smoothness are `metallic` and `smoothness`, with unit shading
+    /// normal `n`, seen along unit `view` (from the point towards the eye).
+    pub fn gloss(self, base: Vec3, metallic: f32, smoothness: f32, n: Vec3, view: Vec3) -> Gloss {
+        let metallic = metallic.clamp(0.0, 1.0);
         let f0 = Vec3::splat(self.dielectric()).lerp(base, metallic);
         Gloss::new(self, f0, 1.0 - smoothness.clamp(0.0, 1.0), n, view)
     }
@@ -67,11 +60,11 @@ impl Brdf {
 
 /// Whether lights can show on a material at all: its diffuse albedo is not black, or it
 /// has highlights and its specular reflectance is not black (dielectrics reflect 4 %; only
-/// a black, fully metallic surface reflects nothing). Unlit shaders take no light.
+/// a black surface fully metallic everywhere reflects nothing). Unlit shaders take no light.
 pub fn shows_light(m: &Material) -> bool {
     !m.unlit
         && (m.albedo().max_element() > 0.0
-            || (m.highlights && (m.metallic < 1.0 || m.color.max_element() > 0.0)))
+            || (m.highlights && (m.least_metallic() < 1.0 || m.color.max_element() > 0.0)))
 }
 
 /// A shaded point's glossy reflection of the lights, with what its lobe's formula needs
@@ -178,6 +171,8 @@ impl Gloss {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use formats::texture::{TextureRef, Tiling};
+    use formats::MetallicMap;
     use std::f32::consts::PI;
 
     /// A gloss on a floor facing +Y.
@@ -306,7 +301,7 @@ mod tests {
         m.metallic = 0.5;
         m.smoothness = 0.75;
         let built_in = Brdf::of(Attenuation::BuiltIn, ColorSpace::Linear);
-        let g = built_in.gloss(&m, Vec3::new(1.0, 0.0, 0.0), 0.75, Vec3::Y, Vec3::Y);
+        let g = built_in.gloss(Vec3::new(1.0, 0.0, 0.0), 0.5, 0.75, Vec3::Y, Vec3::Y);
         assert_eq!(g.f0, Vec3::new(0.52, 0.02, 0.02));
         // Roughness (1 − 0.75)² = 1/16, so a² = 1/256 and, head-on, d = a².
         let a2 = 1.0f32 / 256.0;
@@ -315,13 +310,23 @@ mod tests {
         assert!((peak - want).abs() < 1e-4 * want, "{peak} vs {want}");
         let gamma = Brdf::of(Attenuation::BuiltIn, ColorSpace::Gamma);
         let zero = Vec3::ZERO;
-        let f0 = gamma.gloss(&m, zero, 0.75, Vec3::Y, Vec3::Y).f0.x;
+        let f0 = gamma.gloss(zero, 0.5, 0.75, Vec3::Y, Vec3::Y).f0.x;
         assert_eq!(f0, DIELECTRIC_GAMMA * 0.5);
         let urp = Brdf::of(Attenuation::Universal, ColorSpace::Gamma);
-        assert_eq!(urp.gloss(&m, zero, 0.75, Vec3::Y, Vec3::Y).f0.x, 0.02);
+        assert_eq!(urp.gloss(zero, 0.5, 0.75, Vec3::Y, Vec3::Y).f0.x, 0.02);
         m.metallic = 1.0;
         m.color = Vec3::ZERO;
         assert!(!shows_light(&m));
+        // A metallic map may hold dielectric texels, which reflect 4 % of white light.
+        m.metallic_map = Some(MetallicMap {
+            map: TextureRef {
+                texture: 0,
+                tiling: Tiling::default(),
+            },
+            smoothness: 0.5,
+        });
+        assert!(shows_light(&m));
+        m.metallic_map = None;
         m.metallic = 0.99;
         assert!(shows_light(&m));
         m.highlights = false;

@@ -1,4 +1,4 @@
-//! A material's albedo, normal, emission and occlusion maps in the soup: the textures a `.mat` names,
+//! A material's albedo, normal, emission, occlusion and metallic maps in the soup: the textures a `.mat` names,
 //! or the file a model's own material names, found the way Unity's model importer finds
 //! it. Each image is decoded once per import settings and shared by every material that
 //! uses it; a texture that cannot be read leaves the material its tint alone (or without
@@ -7,17 +7,20 @@
 
 use crate::emit::Emitter;
 use crate::texture::{
-    albedo_slot, emission_slot, load, normal_slot, occlusion_slot, Import, TextureSlot,
+    albedo_slot, emission_slot, load, metallic_slot, normal_slot, occlusion_slot, Import,
+    TextureSlot,
 };
 use crate::yaml::Node;
 use formats::texture::{TextureRef, Tiling};
-use formats::{Material, NormalMap, OcclusionMap};
+use formats::{Material, MetallicMap, NormalMap, OcclusionMap};
 
 /// What a material loses with its albedo map, and with its normal map, as warnings say.
 pub(crate) const TINT_ALONE: &str = "drawn with its tint alone";
 const NO_NORMAL_MAP: &str = "drawn without its normal map";
 const EMISSION_COLOUR_ALONE: &str = "glows with its emission colour alone";
 const NO_OCCLUSION_MAP: &str = "drawn without its occlusion map";
+const NO_METALLIC_MAP: &str =
+    "drawn with its metallic and smoothness values, without its metallic map";
 use rayon::prelude::*;
 use std::path::{Component, Path, PathBuf};
 
@@ -88,6 +91,22 @@ impl Emitter<'_, '_> {
             NO_OCCLUSION_MAP,
         )?;
         Some(OcclusionMap { map, strength })
+    }
+
+    /// The metallic map of Material `body` where its shader samples one; `what` names the
+    /// material in warnings. The texture is read as imported: Unity decodes an sRGB one
+    /// before the shader reads its red channel.
+    pub(crate) fn mat_metallic(&mut self, body: &Node, what: &str) -> Option<MetallicMap> {
+        let (slot, smoothness) = metallic_slot(body)?;
+        let path = self.slot_file(&slot, what, NO_METALLIC_MAP)?;
+        let map = self.texture_ref(
+            &path,
+            Import::read(&path),
+            slot.tiling,
+            what,
+            NO_METALLIC_MAP,
+        )?;
+        Some(MetallicMap { map, smoothness })
     }
 
     /// The normal map of Material `body` where its shader samples one; `what` names the
@@ -181,6 +200,9 @@ impl Emitter<'_, '_> {
             m.occlusion_map = m
                 .occlusion_map
                 .and_then(|o| decoded(o.map).map(|map| OcclusionMap { map, ..o }));
+            m.metallic_map = m
+                .metallic_map
+                .and_then(|g| decoded(g.map).map(|map| MetallicMap { map, ..g }));
         }
         if !self.soup.materials.iter().any(Material::reads_uvs) {
             self.soup.uvs = Vec::new();

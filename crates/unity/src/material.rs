@@ -194,7 +194,7 @@ pub fn convert(body: &Node, source: &str) -> (Material, Vec<String>) {
 }
 
 /// Built-in shaders (under [`BUILTIN_EXTRA_GUID`]) by fileID.
-const STANDARD: i64 = 46;
+pub(crate) const STANDARD: i64 = 46;
 const STANDARD_SPECULAR: i64 = 45;
 const UNLIT_TRANSPARENT: i64 = 10750;
 const UNLIT_TRANSPARENT_CUTOUT: i64 = 10751;
@@ -214,7 +214,7 @@ const HDRP_LIT: &str = "6e4ae4064600d784cac1e41a9e6f2e59";
 pub(crate) const URP_UNLIT: &str = "650dd9526735d5b46b79224bc6e94025";
 
 /// The material's shader as `m_Shader` names it: its guid and fileID.
-fn shader_of(body: &Node) -> (Option<&str>, Option<i64>) {
+pub(crate) fn shader_of(body: &Node) -> (Option<&str>, Option<i64>) {
     let shader = body.get("m_Shader");
     (
         shader.and_then(|s| s.str_at("guid")),
@@ -426,11 +426,12 @@ impl Emitter<'_, '_> {
     /// in warnings).
     fn mat_maps(&mut self, m: &mut Material, body: &Node, what: &str) {
         m.albedo_map = self.mat_albedo(body, what);
-        // Unlit shaders sample no normal, emission or occlusion map.
+        // Unlit shaders sample no normal, emission, occlusion or metallic map.
         if !m.unlit {
             m.normal_map = self.mat_normal(body, what);
             m.emission_map = self.mat_emission(body, m.emission, what);
             m.occlusion_map = self.mat_occlusion(body, what);
+            m.metallic_map = self.mat_metallic(body, what);
         }
     }
 

@@ -1,4 +1,4 @@
-//! Albedo, normal and emission maps: which textures a `.mat` draws with, how their `.meta`
+//! Albedo, normal, emission, occlusion and metallic maps: which textures a `.mat` draws with, how their `.meta`
 //! TextureImporter says to import them, and decoding the image file into a [`formats::texture::Texture`] the
 //! way Unity's importer would hand it to the shader (power-of-two rounding, size limit,
 //! bottom row first).
@@ -142,6 +142,46 @@ pub fn occlusion_slot(body: &Node) -> Option<(TextureSlot, f32)> {
         .unwrap_or(1.0)
         .clamp(0.0, 1.0);
     Some((found, strength))
+}
+
+/// The metallic map of a Material body and the scale of its alpha (smoothness), where the
+/// shader reads metallic and smoothness from one: Standard's `_MetallicGlossMap` with the
+/// `_METALLICGLOSSMAP` keyword, scaled by `_GlossMapScale` (default 1), and URP Lit's in
+/// its metallic workflow with `_METALLICSPECGLOSSMAP`, scaled by `_Smoothness` (default
+/// 0.5); in a file that lists no keywords, whenever the slot holds a texture. Tiled as the
+/// albedo map. The other built-in shaders read none (Standard (Specular setup)'s
+/// `_SpecGlossMap` is a specular colour), nor does HDRP, which keeps metallic in its mask
+/// map.
+pub fn metallic_slot(body: &Node) -> Option<(TextureSlot, f32)> {
+    let (keyword, scale, default) = match crate::material::shader_of(body) {
+        (Some(BUILTIN_SHADERS), Some(crate::material::STANDARD)) => {
+            ("_METALLICGLOSSMAP", "_GlossMapScale", 1.0)
+        }
+        (Some(BUILTIN_SHADERS) | Some(HDRP_LIT), _) => return None,
+        (Some(URP_LIT), _) => {
+            let floats = props(body.get("m_SavedProperties")?, "m_Floats");
+            let specular =
+                crate::material::keyword_on(body, "_SPECULAR_SETUP").unwrap_or_else(|| {
+                    prop(&floats, "_WorkflowMode").and_then(Node::as_f32) == Some(0.0)
+                });
+            if specular {
+                return None;
+            }
+            ("_METALLICSPECGLOSSMAP", "_Smoothness", 0.5)
+        }
+        _ => ("_METALLICGLOSSMAP", "_GlossMapScale", 1.0),
+    };
+    if crate::material::keyword_on(body, keyword) == Some(false) {
+        return None;
+    }
+    let found = map_slot(body, "_MetallicGlossMap")?;
+    let floats = props(body.get("m_SavedProperties")?, "m_Floats");
+    let scale = prop(&floats, scale)
+        .and_then(Node::as_f32)
+        .filter(|x| x.is_finite())
+        .unwrap_or(default)
+        .clamp(0.0, 1.0);
+    Some((found, scale))
 }
 
 /// The texture in slot `property`, tiled by the albedo property's scale and offset (the
@@ -843,6 +883,72 @@ m_SavedProperties:
       m_Texture: {fileID: 0}
 ");
         assert_eq!(normal_slot(&empty), None);
+    }
+
+    #[test]
+    fn metallic_slot_follows_the_shader_its_keyword_and_workflow() {
+        let material = |shader: &str, keywords: &str, floats: &str| {
+            mat(&format!(
+                "m_Shader: {{{shader}, type: 0}}
+{keywords}m_SavedProperties:
+  m_TexEnvs:
+  - _MetallicGlossMap:
+      m_Texture: {{fileID: 2800000, guid: mmmm, type: 3}}
+  - _MainTex:
+      m_Texture: {{fileID: 0}}
+      m_Scale: {{x: 3, y: 1}}
+      m_Offset: {{x: 0, y: 0.5}}
+  m_Floats:
+  - _Glossiness: 0.2
+{floats}"
+            ))
+        };
+        let standard = format!("fileID: 46, guid: {BUILTIN_SHADERS}");
+        let specular = format!("fileID: 45, guid: {BUILTIN_SHADERS}");
+        let legacy = format!("fileID: 7, guid: {BUILTIN_SHADERS}");
+        let urp = format!("fileID: 4800000, guid: {URP_LIT}");
+        let hdrp = format!("fileID: 4800000, guid: {HDRP_LIT}");
+        let on = "m_ShaderKeywords: _METALLICGLOSSMAP _NORMALMAP
+";
+        let off = "m_ShaderKeywords: _NORMALMAP
+";
+        let scale = "  - _GlossMapScale: 0.6
+";
+        let (s, smoothness) = metallic_slot(&material(&standard, on, scale)).unwrap();
+        assert_eq!(
+            (s.guid.as_str(), smoothness, s.tiling.scale, s.tiling.offset),
+            ("mmmm", 0.6, [3.0, 1.0], [0.0, 0.5]),
+            "the map, _GlossMapScale and the albedo's tiling"
+        );
+        assert_eq!(metallic_slot(&material(&standard, on, "")).unwrap().1, 1.0);
+        assert!(metallic_slot(&material(&standard, "", scale)).is_some());
+        assert!(metallic_slot(&material(&standard, off, scale)).is_none());
+        // A stale slot left by an earlier shader is not read.
+        assert!(metallic_slot(&material(&specular, on, scale)).is_none());
+        assert!(metallic_slot(&material(&legacy, on, scale)).is_none());
+        assert!(metallic_slot(&material(&hdrp, on, scale)).is_none());
+        // URP Lit: its own keyword, `_Smoothness` as the scale, the metallic workflow only.
+        let urp_on = "m_ValidKeywords:
+- _METALLICSPECGLOSSMAP
+";
+        let smooth = "  - _Smoothness: 1.5
+  - _WorkflowMode: 1
+";
+        assert_eq!(
+            metallic_slot(&material(&urp, urp_on, smooth)).unwrap().1,
+            1.0
+        );
+        assert_eq!(metallic_slot(&material(&urp, urp_on, "")).unwrap().1, 0.5);
+        assert!(metallic_slot(&material(&urp, on, smooth)).is_none());
+        let urp_specular = "m_ValidKeywords:
+- _METALLICSPECGLOSSMAP
+- _SPECULAR_SETUP
+";
+        assert!(metallic_slot(&material(&urp, urp_specular, smooth)).is_none());
+        let workflow = "  - _WorkflowMode: 0
+";
+        assert!(metallic_slot(&material(&urp, "", workflow)).is_none());
+        assert!(metallic_slot(&material(&urp, "", smooth)).is_some());
     }
 
     #[test]

@@ -72,6 +72,7 @@ fn material(name: &str, color: Vec3, metallic: f32, smoothness: f32) -> Material
         normal_map: None,
         emission_map: None,
         occlusion_map: None,
+        metallic_map: None,
         unlit: false,
         albedo_map: None,
         opacity: 1.0,
@@ -256,6 +257,7 @@ pub fn checkerboard() -> Scene {
         normal_map: None,
         emission_map: None,
         occlusion_map: None,
+        metallic_map: None,
         unlit: false,
         albedo_map: Some(TextureRef {
             texture: 0,

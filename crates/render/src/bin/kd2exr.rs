@@ -307,16 +307,19 @@ fn run(a: RenderArgs) -> Result<()> {
         + c.normal_lookups
         + c.emission_lookups
         + c.occlusion_lookups
+        + c.metallic_lookups
         + c.alpha_lookups
         > 0
     {
         eprintln!(
             "kd2exr: texture lookups {}, normal-map lookups {}, emission-map lookups {}, \
-             occlusion-map lookups {}, alpha lookups {} ({:.1} MiB of mip levels)",
+             occlusion-map lookups {}, metallic-map lookups {}, alpha lookups {} \
+             ({:.1} MiB of mip levels)",
             c.texture_lookups,
             c.normal_lookups,
             c.emission_lookups,
             c.occlusion_lookups,
+            c.metallic_lookups,
             c.alpha_lookups,
             plan.textures.bytes as f64 / (1u64 << 20) as f64
         );

@@ -328,6 +328,7 @@ mod tests {
             normal_map: None,
             emission_map: None,
             occlusion_map: None,
+            metallic_map: None,
             unlit: false,
             albedo_map: None,
             opacity,

@@ -1,6 +1,6 @@
-//! A hit's surface: its material's colour, alpha, normal, emission and occlusion, each
-//! map read once at the hit's UV and the footprint of the ray's cone there, and the light
-//! it gives off whatever the lights do (emission, ambient).
+//! A hit's surface: its material's colour, alpha, metallic and smoothness, normal, emission
+//! and occlusion, each map read once at the hit's UV and the footprint of the ray's cone
+//! there, and the light it gives off whatever the lights do (emission, ambient).
 
 use super::*;
 
@@ -20,9 +20,10 @@ impl Integrator<'_> {
         let prim = hit.prim as usize;
         let mat_index = self.soup.tri_material[prim] as usize;
         let mat = &self.soup.materials[mat_index];
-        let mut albedo = mat.albedo();
         // The colour a metal's highlight takes: colour times texel, before metallic.
         let mut base = mat.color;
+        let mut texel_colour = None;
+        let mut metallic = mat.metallic;
         let mut smoothness = mat.smoothness;
         let mut a = 1.0f32;
         let surfacing = self.surfacing.get(mat_index);
@@ -39,7 +40,7 @@ impl Integrator<'_> {
                     let texel = lookup(map);
                     if s.colour {
                         counts.texture_lookups += 1;
-                        albedo *= texel.truncate();
+                        texel_colour = Some(texel.truncate());
                         base *= texel.truncate();
                         if mat.smoothness_in_alpha {
                             smoothness *= texel.w;
@@ -57,6 +58,18 @@ impl Integrator<'_> {
             if a <= 0.0 {
                 return None;
             }
+            if let Some((i, tiling, scale)) = s.metallic {
+                counts.metallic_lookups += 1;
+                let texel = lookup(&(i, tiling));
+                metallic = texel.x;
+                if !mat.smoothness_in_alpha {
+                    smoothness = scale * texel.w;
+                }
+            }
+        }
+        let mut albedo = mat.albedo_at(metallic);
+        if let Some(texel) = texel_colour {
+            albedo *= texel;
         }
 
         let tri = &self.soup.corners(prim);
@@ -127,10 +140,10 @@ impl Integrator<'_> {
         let gloss = self
             .brdf
             .filter(|_| mat.highlights && !mat.unlit)
-            .map(|brdf| brdf.gloss(mat, base, smoothness, ns, -ray.dir))
+            .map(|brdf| brdf.gloss(base, metallic, smoothness, ns, -ray.dir))
             .filter(Gloss::any);
         let lit = !mat.unlit && (albedo.max_element() > 0.0 || gloss.is_some());
-        let mut reflectance = mat.reflectance_at(smoothness);
+        let mut reflectance = mat.reflectance_at(metallic, smoothness);
         // The share of ambient light and reflection the occlusion map leaves (1 without
         // one: a product with 1 leaves every other pixel's bits as they were).
         let occlusion = match surfacing.and_then(|s| s.occlusion) {

@@ -337,6 +337,7 @@ fn the_texture_filter_is_an_option_and_lookups_are_reported() {
         normal_map: None,
         emission_map: None,
         occlusion_map: None,
+        metallic_map: None,
         unlit: false,
         albedo_map: Some(TextureRef {
             texture: t,

@@ -7,7 +7,7 @@ use formats::{Attenuation, ColorSpace, Material, Shadows};
 use glam::Vec3;
 use std::f32::consts::PI;
 
-const COLOUR: Vec3 = Vec3::new(0.8, 0.6, 0.4);
+pub(crate) const COLOUR: Vec3 = Vec3::new(0.8, 0.6, 0.4);
 
 /// The floor of `material` under a directional light of intensity 2 shining straight down,
 /// seen by an orthographic camera straight down, in a project of `pipeline` and `space`:
@@ -27,7 +27,7 @@ fn overhead(material: Material, pipeline: Attenuation, space: ColorSpace) -> Vec
     out.frame.pixel(4, 4)
 }
 
-fn glossy(metallic: f32, smoothness: f32) -> Material {
+pub(crate) fn glossy(metallic: f32, smoothness: f32) -> Material {
     Material {
         metallic,
         smoothness,
@@ -38,14 +38,14 @@ fn glossy(metallic: f32, smoothness: f32) -> Material {
 
 /// The built-in pipeline's head-on peak: D·V·π with D = 1/(π a²) (a = (1 − s)², at least
 /// 0.002) and V = 0.5/(2 + 1e-5), F = f0.
-fn built_in_peak(smoothness: f32) -> f32 {
+pub(crate) fn built_in_peak(smoothness: f32) -> f32 {
     let a = ((1.0 - smoothness) * (1.0 - smoothness)).max(0.002);
     let a2 = a * a;
     (0.5 / (2.0 + 1e-5)) * (a2 / (PI * (a2 * a2 + 1e-7))) * PI
 }
 
 /// URP's head-on peak: r²/(d²·(4r + 2)) with d = r² + 0.00001.
-fn urp_peak(smoothness: f32) -> f32 {
+pub(crate) fn urp_peak(smoothness: f32) -> f32 {
     let r = (1.0 - smoothness) * (1.0 - smoothness);
     let r2 = r * r;
     let d = r2 + 0.00001;

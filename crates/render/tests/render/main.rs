@@ -9,6 +9,7 @@ mod exr;
 mod fog;
 mod highlights;
 mod lighting;
+mod metallic;
 mod plan;
 mod robustness;
 mod textures;

@@ -351,6 +351,7 @@ fn shadow_and_mirror_rays_traced_in_blocks_equal_rays_traced_alone() {
                 normal_map: None,
                 emission_map: None,
                 occlusion_map: None,
+                metallic_map: None,
                 unlit: false,
                 albedo_map: map,
                 ..diffuse(Vec3::splat(0.6))

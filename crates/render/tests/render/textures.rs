@@ -27,6 +27,7 @@ fn mapped(t: u32, tiling: Tiling) -> Material {
         normal_map: None,
         emission_map: None,
         occlusion_map: None,
+        metallic_map: None,
         unlit: false,
         albedo_map: Some(TextureRef { texture: t, tiling }),
         ..diffuse(Vec3::ONE)
@@ -220,6 +221,7 @@ fn quad_over_lit_floor(quad: Material, tex: Option<formats::Texture>) -> SceneBu
                 normal_map: None,
                 emission_map: None,
                 occlusion_map: None,
+                metallic_map: None,
                 unlit: false,
                 albedo_map: Some(TextureRef {
                     texture: t,

@@ -179,9 +179,16 @@ fn list(report: &unity::Report) {
         let occlusion = m.occlusion_map.as_ref().map_or(String::new(), |o| {
             format!(", occlusion map {} strength {}", image(&o.map), o.strength)
         });
+        let metal = m.metallic_map.as_ref().map_or(String::new(), |g| {
+            format!(
+                ", metallic map {} smoothness {}",
+                image(&g.map),
+                g.smoothness
+            )
+        });
         let unlit = if m.unlit { ", unlit" } else { "" };
         eprintln!(
-            "material {:?} ({}): {texture}{normal}{glow}{occlusion}, opacity {}, alpha {:?}{unlit}",
+            "material {:?} ({}): {texture}{normal}{glow}{occlusion}{metal}, opacity {}, alpha {:?}{unlit}",
             m.name, m.source, m.opacity, m.alpha
         );
     }

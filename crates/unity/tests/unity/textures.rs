@@ -617,3 +617,61 @@ fn an_occlusion_map_is_read_with_its_strength() {
             .to_string()]
     );
 }
+
+/// A metallic map reaches the soup with its smoothness scale (`_GlossMapScale`) where the
+/// `_METALLICGLOSSMAP` keyword is on, sharing the decoded image with the emission map that
+/// names the same file; without the keyword it is not loaded, and a missing one is a
+/// warning that leaves the material its `_Metallic` and `_Glossiness`.
+#[test]
+fn a_metallic_map_is_read_with_its_smoothness_scale_where_its_keyword_is_on() {
+    let src = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/textures");
+    let dir = tempfile::tempdir().unwrap();
+    copy_dir(&src, dir.path());
+    let mat = dir.path().join("Assets/Materials/Glow.mat");
+    let text = std::fs::read_to_string(&mat).unwrap();
+    let quadrants = "b9c15245bb706d4c19dc7f7ee351e73a";
+    let with = |guid: &str, keyword: bool| {
+        let t = text
+            .replace(
+                "    - _MetallicGlossMap:\n        m_Texture: {fileID: 0}\n",
+                &format!(
+                    "    - _MetallicGlossMap:\n        m_Texture: {{fileID: 2800000, guid: {guid}, type: 3}}\n"
+                ),
+            )
+            .replace("    - _GlossMapScale: 1\n", "    - _GlossMapScale: 0.625\n")
+            .replace("    - _Metallic: 0\n", "    - _Metallic: 0.25\n");
+        if keyword {
+            t.replace("  - _EMISSION\n", "  - _EMISSION\n  - _METALLICGLOSSMAP\n")
+        } else {
+            t
+        }
+    };
+    let scene = dir.path().join("Assets/Scenes/EmissionMap.unity");
+    std::fs::write(&mat, with(quadrants, true)).unwrap();
+    let soup = convert(&scene);
+    assert!(soup.warnings.is_empty(), "{:?}", soup.warnings);
+    let m = &soup.materials[0];
+    let metal = m.metallic_map.expect("a metallic map");
+    assert_eq!(metal.smoothness, 0.625);
+    assert_eq!((m.metallic, m.smoothness), (0.25, 0.0));
+    assert_eq!(Some(metal.map.texture), m.emission_map.map(|r| r.texture));
+    assert_eq!(soup.textures.len(), 1);
+
+    std::fs::write(&mat, with(quadrants, false)).unwrap();
+    let soup = convert(&scene);
+    assert_eq!(soup.materials[0].metallic_map, None, "no _METALLICGLOSSMAP");
+
+    std::fs::write(&mat, with("0123456789abcdef0123456789abcdef", true)).unwrap();
+    let soup = convert(&scene);
+    assert_eq!(soup.materials[0].metallic_map, None);
+    assert_eq!(soup.materials[0].metallic, 0.25);
+    assert_eq!(
+        soup.warnings,
+        vec![
+            "Assets/Materials/Glow.mat: _MetallicGlossMap: texture GUID \
+              0123456789abcdef0123456789abcdef is not in the project; drawn with its metallic \
+              and smoothness values, without its metallic map"
+                .to_string()
+        ]
+    );
+}
