@@ -235,7 +235,7 @@ impl ExrImage {
             Ok(())
         })
         .map_err(|e| e.to_string())?;
-        Ok(out.into_inner())
+        sorted_header(out.into_inner())
     }
 
     /// Encode with the `exr` crate's own compressors (what `exrwrite` compares).
@@ -245,7 +245,7 @@ impl ExrImage {
             .write()
             .to_buffered(&mut out)
             .map_err(|e| e.to_string())?;
-        Ok(out.into_inner())
+        sorted_header(out.into_inner())
     }
 
     /// The `exr` crate's image of this one: one layer, its channels and attributes; without
@@ -319,6 +319,50 @@ fn frame_layout(frame: &Frame, half: bool) -> Vec<(&'static str, ChannelView<'_>
 }
 
 /// An encoded image written atomically, or its encoding error named with the path.
+/// The single-part file `bytes` with its header's attributes in the order of their names.
+/// The `exr` crate keeps a layer's other attributes in a hash map, whose order changes from
+/// one run to the next: without this the same render would write different bytes each
+/// time. The header keeps its length, so the offset table after it stays right.
+fn sorted_header(mut bytes: Vec<u8>) -> std::result::Result<Vec<u8>, String> {
+    const MULTIPART: u8 = 0x10;
+    if bytes.len() < 8 || bytes[5] & MULTIPART != 0 {
+        return Err("not a single-part EXR file".into());
+    }
+    let bad = || "the EXR header ends inside an attribute".to_string();
+    let mut attributes: Vec<(&[u8], &[u8])> = Vec::new();
+    let mut at = 8;
+    loop {
+        let name_end = at + bytes[at..].iter().position(|&b| b == 0).ok_or_else(bad)?;
+        if name_end == at {
+            break;
+        }
+        let type_end = name_end
+            + 1
+            + bytes[name_end + 1..]
+                .iter()
+                .position(|&b| b == 0)
+                .ok_or_else(bad)?;
+        let size: [u8; 4] = bytes
+            .get(type_end + 1..type_end + 5)
+            .ok_or_else(bad)?
+            .try_into()
+            .map_err(|_| bad())?;
+        let end = type_end + 5 + u32::from_le_bytes(size) as usize;
+        if end > bytes.len() {
+            return Err(bad());
+        }
+        attributes.push((&bytes[at..name_end], &bytes[at..end]));
+        at = end;
+    }
+    attributes.sort_by_key(|&(name, _)| name);
+    let header: Vec<u8> = attributes
+        .iter()
+        .flat_map(|&(_, a)| a.iter().copied())
+        .collect();
+    bytes[8..8 + header.len()].copy_from_slice(&header);
+    Ok(bytes)
+}
+
 fn write_encoded(
     path: &Path,
     encoded: std::result::Result<Vec<u8>, String>,
@@ -822,6 +866,40 @@ pub(crate) mod tests {
             ],
             attributes: BTreeMap::from([(format!("{ATTR_PREFIX}spp"), "1".to_string())]),
         }
+    }
+
+    /// The same image gives the same bytes every time, its attributes in name order,
+    /// whatever order the `exr` crate's map hands them out in; and it reads back whole.
+    #[test]
+    fn encoding_is_deterministic_with_the_attributes_in_name_order() {
+        let mut image = encodable(false);
+        image.attributes = (0..24)
+            .map(|i| (format!("{ATTR_PREFIX}k{:02}", 23 - i), "v".repeat(i)))
+            .collect();
+        let first = image.encode().unwrap();
+        for _ in 0..4 {
+            assert!(image.encode().unwrap() == first);
+            assert!(image.encode_with(Encoding::SMALL_LOSSLESS).unwrap()[..200] == first[..200]);
+        }
+        let text = String::from_utf8_lossy(&first);
+        let at: Vec<usize> = (0..24)
+            .map(|i| text.find(&format!("{ATTR_PREFIX}k{i:02}")).unwrap())
+            .collect();
+        assert!(at.windows(2).all(|w| w[0] < w[1]), "{at:?}");
+        for name in ["channels", "compression", "dataWindow", "software"] {
+            assert!(
+                text.find(name).unwrap() < at[0],
+                "{name} before unitrace.k00"
+            );
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("sorted.exr");
+        std::fs::write(&path, &first).unwrap();
+        let back = ExrImage::read(&path).unwrap();
+        assert_eq!(back.attributes, image.attributes);
+        assert_eq!(back.channels, image.channels);
+        assert!(sorted_header(vec![0x76, 0x2f, 0x31, 0x01, 2, 0x10, 0, 0]).is_err());
+        assert!(sorted_header(first[..60].to_vec()).is_err());
     }
 
     #[test]
