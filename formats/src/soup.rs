@@ -127,8 +127,13 @@ pub struct Material {
     /// Smoothness is the albedo map's alpha times `smoothness` at each point (Smoothness
     /// Source: Albedo Alpha, the `_SMOOTHNESS_TEXTURE_ALBEDO_CHANNEL_A` keyword).
     pub smoothness_in_alpha: bool,
-    /// The lights leave highlights on the surface: its shader has the Standard or Lit
-    /// shaders' specular lobe (a smoothness property) and `_SpecularHighlights` is on.
+    /// The surface is lit by Unity's physically based shading (the Standard and Lit
+    /// shaders, and other shaders with their smoothness property): its diffuse light is
+    /// (1 − the dielectric reflectance) of its albedo, and in the built-in pipeline
+    /// Disney's. Else (the legacy, mobile and Tree Creator shaders) it is Lambert's.
+    pub pbs: bool,
+    /// The lights leave highlights on the surface: it is `pbs` and `_SpecularHighlights`
+    /// is on.
     pub highlights: bool,
     /// `_Reflectivity` when the material sets it: overrides metallic·smoothness.
     pub reflectivity: Option<f32>,
@@ -252,6 +257,7 @@ impl Material {
             metallic: 0.0,
             smoothness: 0.5,
             smoothness_in_alpha: false,
+            pbs: true,
             highlights: true,
             reflectivity: None,
             emission: Vec3::ZERO,

@@ -874,13 +874,14 @@ fn draw_rule_fields_are_encoded_in_unitys_numbering() {
     assert_eq!(payload[o], 7);
     assert_eq!(&payload[o + 1..o + 5], &2u32.to_le_bytes(), "TwoSided is 2");
     assert_eq!(payload[o + 5], 0);
-    // Material: colour, metallic, smoothness, smoothness_in_alpha and highlights (a bool
-    // byte each), reflectivity (None: one byte), the 12-byte emission, then cull (u32
+    // Material: colour, metallic, smoothness, smoothness_in_alpha, pbs and highlights (a
+    // bool byte each), reflectivity (None: one byte), the 12-byte emission, then cull (u32
     // variant).
     let m = find(b"builtin:Default-Material") + "builtin:Default-Material".len();
     assert_eq!(payload[m + 12 + 4 + 4], 0, "smoothness from _Glossiness");
-    assert_eq!(payload[m + 12 + 4 + 4 + 1], 1, "highlights on");
-    let cull = m + 12 + 4 + 4 + 1 + 1 + 1 + 12;
+    assert_eq!(payload[m + 12 + 4 + 4 + 1], 1, "physically based");
+    assert_eq!(payload[m + 12 + 4 + 4 + 2], 1, "highlights on");
+    let cull = m + 12 + 4 + 4 + 1 + 1 + 1 + 1 + 12;
     assert_eq!(&payload[cull..cull + 4], &1u32.to_le_bytes(), "Front is 1");
     assert_eq!(Soup::from_bytes(&b, p).unwrap(), s);
 }

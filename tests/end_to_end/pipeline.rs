@@ -14,7 +14,7 @@ use scenegen::material::MatDesc;
 use scenegen::unity::{Ambient, CameraDesc, LightDesc, Xform, PLANE, QUAD};
 use std::f32::consts::PI;
 use std::path::Path;
-use unitrace::{run_ok, Rgba};
+use unitrace::{run_ok, unity_diffuse, Rgba};
 
 const SIZE: u32 = 100;
 
@@ -178,13 +178,16 @@ fn unity_scene_through_the_three_binaries_gives_the_known_pixels() {
     let light = &soup.lights[0];
     // The soup is right-handed: Unity's X is negated, so Unity (x, y, z) is (−x, y, z) there.
     assert_eq!(light.position, Vec3::new(2.0, 2.0, 0.0));
-    assert!(grey.highlights, "the Standard shader draws highlights");
+    assert!(
+        grey.pbs && grey.highlights,
+        "the Standard shader draws highlights"
+    );
     // The orthographic camera looks straight down: every floor point is seen from above.
     let lit = |ux: f32, uz: f32| {
         let to = light.position - Vec3::new(-ux, 0.0, uz);
         let d = to.length();
         let l = to / d;
-        let reflected = grey.albedo() * l.y
+        let reflected = grey.albedo() * unity_diffuse(Vec3::Y, l, Vec3::Y, grey.smoothness)
             + Vec3::splat(unity_highlight(Vec3::Y, l, Vec3::Y, grey.smoothness));
         reflected * light.color * light.intensity * unity_falloff(d, light.range)
     };

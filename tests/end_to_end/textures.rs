@@ -2,14 +2,22 @@
 //! (written by `scenegen`): each scene is a Quad whose every pixel follows from a texel.
 //!
 //! Every scene is lit by one white directional light of intensity 1 and has no ambient
-//! light, so a lit pixel is texel · tint · cos(angle of incidence). The Quads face the
-//! camera; image x grows to the right and y downwards.
+//! light, so a lit pixel is texel · tint times the Standard shader's diffuse term (smoothness
+//! 0, Specular Highlights off). The Quads face the camera; image x grows to the right and y
+//! downwards.
 
 use glam::Vec3;
 use std::path::Path;
-use unitrace::{repo, run_ok, Rgba};
+use unitrace::{repo, run_ok, unity_diffuse, Rgba};
 
 const SIDE: usize = 64;
+
+/// The diffuse term of a Quad facing the camera (−Z in Unity) under the sun turned `deg`
+/// about Y from shining straight at it: Unity's, with n·l = cos `deg`.
+fn sun_at(deg: f32) -> f32 {
+    let (s, c) = deg.to_radians().sin_cos();
+    unity_diffuse(Vec3::NEG_Z, Vec3::new(-s, 0.0, -c), Vec3::NEG_Z, 0.0)
+}
 
 /// Unity's sRGB → linear decoding.
 fn linear(c: f32) -> f32 {
@@ -77,10 +85,13 @@ fn the_quadrant_texture_is_upright_and_not_mirrored() {
     let f = render(dir.path(), "Quadrants");
     // The image file's top-left texel is red, top-right green, bottom-left blue,
     // bottom-right white: the render shows them in the same corners.
-    assert_close(f.rgb(8, 8), Vec3::X, "top left");
-    assert_close(f.rgb(56, 8), Vec3::Y, "top right");
-    assert_close(f.rgb(8, 56), Vec3::Z, "bottom left");
-    assert_close(f.rgb(56, 56), Vec3::ONE, "bottom right");
+    // Head-on, the diffuse term is the 96 % a dielectric does not reflect.
+    let lit = sun_at(0.0);
+    assert!((lit - 0.96).abs() < 1e-6, "{lit}");
+    assert_close(f.rgb(8, 8), Vec3::X * lit, "top left");
+    assert_close(f.rgb(56, 8), Vec3::Y * lit, "top right");
+    assert_close(f.rgb(8, 56), Vec3::Z * lit, "bottom left");
+    assert_close(f.rgb(56, 56), Vec3::ONE * lit, "bottom right");
     assert_eq!(f.json["plan"]["textures"]["enabled"], true, "{}", f.json);
 }
 
@@ -88,8 +99,9 @@ fn the_quadrant_texture_is_upright_and_not_mirrored() {
 fn a_mid_grey_srgb_texel_is_0_2158_linear() {
     let dir = tempfile::tempdir().unwrap();
     let f = render(dir.path(), "Grey");
-    let want = Vec3::splat(linear(128.0 / 255.0));
-    assert!((want.x - 0.2158).abs() < 1e-4);
+    let texel = linear(128.0 / 255.0);
+    assert!((texel - 0.2158).abs() < 1e-4);
+    let want = Vec3::splat(texel * sun_at(0.0));
     for (x, y) in [(0, 0), (31, 31), (63, 0), (10, 50), (63, 63)] {
         assert_close(f.rgb(x, y), want, &format!("pixel ({x}, {y})"));
     }
@@ -107,6 +119,7 @@ fn tiling_and_offset_land_where_unity_puts_them() {
         } else {
             (Vec3::X, Vec3::Z)
         };
+        let (top, bottom) = (top * sun_at(0.0), bottom * sun_at(0.0));
         assert_close(f.rgb(col, 8), top, &format!("column {col}, top"));
         assert_close(f.rgb(col, 56), bottom, &format!("column {col}, bottom"));
     }
@@ -116,8 +129,9 @@ fn tiling_and_offset_land_where_unity_puts_them() {
 fn a_cut_out_shows_the_wall_and_casts_a_cut_out_shadow() {
     let dir = tempfile::tempdir().unwrap();
     let f = render(dir.path(), "Cutout");
-    // The sun is turned 25° about Y, so every lit surface facing the camera gets cos 25°.
-    let cos = 25f32.to_radians().cos();
+    // The sun is turned 25° about Y, so every lit surface facing the camera gets n·l =
+    // cos 25°.
+    let cos = sun_at(25.0);
     // The wall's `_Color` is 0.75 grey; the cut-out's texels are sRGB (255, 200, 0).
     let wall = Vec3::splat(linear(0.75)) * cos;
     let quad = Vec3::new(1.0, linear(200.0 / 255.0), 0.0) * cos;
@@ -149,8 +163,8 @@ fn a_cut_out_shows_the_wall_and_casts_a_cut_out_shadow() {
 fn a_transparent_quad_blends_half_its_colour_and_half_a_shadow() {
     let dir = tempfile::tempdir().unwrap();
     let f = render(dir.path(), "Transparent");
-    let wall = Vec3::splat(linear(0.75));
-    let red = Vec3::X;
+    let wall = Vec3::splat(linear(0.75)) * sun_at(0.0);
+    let red = Vec3::X * sun_at(0.0);
     // In the middle the camera sees the wall through the quad where the quad also stands
     // between the wall and the light: half the quad's colour, half the wall in half light.
     assert_close(f.rgb(32, 32), red * 0.5 + wall * 0.25, "centre");
@@ -169,8 +183,14 @@ fn the_normal_map_bends_the_normal_towards_increasing_u_as_in_unity() {
     let z = (1.0f32 - x * x - y * y).sqrt();
     let cos = 0.5 * x + 30f32.to_radians().cos() * z;
     assert!((cos - 0.9928).abs() < 1e-4, "{cos}");
+    // In the Quad's frame (u, v, its normal towards the camera): the bent normal, the sun
+    // and the eye. The eye sees the bent normal at n·v = z.
+    let n = Vec3::new(x, y, z);
+    let sun = Vec3::new(0.5, 0.0, 30f32.to_radians().cos());
+    assert!((n.dot(sun) - cos).abs() < 1e-6);
+    let lit = unity_diffuse(n, sun, Vec3::Z, 0.0);
     for (px, py) in [(0, 0), (8, 40), (32, 32), (63, 63)] {
-        assert_close(f.rgb(px, py), Vec3::splat(cos), "bent");
+        assert_close(f.rgb(px, py), Vec3::splat(lit), "bent");
     }
     // Unmapped, the Quad would take cos 30° = 0.866; mirrored, 0.393.
     assert_eq!(f.json["plan"]["normal_maps"]["enabled"], true, "{}", f.json);

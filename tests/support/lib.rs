@@ -99,6 +99,20 @@ where
     r
 }
 
+/// The built-in Standard shader's diffuse term per unit of albedo and of a light's radiance,
+/// the cosine included, written out again from Unity's shader source (`BRDF1_Unity_PBS`):
+/// the share a dielectric does not reflect (`OneMinusReflectivityFromMetallic`, 1 − 0.04,
+/// a linear project) times `DisneyDiffuse` times n·l; unit vectors towards the light `l`
+/// and the eye `v`, normal `n`.
+pub fn unity_diffuse(n: glam::Vec3, l: glam::Vec3, v: glam::Vec3, smoothness: f32) -> f32 {
+    let h = (l + v).normalize();
+    let (nl, nv, lh) = (n.dot(l), n.dot(v).abs(), l.dot(h));
+    let fd90 = 0.5 + 2.0 * lh * lh * (1.0 - smoothness);
+    let light_scatter = 1.0 + (fd90 - 1.0) * (1.0 - nl).powi(5);
+    let view_scatter = 1.0 + (fd90 - 1.0) * (1.0 - nv).powi(5);
+    0.96 * light_scatter * view_scatter * nl
+}
+
 /// Run a binary and require exit code 0, showing its stderr otherwise.
 pub fn run_ok<I, S>(name: &str, args: I) -> Run
 where

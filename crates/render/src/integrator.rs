@@ -1,16 +1,20 @@
 //! Whitted ray tracing, driven by the effects plan:
 //!
 //! ```text
-//! L = emission + ambient(n)·albedo
-//!   + Σ_lights visible · falloff · intensity·colour · (max(0, n·l) · albedo + highlight)
+//! L = emission + ambient(n)·diffuse colour
+//!   + Σ_lights visible · falloff · intensity·colour · (max(0, n·l) · diffuse colour · shape
+//!     + highlight)
 //!   + reflectance · L(mirror ray)        while bounce < depth and weight ≥ cutoff
 //! ```
 //!
 //! n is the interpolated shading normal turned to face the incoming ray; the geometric
 //! normal decides which side a secondary ray leaves from (see [`crate::offset`]).
 //!
-//! The highlight is the specular term of the scene's pipeline's shader for a punctual light
-//! (see [`crate::specular`]).
+//! For a physically based material the diffuse colour is the albedo times the share its
+//! shader lights as diffuse, the shape 1 (URP) or the built-in pipeline's Disney term, and
+//! the highlight the specular term of the pipeline's shader for a punctual light (see
+//! [`crate::brdf`]); otherwise the diffuse colour is the albedo, the shape 1 and there is
+//! no highlight.
 //!
 //! Albedo is colour·texel·(1 − metallic) where the material has a map and the plan turns
 //! textures on: the texel is looked up at the hit's interpolated UV through the material's
@@ -30,6 +34,7 @@
 //! `visibility`, and how much of a light reaches a point in `shadows`.
 
 use crate::alpha::{alpha_use, AlphaUse};
+use crate::brdf::{Brdf, Diffuse, Gloss};
 use crate::cone::RayCone;
 use crate::counters::RayCounts;
 use crate::environment;
@@ -43,12 +48,11 @@ use crate::plan::{colour_mapped, Plan, ShadowMode};
 use crate::sampling::{DiscSpiral, Rng};
 use crate::sky::{SkyAmbient, Skybox};
 use crate::soft::{probe_asked, probe_fits, SoftCone};
-use crate::specular::{Brdf, Gloss};
 use crate::tangents::Tangents;
 use crate::texture::{cone_footprint, Sampler};
 use crate::RenderOptions;
 use crate::TextureFilter;
-use formats::{AmbientMode, CastShadows, ClearFlags, Hit, Light, Soup, Tiling};
+use formats::{AmbientMode, Attenuation, CastShadows, ClearFlags, Hit, Light, Soup, Tiling};
 use glam::{Vec2, Vec3, Vec4};
 use kdtree::triangle::RayPre;
 use kdtree::{Accel, Ray, LANES};
@@ -118,7 +122,11 @@ struct Lit {
     l: Vec3,
     /// The surface's α.
     a: f32,
+    /// The colour its diffuse term lights: the albedo, times the diffuse share of a
+    /// physically based material.
     albedo: Vec3,
+    /// The shape of its diffuse term.
+    diffuse: Diffuse,
     /// The glossy side of the surface, where it reflects the lights' highlights.
     gloss: Option<Gloss>,
     /// The albedo or the gloss is not black, so lights can show.
@@ -146,7 +154,7 @@ impl Lit {
             visible
         };
         if visible > 0.0 {
-            let mut reflected = self.albedo * cos;
+            let mut reflected = self.albedo * (cos * self.diffuse.scale(inc.dir, cos));
             if let Some(g) = &self.gloss {
                 reflected += g.highlight(inc.dir, cos);
             }
@@ -333,8 +341,8 @@ pub struct Integrator<'a> {
     tangents: Option<Tangents<'a>>,
     /// How shadows fade out with distance from the camera, where the pipeline limits it.
     shadow_fade: Option<ShadowFade>,
-    /// The pipeline's specular formula, where some light is on.
-    brdf: Option<Brdf>,
+    /// The pipeline's formulas for physically based materials.
+    brdf: Brdf,
 }
 
 /// [`Integrator::sides`] bits: camera and reflection rays that meet the triangle's front
@@ -410,9 +418,13 @@ impl<'a> Integrator<'a> {
             })
             .collect();
         let shadow_fade = ShadowFade::of(soup, &lights);
-        let brdf = lights
+        // A scene's lights all follow its pipeline; one without lights is shaded as the
+        // built-in pipeline would (only its ambient light's diffuse share depends on it).
+        let pipeline = soup
+            .lights
             .first()
-            .map(|al| Brdf::of(al.light.attenuation, soup.environment.color_space));
+            .map_or(Attenuation::BuiltIn, |l| l.attenuation);
+        let brdf = Brdf::of(pipeline, soup.environment.color_space);
         let textures = plan.textures.enabled;
         let alpha = plan.alpha.enabled;
         let read = &plan.textures.read;

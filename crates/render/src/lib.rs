@@ -18,6 +18,7 @@
 
 pub mod alpha;
 pub mod aov;
+pub mod brdf;
 pub mod camera;
 pub mod cone;
 pub mod counters;
@@ -40,7 +41,6 @@ pub mod sampling;
 pub mod sky;
 pub mod sky_image;
 mod soft;
-pub mod specular;
 pub mod tangents;
 pub mod texture;
 

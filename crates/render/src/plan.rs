@@ -3,7 +3,7 @@
 //! never traced; it is printed, stored in the EXR header and returned in `--json`.
 
 use crate::alpha::{alpha_use, min_alphas, AlphaUse};
-use crate::specular::shows_light;
+use crate::brdf::shows_light;
 use crate::{RenderOptions, TextureFilter};
 use formats::{
     AmbientMode, Attenuation, CastShadows, ClearFlags, Cull, Fog, FogMode, LightKind, Material,

@@ -155,7 +155,8 @@ pub fn convert(body: &Node, source: &str) -> (Material, Vec<String>) {
         _ => {}
     }
     m.alpha = alpha_mode(body, &float);
-    m.highlights = highlights(body, &float);
+    m.pbs = pbs(body, &float);
+    m.highlights = m.pbs && highlights_on(body, &float);
     if let Some(x) = float("_Reflectivity") {
         m.reflectivity = Some(x.clamp(0.0, 1.0));
     }
@@ -172,6 +173,7 @@ pub fn convert(body: &Node, source: &str) -> (Material, Vec<String>) {
         m.unlit = true;
         m.metallic = 0.0;
         m.smoothness = 0.0;
+        m.pbs = false;
         m.highlights = false;
         m.reflectivity = None;
         m.emission = Vec3::ZERO;
@@ -253,21 +255,24 @@ pub(crate) fn unlit_shader(body: &Node) -> Option<Unlit> {
     })
 }
 
-/// Whether the material's shader draws the lights' specular highlights: it has the
-/// Standard or Lit shaders' smoothness (`_Glossiness`, `_Smoothness`), is not one of the
-/// other built-in shaders (legacy, mobile, Tree Creator: Lambert or Blinn-Phong, not
-/// modelled), and its Specular Highlights switch is on: the `_SPECULARHIGHLIGHTS_OFF`
-/// keyword, which the shaders compile by, or `_SpecularHighlights` in a file without
-/// keywords.
-fn highlights(body: &Node, float: &dyn Fn(&str) -> Option<f32>) -> bool {
+/// Whether the material's shader is physically based: it has the Standard or Lit shaders'
+/// smoothness (`_Glossiness`, `_Smoothness`) and is not one of the other built-in shaders
+/// (legacy, mobile, Tree Creator: Lambert diffuse, and Blinn-Phong highlights that are not
+/// modelled).
+fn pbs(body: &Node, float: &dyn Fn(&str) -> Option<f32>) -> bool {
     if float("_Glossiness").is_none() && float("_Smoothness").is_none() {
         return false;
     }
-    if let (Some(BUILTIN_EXTRA_GUID), Some(id)) = shader_of(body) {
-        if id != STANDARD && id != STANDARD_SPECULAR {
-            return false;
-        }
+    match shader_of(body) {
+        (Some(BUILTIN_EXTRA_GUID), Some(id)) => id == STANDARD || id == STANDARD_SPECULAR,
+        _ => true,
     }
+}
+
+/// Whether a physically based shader's Specular Highlights switch is on: the
+/// `_SPECULARHIGHLIGHTS_OFF` keyword, which the shaders compile by, or `_SpecularHighlights`
+/// in a file without keywords.
+fn highlights_on(body: &Node, float: &dyn Fn(&str) -> Option<f32>) -> bool {
     match keyword_on(body, "_SPECULARHIGHLIGHTS_OFF") {
         Some(off) => !off,
         None => float("_SpecularHighlights") != Some(0.0),
@@ -826,12 +831,19 @@ mod tests {
 
     #[test]
     fn highlights_follow_the_shader_and_its_switch() {
-        let mat = |shader: i64, keywords: &str, floats: &str| {
+        let converted = |shader: i64, keywords: &str, floats: &str| {
             let text = format!("Material:\n  m_Shader: {{fileID: {shader}, guid: 0000000000000000f000000000000000, type: 0}}\n{keywords}  m_SavedProperties:\n    m_Floats:\n{floats}    m_Colors: []\n");
-            convert(parse(&text).get("Material").unwrap(), "a.mat")
-                .0
-                .highlights
+            convert(parse(&text).get("Material").unwrap(), "a.mat").0
         };
+        let mat = |shader: i64, keywords: &str, floats: &str| {
+            let m = converted(shader, keywords, floats);
+            assert!(
+                m.pbs || !m.highlights,
+                "highlights only on physically based shaders"
+            );
+            m.highlights
+        };
+        let pbs = |shader: i64, floats: &str| converted(shader, "", floats).pbs;
         let glossy = "    - _Glossiness: 0.5\n";
         // Standard and Standard (Specular setup), with their switch on, off by keyword, and
         // off by the float where the file lists no keywords.
@@ -849,14 +861,21 @@ mod tests {
         ));
         let off = "    - _Glossiness: 0.5\n    - _SpecularHighlights: 0\n";
         assert!(!mat(46, "", off));
+        assert!(
+            pbs(46, off),
+            "the switch leaves the diffuse term physically based"
+        );
         // The keyword list is what the shader compiles by: a stale float does not count.
         assert!(mat(46, "  m_ShaderKeywords: _EMISSION\n", off));
         // Legacy Diffuse keeps a stale smoothness from a Standard past; no smoothness at
         // all means a shader without the lobe.
         assert!(!mat(7, "", glossy));
+        assert!(!pbs(7, glossy), "Legacy Diffuse is Lambert's");
         assert!(!mat(46, "", "    - _Metallic: 0\n"));
         // An unlit shader has no lights to reflect.
         assert!(!mat(10752, "", glossy));
+        assert!(!pbs(10752, glossy));
+        assert!(pbs(45, glossy));
         // URP Lit (a project shader, by GUID) with its smoothness.
         let urp = parse("Material:\n  m_Shader: {fileID: 4800000, guid: 933532a4fcc9baf4fa0491de14d08ed7, type: 3}\n  m_ValidKeywords: []\n  m_SavedProperties:\n    m_Floats:\n    - _Smoothness: 0.5\n    - _SpecularHighlights: 1\n");
         assert!(convert(urp.get("Material").unwrap(), "u.mat").0.highlights);

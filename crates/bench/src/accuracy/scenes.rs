@@ -64,6 +64,7 @@ fn material(name: &str, color: Vec3, metallic: f32, smoothness: f32) -> Material
         smoothness,
         // The analytic references are diffuse.
         smoothness_in_alpha: false,
+        pbs: false,
         highlights: false,
         reflectivity: None,
         emission: Vec3::ZERO,

@@ -321,6 +321,7 @@ mod tests {
             metallic: 0.0,
             smoothness: 0.0,
             smoothness_in_alpha: false,
+            pbs: false,
             highlights: false,
             reflectivity: None,
             emission: Vec3::ZERO,

@@ -137,12 +137,23 @@ impl Integrator<'_> {
         if mat.unlit {
             l += albedo;
         }
-        let gloss = self
-            .brdf
-            .filter(|_| mat.highlights && !mat.unlit)
+        let pbs = mat.pbs && !mat.unlit;
+        let gloss = Some(self.brdf)
+            .filter(|_| pbs && mat.highlights && !self.lights.is_empty())
             .map(|brdf| brdf.gloss(base, metallic, smoothness, ns, -ray.dir))
             .filter(Gloss::any);
         let lit = !mat.unlit && (albedo.max_element() > 0.0 || gloss.is_some());
+        // What the diffuse term lights (the AOV keeps the albedo).
+        let diffuse_colour = if pbs {
+            albedo * self.brdf.diffuse_share()
+        } else {
+            albedo
+        };
+        let diffuse = if pbs && !self.lights.is_empty() {
+            self.brdf.diffuse(smoothness, ns, -ray.dir)
+        } else {
+            Diffuse::Lambert
+        };
         let mut reflectance = mat.reflectance_at(metallic, smoothness);
         // The share of ambient light and reflection the occlusion map leaves (1 without
         // one: a product with 1 leaves every other pixel's bits as they were).
@@ -162,13 +173,14 @@ impl Integrator<'_> {
                 Some(sky) => sky.at(ns),
                 None => environment::ambient(&self.soup.environment, ns),
             };
-            l += ambient * albedo * occlusion;
+            l += ambient * diffuse_colour * occlusion;
         }
         Some(Lit {
             fade: self.shadow_fade.map_or(0.0, |f| f.at(surf.p)),
             l,
             a,
-            albedo,
+            albedo: diffuse_colour,
+            diffuse,
             gloss,
             lit,
             surf,

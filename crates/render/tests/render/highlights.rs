@@ -8,6 +8,11 @@ use glam::Vec3;
 use std::f32::consts::PI;
 
 pub(crate) const COLOUR: Vec3 = Vec3::new(0.8, 0.6, 0.4);
+/// The share of its albedo a physically based shader lights as diffuse in a linear project
+/// (1 − 0.04), and in a built-in gamma one (1 − 0.2209). Head-on the built-in pipeline's
+/// Disney term is 1.
+pub(crate) const DIFFUSE: f32 = 0.96;
+const DIFFUSE_GAMMA: f32 = 1.0 - 0.220_916_3;
 
 /// The floor of `material` under a directional light of intensity 2 shining straight down,
 /// seen by an orthographic camera straight down, in a project of `pipeline` and `space`:
@@ -31,6 +36,7 @@ pub(crate) fn glossy(metallic: f32, smoothness: f32) -> Material {
     Material {
         metallic,
         smoothness,
+        pbs: true,
         highlights: true,
         ..diffuse(COLOUR)
     }
@@ -60,7 +66,7 @@ fn a_dielectric_shows_its_diffuse_light_and_a_four_percent_highlight() {
             Attenuation::BuiltIn,
             ColorSpace::Linear,
         );
-        let want = 2.0 * (COLOUR + Vec3::splat(0.04 * built_in_peak(smoothness)));
+        let want = 2.0 * (COLOUR * DIFFUSE + Vec3::splat(0.04 * built_in_peak(smoothness)));
         assert_close(
             got,
             want,
@@ -72,7 +78,7 @@ fn a_dielectric_shows_its_diffuse_light_and_a_four_percent_highlight() {
             Attenuation::Universal,
             ColorSpace::Linear,
         );
-        let want = 2.0 * (COLOUR + Vec3::splat(0.04 * urp_peak(smoothness)));
+        let want = 2.0 * (COLOUR * DIFFUSE + Vec3::splat(0.04 * urp_peak(smoothness)));
         assert_close(got, want, 2e-3, &format!("URP, smoothness {smoothness}"));
     }
     // Smoothness 0.5 adds about a fifth (built-in) or a quarter (URP) of white's light.
@@ -94,7 +100,7 @@ fn a_metal_shows_its_colour_in_the_highlight_alone() {
     let f0 = Vec3::splat(0.02) + COLOUR * 0.5;
     assert_close(
         half,
-        2.0 * (COLOUR * 0.5 + f0 * urp_peak(0.5)),
+        2.0 * (COLOUR * 0.5 * DIFFUSE + f0 * urp_peak(0.5)),
         2e-3,
         "half metal, URP",
     );
@@ -105,9 +111,82 @@ fn a_gamma_project_takes_the_square_root_of_the_specular_term() {
     // Built-in gamma shaders: f0 = 0.2209 (0.04 encoded), term √(D·V·π), all on stored
     // values; the pixel is decoded at the end.
     let got = overhead(glossy(0.0, 0.5), Attenuation::BuiltIn, ColorSpace::Gamma);
-    let stored = 2.0 * (COLOUR + Vec3::splat(0.220_916_3 * built_in_peak(0.5).sqrt()));
+    let stored =
+        2.0 * (COLOUR * DIFFUSE_GAMMA + Vec3::splat(0.220_916_3 * built_in_peak(0.5).sqrt()));
     let want = stored.map(formats::srgb::gamma_to_linear);
     assert_close(got, want, 2e-4, "gamma");
+}
+
+/// The built-in pipeline's Disney diffuse under a light 60° from the normal, seen head-on:
+/// (1 + (f90 − 1)·(1 − n·l)⁵) with f90 = 0.5 + (1 + l·v)·(1 − smoothness), brighter than
+/// Lambert on a rough surface and darker on a smooth one; URP's is Lambert's. A legacy
+/// (not physically based) material is Lambert's without the diffuse share.
+#[test]
+fn the_built_in_diffuse_is_disneys_and_urps_lamberts() {
+    let slanted = |material: Material, pipeline: Attenuation| {
+        let mut s = SceneBuilder::new();
+        let m = s.material(Material {
+            highlights: false,
+            ..material
+        });
+        s.floor(0.0, 0.0, 0.0, 20.0, m);
+        s.camera(top_down_camera(Vec3::new(0.0, 10.0, 0.0), 5.0));
+        let travel = Vec3::new(60f32.to_radians().sin(), -60f32.to_radians().cos(), 0.0);
+        s.light(formats::Light {
+            attenuation: pipeline,
+            ..directional_light(travel, 2.0, Shadows::None)
+        });
+        let (soup, kd) = s.build();
+        render(&soup, &kd, &opts(8, 8)).0.frame.pixel(4, 4)
+    };
+    let (nl, lv) = (0.5f32, 0.5f32);
+    for (smoothness, shape) in [(0.0f32, 1.03125f32), (1.0, 0.984375), (0.5, 1.0078125)] {
+        let f90_less_1 = (1.0 + lv) * (1.0 - smoothness) - 0.5;
+        assert!((1.0 + f90_less_1 * (1.0 - nl).powi(5) - shape).abs() < 1e-6);
+        let want = 2.0 * COLOUR * DIFFUSE * nl * shape;
+        let got = slanted(glossy(0.0, smoothness), Attenuation::BuiltIn);
+        assert_close(
+            got,
+            want,
+            1e-5,
+            &format!("built-in, smoothness {smoothness}"),
+        );
+        let got = slanted(glossy(0.0, smoothness), Attenuation::Universal);
+        let want = 2.0 * COLOUR * DIFFUSE * nl;
+        assert_close(got, want, 1e-5, &format!("URP, smoothness {smoothness}"));
+    }
+    let legacy = slanted(diffuse(COLOUR), Attenuation::BuiltIn);
+    assert_close(legacy, 2.0 * COLOUR * nl, 1e-5, "legacy Lambert");
+}
+
+/// Ambient light is diffuse light too: a physically based surface shows the same share of
+/// its albedo under it, with or without lights in the scene; a legacy one all of it.
+#[test]
+fn ambient_light_takes_the_diffuse_share_of_a_physically_based_albedo() {
+    let ambient = |material: Material, pipeline: Option<Attenuation>| {
+        let mut s = SceneBuilder::new();
+        s.soup.environment.ambient.mode = formats::AmbientMode::Flat;
+        s.soup.environment.ambient.sky = Vec3::splat(0.5);
+        let m = s.material(material);
+        s.floor(0.0, 0.0, 0.0, 20.0, m);
+        s.camera(top_down_camera(Vec3::new(0.0, 10.0, 0.0), 5.0));
+        if let Some(pipeline) = pipeline {
+            // A light from below the floor: it lights nothing the camera sees.
+            s.light(formats::Light {
+                attenuation: pipeline,
+                ..directional_light(Vec3::Y, 1.0, Shadows::None)
+            });
+        }
+        let (soup, kd) = s.build();
+        render(&soup, &kd, &opts(8, 8)).0.frame.pixel(4, 4)
+    };
+    let pbs = glossy(0.0, 0.5);
+    let want = 0.5 * COLOUR * DIFFUSE;
+    assert_close(ambient(pbs.clone(), None), want, 1e-6, "no lights");
+    for pipeline in [Attenuation::BuiltIn, Attenuation::Universal] {
+        assert_close(ambient(pbs.clone(), Some(pipeline)), want, 1e-6, "a light");
+    }
+    assert_close(ambient(diffuse(COLOUR), None), 0.5 * COLOUR, 1e-6, "legacy");
 }
 
 #[test]
@@ -119,7 +198,7 @@ fn highlights_off_leave_the_diffuse_light() {
         };
         overhead(m, Attenuation::BuiltIn, ColorSpace::Linear)
     };
-    assert_close(off(0.0), 2.0 * COLOUR, 1e-5, "highlights off");
+    assert_close(off(0.0), 2.0 * COLOUR * DIFFUSE, 1e-5, "highlights off");
     let got = off(1.0);
     assert_eq!(got, Vec3::ZERO, "a metal without highlights takes no light");
 }
@@ -214,7 +293,8 @@ fn smoothness_can_come_from_the_albedo_alpha() {
         let (soup, kd) = s.build();
         render(&soup, &kd, &opts(8, 8)).0.frame.pixel(4, 4)
     };
-    let want = |smoothness: f32| 2.0 * (COLOUR + Vec3::splat(0.04 * built_in_peak(smoothness)));
+    let want =
+        |smoothness: f32| 2.0 * (COLOUR * DIFFUSE + Vec3::splat(0.04 * built_in_peak(smoothness)));
     assert_close(pixel(true), want(128.0 / 255.0), 2e-4, "alpha 128");
     // The same material reading its smoothness of 1 as it is: Unity's floor on the
     // roughness caps a perfect mirror's head-on peak at 10.

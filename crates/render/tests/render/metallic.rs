@@ -3,7 +3,7 @@
 //! mirror alike; the map is read only where one of them shows.
 
 use crate::common::*;
-use crate::highlights::{built_in_peak, glossy, urp_peak, COLOUR};
+use crate::highlights::{built_in_peak, glossy, urp_peak, COLOUR, DIFFUSE};
 use formats::texture::{TextureRef, Tiling, Wrap};
 use formats::{Attenuation, Material, MetallicMap, Shadows};
 use glam::Vec3;
@@ -43,7 +43,7 @@ fn the_maps_red_channel_is_metallic_and_its_alpha_times_the_scale_smoothness() {
     let material = glossy(1.0, 0.1);
     let (dielectric, lookups) = mapped(material.clone(), 0, 128, 1.0, Attenuation::BuiltIn);
     let s = 128.0 / 255.0;
-    let want = 2.0 * (COLOUR + Vec3::splat(0.04 * built_in_peak(s)));
+    let want = 2.0 * (COLOUR * DIFFUSE + Vec3::splat(0.04 * built_in_peak(s)));
     assert_close(dielectric, want, 2e-4, "metallic 0, smoothness 128/255");
     assert_eq!(lookups, 64, "one texel per pixel");
 
@@ -60,7 +60,7 @@ fn the_maps_red_channel_is_metallic_and_its_alpha_times_the_scale_smoothness() {
     let f0 = Vec3::splat(0.04 * (1.0 - m)) + COLOUR * m;
     assert_close(
         half,
-        2.0 * (COLOUR * (1.0 - m) + f0 * urp_peak(0.5)),
+        2.0 * (COLOUR * (1.0 - m) * DIFFUSE + f0 * urp_peak(0.5)),
         2e-3,
         "metallic 128/255, URP",
     );

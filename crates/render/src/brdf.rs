@@ -1,11 +1,12 @@
-//! The highlight a light leaves on a glossy surface: the specular half of Unity's
-//! physically based shaders (Standard, URP Lit) for a punctual light, in each pipeline's
-//! own formula, so a highlight has the size and brightness it has in the editor.
+//! How Unity's physically based shaders (Standard, URP Lit) light a surface with a punctual
+//! light, in each pipeline's own formula, so that a surface has the brightness and a
+//! highlight the size it has in the editor: the diffuse term's share of the albedo and, in
+//! the built-in pipeline, its Disney shape; the specular highlight.
 //!
-//! Both pipelines fold π into the light's intensity, as the diffuse term does (albedo ·
-//! cosine, no 1/π), and both work in the metallic workflow: a surface reflects
-//! f0 = lerp(dielectric, colour, metallic) at normal incidence, and the roughness that
-//! shapes the GGX lobe is (1 − smoothness)².
+//! Both pipelines fold π into the light's intensity (albedo · cosine, no 1/π), and both
+//! work in the metallic workflow: a surface reflects f0 = lerp(dielectric, colour,
+//! metallic) at normal incidence and lights (1 − dielectric)·(1 − metallic) of its colour
+//! as diffuse, and the roughness that shapes the GGX lobe is (1 − smoothness)².
 
 use formats::{Attenuation, ColorSpace, Material};
 use glam::Vec3;
@@ -17,15 +18,15 @@ pub const DIELECTRIC: f32 = 0.04;
 /// shaders work on gamma-encoded values (0.04 encoded).
 pub const DIELECTRIC_GAMMA: f32 = 0.220_916_3;
 
-/// Which of Unity's specular formulas a scene's lights are shaded with.
+/// Which of Unity's formulas a scene's surfaces are shaded with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Brdf {
-    /// The built-in pipeline's `BRDF1_Unity_PBS`: GGX, the Smith-joint visibility
-    /// approximation and Schlick's Fresnel; in a gamma project the square root of the
-    /// specular term, as its gamma-space shaders take it.
+    /// The built-in pipeline's `BRDF1_Unity_PBS`: Disney diffuse; GGX, the Smith-joint
+    /// visibility approximation and Schlick's Fresnel, in a gamma project the square root
+    /// of the specular term, as its gamma-space shaders take it.
     BuiltIn { gamma: bool },
-    /// URP's `DirectBRDFSpecular`: GGX with a combined visibility and Fresnel
-    /// approximation, without Fresnel's change with angle.
+    /// URP's Lambert diffuse and `DirectBRDFSpecular`: GGX with a combined visibility and
+    /// Fresnel approximation, without Fresnel's change with angle.
     Universal,
 }
 
@@ -38,6 +39,27 @@ impl Brdf {
             Attenuation::BuiltIn => Brdf::BuiltIn {
                 gamma: space == ColorSpace::Gamma,
             },
+        }
+    }
+
+    /// The share of a physically based surface's albedo (colour · (1 − metallic)) that
+    /// its shader lights as diffuse: what the dielectric does not reflect
+    /// (`OneMinusReflectivityFromMetallic`).
+    pub fn diffuse_share(self) -> f32 {
+        1.0 - self.dielectric()
+    }
+
+    /// The shape of the diffuse term at a point of smoothness `smoothness`, unit shading
+    /// normal `n`, seen along unit `view`: the built-in pipeline's Disney term, URP's
+    /// Lambert.
+    pub fn diffuse(self, smoothness: f32, n: Vec3, view: Vec3) -> Diffuse {
+        match self {
+            Brdf::BuiltIn { .. } => Diffuse::Disney {
+                pr: 1.0 - smoothness.clamp(0.0, 1.0),
+                view_scatter: (1.0 - n.dot(view).abs()).powi(5),
+                view,
+            },
+            Brdf::Universal => Diffuse::Lambert,
         }
     }
 
@@ -65,6 +87,44 @@ pub fn shows_light(m: &Material) -> bool {
     !m.unlit
         && (m.albedo().max_element() > 0.0
             || (m.highlights && (m.least_metallic() < 1.0 || m.color.max_element() > 0.0)))
+}
+
+/// The shape of a shaded point's diffuse term: what multiplies albedo · cosine.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Diffuse {
+    /// Lambert's cosine alone: URP, and the shaders that are not physically based.
+    Lambert,
+    /// The built-in pipeline's `DisneyDiffuse`: (1 + (f90 − 1)(1 − n·l)⁵)(1 + (f90 − 1)
+    /// (1 − n·v)⁵) with f90 = 0.5 + 2(l·h)²·(1 − smoothness), which darkens smooth surfaces
+    /// and brightens rough ones towards grazing light and view.
+    Disney {
+        /// Perceptual roughness, 1 − smoothness.
+        pr: f32,
+        /// (1 − |n·v|)⁵.
+        view_scatter: f32,
+        /// Unit direction from the point towards the eye.
+        view: Vec3,
+    },
+}
+
+impl Diffuse {
+    /// What albedo · `nl` is multiplied by for a light from unit direction `l` at cosine
+    /// `nl` > 0 with the normal.
+    #[inline(always)]
+    pub fn scale(&self, l: Vec3, nl: f32) -> f32 {
+        match *self {
+            Diffuse::Lambert => 1.0,
+            Diffuse::Disney {
+                pr,
+                view_scatter,
+                view,
+            } => {
+                // 2(l·h)² = 1 + l·v: the half vector is never formed.
+                let f90_less_1 = (1.0 + l.dot(view)).max(0.0) * pr - 0.5;
+                (1.0 + f90_less_1 * (1.0 - nl).powi(5)) * (1.0 + f90_less_1 * view_scatter)
+            }
+        }
+    }
 }
 
 /// A shaded point's glossy reflection of the lights, with what its lobe's formula needs
@@ -293,6 +353,47 @@ mod tests {
         // l·h = cos 87° ≈ 0.05: F = 0.04 + 0.96 · 0.95⁵ ≈ 0.78 of the metal's.
         let ratio = dielectric.x / metal.x;
         assert!((ratio - 0.783).abs() < 0.01, "{ratio}");
+    }
+
+    /// The Disney term without the half vector agrees with Unity's `DisneyDiffuse`, which
+    /// forms it, at grazing and head-on light and view; URP's diffuse is Lambert's. The
+    /// diffuse share is what a dielectric does not reflect.
+    #[test]
+    fn disney_diffuse_follows_unitys_formula_at_every_angle() {
+        let unity = |n: Vec3, l: Vec3, v: Vec3, pr: f32| {
+            let h = (l + v).normalize();
+            let lh = l.dot(h).clamp(0.0, 1.0);
+            let (nl, nv) = (n.dot(l).clamp(0.0, 1.0), n.dot(v).abs());
+            let fd90 = 0.5 + 2.0 * lh * lh * pr;
+            (1.0 + (fd90 - 1.0) * (1.0 - nl).powi(5)) * (1.0 + (fd90 - 1.0) * (1.0 - nv).powi(5))
+        };
+        let n = Vec3::Y;
+        let dir = |deg: f32, az: f32| {
+            let (t, a) = (deg.to_radians(), az.to_radians());
+            Vec3::new(t.sin() * a.cos(), t.cos(), t.sin() * a.sin())
+        };
+        let built_in = Brdf::of(Attenuation::BuiltIn, ColorSpace::Linear);
+        let mut spread = (f32::MAX, f32::MIN);
+        for pr in [0.0f32, 0.3, 0.5, 1.0] {
+            for (lt, la) in [(0.0, 0.0), (45.0, 0.0), (80.0, 90.0), (89.0, 180.0)] {
+                for (vt, va) in [(0.0, 0.0), (60.0, 30.0), (85.0, 0.0), (89.5, 180.0)] {
+                    let (l, v) = (dir(lt, la), dir(vt, va));
+                    let want = unity(n, l, v, pr);
+                    let got = built_in.diffuse(1.0 - pr, n, v).scale(l, n.dot(l));
+                    assert!((got - want).abs() < 1e-5, "{pr} {l} {v}: {got} vs {want}");
+                    spread = (spread.0.min(got), spread.1.max(got));
+                    let urp = Brdf::Universal.diffuse(1.0 - pr, n, v);
+                    assert_eq!(urp.scale(l, n.dot(l)), 1.0);
+                }
+            }
+        }
+        // Smooth surfaces darken towards grazing angles (to a quarter), rough ones brighten
+        // (to about 2.5²).
+        assert!(spread.0 < 0.3 && spread.1 > 5.0, "{spread:?}");
+        assert_eq!(built_in.diffuse_share(), 0.96);
+        assert_eq!(Brdf::Universal.diffuse_share(), 0.96);
+        let gamma = Brdf::of(Attenuation::BuiltIn, ColorSpace::Gamma);
+        assert_eq!(gamma.diffuse_share(), 1.0 - DIELECTRIC_GAMMA);
     }
 
     #[test]
