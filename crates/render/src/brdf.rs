@@ -54,12 +54,12 @@ impl Brdf {
     /// Lambert.
     pub fn diffuse(self, smoothness: f32, n: Vec3, view: Vec3) -> Diffuse {
         match self {
-            Brdf::BuiltIn { .. } => Diffuse::Disney {
-                pr: 1.0 - smoothness.clamp(0.0, 1.0),
+            Brdf::BuiltIn { .. } => Diffuse {
+                slope: 1.0 - smoothness.clamp(0.0, 1.0),
+                offset: -0.5,
                 view_scatter: (1.0 - n.dot(view).abs()).powi(5),
-                view,
             },
-            Brdf::Universal => Diffuse::Lambert,
+            Brdf::Universal => Diffuse::LAMBERT,
         }
     }
 
@@ -89,41 +89,36 @@ pub fn shows_light(m: &Material) -> bool {
             || (m.highlights && (m.least_metallic() < 1.0 || m.color.max_element() > 0.0)))
 }
 
-/// The shape of a shaded point's diffuse term: what multiplies albedo · cosine.
+/// The shape of a shaded point's diffuse term: what multiplies albedo · cosine. The
+/// built-in pipeline's `DisneyDiffuse` is (1 + (f90 − 1)(1 − n·l)⁵)(1 + (f90 − 1)(1 − n·v)⁵)
+/// with f90 = 0.5 + 2(l·h)²·(1 − smoothness), which darkens smooth surfaces and brightens
+/// rough ones towards grazing light and view; Lambert's (URP, and shaders that are not
+/// physically based) is 1. Both are f90 − 1 = (1 + l·v)·`slope` + `offset`: Lambert's with
+/// both 0, which gives exactly 1.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Diffuse {
-    /// Lambert's cosine alone: URP, and the shaders that are not physically based.
-    Lambert,
-    /// The built-in pipeline's `DisneyDiffuse`: (1 + (f90 − 1)(1 − n·l)⁵)(1 + (f90 − 1)
-    /// (1 − n·v)⁵) with f90 = 0.5 + 2(l·h)²·(1 − smoothness), which darkens smooth surfaces
-    /// and brightens rough ones towards grazing light and view.
-    Disney {
-        /// Perceptual roughness, 1 − smoothness.
-        pr: f32,
-        /// (1 − |n·v|)⁵.
-        view_scatter: f32,
-        /// Unit direction from the point towards the eye.
-        view: Vec3,
-    },
+pub struct Diffuse {
+    /// 1 − smoothness for Disney's.
+    slope: f32,
+    /// −0.5 for Disney's.
+    offset: f32,
+    /// (1 − |n·v|)⁵.
+    view_scatter: f32,
 }
 
 impl Diffuse {
-    /// What albedo · `nl` is multiplied by for a light from unit direction `l` at cosine
-    /// `nl` > 0 with the normal.
+    pub const LAMBERT: Diffuse = Diffuse {
+        slope: 0.0,
+        offset: 0.0,
+        view_scatter: 0.0,
+    };
+
+    /// What albedo · `nl` is multiplied by for a light from a direction at cosine `nl` > 0
+    /// with the normal and `lv` with the direction towards the eye.
     #[inline(always)]
-    pub fn scale(&self, l: Vec3, nl: f32) -> f32 {
-        match *self {
-            Diffuse::Lambert => 1.0,
-            Diffuse::Disney {
-                pr,
-                view_scatter,
-                view,
-            } => {
-                // 2(l·h)² = 1 + l·v: the half vector is never formed.
-                let f90_less_1 = (1.0 + l.dot(view)).max(0.0) * pr - 0.5;
-                (1.0 + f90_less_1 * (1.0 - nl).powi(5)) * (1.0 + f90_less_1 * view_scatter)
-            }
-        }
+    pub fn scale(&self, lv: f32, nl: f32) -> f32 {
+        // 2(l·h)² = 1 + l·v: the half vector is never formed.
+        let f90_less_1 = (1.0 + lv).max(0.0) * self.slope + self.offset;
+        (1.0 + f90_less_1 * (1.0 - nl).powi(5)) * (1.0 + f90_less_1 * self.view_scatter)
     }
 }
 
@@ -133,10 +128,6 @@ impl Diffuse {
 pub struct Gloss {
     /// Reflectance at normal incidence.
     pub f0: Vec3,
-    /// Unit shading normal.
-    n: Vec3,
-    /// Unit direction from the point towards the eye.
-    view: Vec3,
     lobe: Lobe,
 }
 
@@ -180,7 +171,7 @@ impl Gloss {
                 }
             }
         };
-        Gloss { f0, n, view, lobe }
+        Gloss { f0, lobe }
     }
 
     /// Whether the surface reflects any light specularly (Unity's shaders drop the term
@@ -190,14 +181,16 @@ impl Gloss {
     }
 
     /// The light reflected towards the eye per unit of a light's radiance arriving from
-    /// unit direction `l` at cosine `nl` > 0 with the normal, the cosine included.
+    /// unit direction `l` at cosine `nl` > 0 with the normal, the cosine included; `n` and
+    /// `view` are the ones the gloss was made for (not kept in it: a shaded point's record
+    /// holds them once).
     #[inline(always)]
-    pub fn highlight(&self, l: Vec3, nl: f32) -> Vec3 {
+    pub fn highlight(&self, n: Vec3, view: Vec3, l: Vec3, nl: f32) -> Vec3 {
         // Unity's `SafeNormalize`: a light straight behind the eye gives no half vector.
         // The half vector is never formed: n·h and l·h are scaled dot products.
-        let sum = l + self.view;
+        let sum = l + view;
         let inv = sum.length_squared().max(0.001).sqrt().recip();
-        let nh = (self.n.dot(sum) * inv).clamp(0.0, 1.0);
+        let nh = (n.dot(sum) * inv).clamp(0.0, 1.0);
         let lh = (l.dot(sum) * inv).clamp(0.0, 1.0);
         match self.lobe {
             Lobe::BuiltIn {
@@ -236,14 +229,24 @@ mod tests {
     use std::f32::consts::PI;
 
     /// A gloss on a floor facing +Y.
-    fn gloss(brdf: Brdf, f0: f32, smoothness: f32, view: Vec3) -> Gloss {
-        Gloss::new(
-            brdf,
-            Vec3::splat(f0),
-            1.0 - smoothness,
-            Vec3::Y,
-            view.normalize(),
-        )
+    /// A gloss on a surface facing +Y, seen along `view`.
+    struct Seen {
+        gloss: Gloss,
+        view: Vec3,
+    }
+
+    impl Seen {
+        fn highlight(&self, l: Vec3, nl: f32) -> Vec3 {
+            self.gloss.highlight(Vec3::Y, self.view, l, nl)
+        }
+    }
+
+    fn gloss(brdf: Brdf, f0: f32, smoothness: f32, view: Vec3) -> Seen {
+        let view = view.normalize();
+        Seen {
+            gloss: Gloss::new(brdf, Vec3::splat(f0), 1.0 - smoothness, Vec3::Y, view),
+            view,
+        }
     }
 
     const BUILT_IN: Brdf = Brdf::BuiltIn { gamma: false };
@@ -379,11 +382,11 @@ mod tests {
                 for (vt, va) in [(0.0, 0.0), (60.0, 30.0), (85.0, 0.0), (89.5, 180.0)] {
                     let (l, v) = (dir(lt, la), dir(vt, va));
                     let want = unity(n, l, v, pr);
-                    let got = built_in.diffuse(1.0 - pr, n, v).scale(l, n.dot(l));
+                    let got = built_in.diffuse(1.0 - pr, n, v).scale(l.dot(v), n.dot(l));
                     assert!((got - want).abs() < 1e-5, "{pr} {l} {v}: {got} vs {want}");
                     spread = (spread.0.min(got), spread.1.max(got));
                     let urp = Brdf::Universal.diffuse(1.0 - pr, n, v);
-                    assert_eq!(urp.scale(l, n.dot(l)), 1.0);
+                    assert_eq!(urp.scale(l.dot(v), n.dot(l)), 1.0);
                 }
             }
         }
@@ -407,7 +410,7 @@ mod tests {
         // Roughness (1 − 0.75)² = 1/16, so a² = 1/256 and, head-on, d = a².
         let a2 = 1.0f32 / 256.0;
         let want = 0.5 * a2 / ((2.0 + 1e-5) * (a2 * a2 + 1e-7));
-        let peak = g.highlight(Vec3::Y, 1.0).x / 0.52;
+        let peak = g.highlight(Vec3::Y, Vec3::Y, Vec3::Y, 1.0).x / 0.52;
         assert!((peak - want).abs() < 1e-4 * want, "{peak} vs {want}");
         let gamma = Brdf::of(Attenuation::BuiltIn, ColorSpace::Gamma);
         let zero = Vec3::ZERO;

@@ -127,6 +127,8 @@ struct Lit {
     albedo: Vec3,
     /// The shape of its diffuse term.
     diffuse: Diffuse,
+    /// Unit direction towards the eye.
+    view: Vec3,
     /// The glossy side of the surface, where it reflects the lights' highlights.
     gloss: Option<Gloss>,
     /// The albedo or the gloss is not black, so lights can show.
@@ -154,9 +156,10 @@ impl Lit {
             visible
         };
         if visible > 0.0 {
-            let mut reflected = self.albedo * (cos * self.diffuse.scale(inc.dir, cos));
+            let lv = inc.dir.dot(self.view);
+            let mut reflected = self.albedo * (cos * self.diffuse.scale(lv, cos));
             if let Some(g) = &self.gloss {
-                reflected += g.highlight(inc.dir, cos);
+                reflected += g.highlight(self.ns, self.view, inc.dir, cos);
             }
             self.l += inc.radiance * visible * reflected;
         }

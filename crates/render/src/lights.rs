@@ -100,7 +100,10 @@ pub struct Incident {
 }
 
 /// The light arriving at `p`, or None where the light delivers nothing (beyond range,
-/// outside the cone, black or zero intensity): such points need no shadow ray.
+/// outside the cone, black or zero intensity): such points need no shadow ray. Inlined
+/// into the shading of four points: left to the compiler, it stopped inlining it once the
+/// shaded point's record grew by one field, and a six-light scene traced 20 % slower.
+#[inline(always)]
 pub fn incident(light: &Light, p: Vec3) -> Option<Incident> {
     let power = light.color * light.intensity;
     if power.max_element() <= 0.0 || !power.is_finite() {

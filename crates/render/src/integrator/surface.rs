@@ -152,7 +152,7 @@ impl Integrator<'_> {
         let diffuse = if pbs && !self.lights.is_empty() {
             self.brdf.diffuse(smoothness, ns, -ray.dir)
         } else {
-            Diffuse::Lambert
+            Diffuse::LAMBERT
         };
         let mut reflectance = mat.reflectance_at(metallic, smoothness);
         // The share of ambient light and reflection the occlusion map leaves (1 without
@@ -181,6 +181,7 @@ impl Integrator<'_> {
             a,
             albedo: diffuse_colour,
             diffuse,
+            view: -ray.dir,
             gloss,
             lit,
             surf,
