@@ -228,7 +228,6 @@ mod tests {
     use formats::MetallicMap;
     use std::f32::consts::PI;
 
-    /// A gloss on a floor facing +Y.
     /// A gloss on a surface facing +Y, seen along `view`.
     struct Seen {
         gloss: Gloss,

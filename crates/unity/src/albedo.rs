@@ -41,8 +41,19 @@ impl Emitter<'_, '_> {
 
     /// The albedo map `slot` names; `what` names its material in warnings.
     pub(crate) fn albedo(&mut self, slot: &TextureSlot, what: &str) -> Option<TextureRef> {
-        let path = self.slot_file(slot, what, TINT_ALONE)?;
-        self.texture_ref(&path, Import::read(&path), slot.tiling, what, TINT_ALONE)
+        self.slot_texture(slot, what, TINT_ALONE)
+    }
+
+    /// The texture `slot` names, imported as its `.meta` says, or None with one warning
+    /// naming the material (`what`) and what it is drawn `without`.
+    fn slot_texture(
+        &mut self,
+        slot: &TextureSlot,
+        what: &str,
+        without: &'static str,
+    ) -> Option<TextureRef> {
+        let path = self.slot_file(slot, what, without)?;
+        self.texture_ref(&path, Import::read(&path), slot.tiling, what, without)
     }
 
     /// The file slot `slot` names, or None with one warning naming the material (`what`),
@@ -69,10 +80,7 @@ impl Emitter<'_, '_> {
         if emission.max_element() <= 0.0 {
             return None;
         }
-        let slot = emission_slot(body)?;
-        let path = self.slot_file(&slot, what, EMISSION_COLOUR_ALONE)?;
-        let import = Import::read(&path);
-        self.texture_ref(&path, import, slot.tiling, what, EMISSION_COLOUR_ALONE)
+        self.slot_texture(&emission_slot(body)?, what, EMISSION_COLOUR_ALONE)
     }
 
     /// The occlusion map of Material `body` where its shader samples one with a strength
@@ -82,14 +90,7 @@ impl Emitter<'_, '_> {
         if strength <= 0.0 {
             return None;
         }
-        let path = self.slot_file(&slot, what, NO_OCCLUSION_MAP)?;
-        let map = self.texture_ref(
-            &path,
-            Import::read(&path),
-            slot.tiling,
-            what,
-            NO_OCCLUSION_MAP,
-        )?;
+        let map = self.slot_texture(&slot, what, NO_OCCLUSION_MAP)?;
         Some(OcclusionMap { map, strength })
     }
 
@@ -98,14 +99,7 @@ impl Emitter<'_, '_> {
     /// before the shader reads its red channel.
     pub(crate) fn mat_metallic(&mut self, body: &Node, what: &str) -> Option<MetallicMap> {
         let (slot, smoothness) = metallic_slot(body)?;
-        let path = self.slot_file(&slot, what, NO_METALLIC_MAP)?;
-        let map = self.texture_ref(
-            &path,
-            Import::read(&path),
-            slot.tiling,
-            what,
-            NO_METALLIC_MAP,
-        )?;
+        let map = self.slot_texture(&slot, what, NO_METALLIC_MAP)?;
         Some(MetallicMap { map, smoothness })
     }
 

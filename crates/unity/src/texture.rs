@@ -104,12 +104,7 @@ pub fn normal_slot(body: &Node) -> Option<(TextureSlot, f32)> {
         _ => ("_BumpMap", "_BumpScale"),
     };
     let found = map_slot(body, texture)?;
-    let floats = props(body.get("m_SavedProperties")?, "m_Floats");
-    let scale = prop(&floats, scale)
-        .and_then(Node::as_f32)
-        .filter(|x| x.is_finite())
-        .unwrap_or(1.0);
-    Some((found, scale))
+    Some((found, finite_float(body, scale).unwrap_or(1.0)))
 }
 
 /// The emission map of a Material body (`_EmissionMap` of the Standard and URP Lit
@@ -135,13 +130,8 @@ pub fn occlusion_slot(body: &Node) -> Option<(TextureSlot, f32)> {
         _ => {}
     }
     let found = map_slot(body, "_OcclusionMap")?;
-    let floats = props(body.get("m_SavedProperties")?, "m_Floats");
-    let strength = prop(&floats, "_OcclusionStrength")
-        .and_then(Node::as_f32)
-        .filter(|x| x.is_finite())
-        .unwrap_or(1.0)
-        .clamp(0.0, 1.0);
-    Some((found, strength))
+    let strength = finite_float(body, "_OcclusionStrength").unwrap_or(1.0);
+    Some((found, strength.clamp(0.0, 1.0)))
 }
 
 /// The metallic map of a Material body and the scale of its alpha (smoothness), where the
@@ -159,11 +149,8 @@ pub fn metallic_slot(body: &Node) -> Option<(TextureSlot, f32)> {
         }
         (Some(BUILTIN_SHADERS) | Some(HDRP_LIT), _) => return None,
         (Some(URP_LIT), _) => {
-            let floats = props(body.get("m_SavedProperties")?, "m_Floats");
-            let specular =
-                crate::material::keyword_on(body, "_SPECULAR_SETUP").unwrap_or_else(|| {
-                    prop(&floats, "_WorkflowMode").and_then(Node::as_f32) == Some(0.0)
-                });
+            let specular = crate::material::keyword_on(body, "_SPECULAR_SETUP")
+                .unwrap_or_else(|| finite_float(body, "_WorkflowMode") == Some(0.0));
             if specular {
                 return None;
             }
@@ -175,13 +162,16 @@ pub fn metallic_slot(body: &Node) -> Option<(TextureSlot, f32)> {
         return None;
     }
     let found = map_slot(body, "_MetallicGlossMap")?;
+    let scale = finite_float(body, scale).unwrap_or(default);
+    Some((found, scale.clamp(0.0, 1.0)))
+}
+
+/// The finite value of a Material body's float property `name`, where it has one.
+fn finite_float(body: &Node, name: &str) -> Option<f32> {
     let floats = props(body.get("m_SavedProperties")?, "m_Floats");
-    let scale = prop(&floats, scale)
+    prop(&floats, name)
         .and_then(Node::as_f32)
         .filter(|x| x.is_finite())
-        .unwrap_or(default)
-        .clamp(0.0, 1.0);
-    Some((found, scale))
 }
 
 /// The texture in slot `property`, tiled by the albedo property's scale and offset (the

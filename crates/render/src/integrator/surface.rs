@@ -138,8 +138,10 @@ impl Integrator<'_> {
             l += albedo;
         }
         let pbs = mat.pbs && !mat.unlit;
+        // Without lights only the diffuse share matters (to the ambient light).
+        let lights = !self.lights.is_empty();
         let gloss = Some(self.brdf)
-            .filter(|_| pbs && mat.highlights && !self.lights.is_empty())
+            .filter(|_| pbs && mat.highlights && lights)
             .map(|brdf| brdf.gloss(base, metallic, smoothness, ns, -ray.dir))
             .filter(Gloss::any);
         let lit = !mat.unlit && (albedo.max_element() > 0.0 || gloss.is_some());
@@ -149,7 +151,7 @@ impl Integrator<'_> {
         } else {
             albedo
         };
-        let diffuse = if pbs && !self.lights.is_empty() {
+        let diffuse = if pbs && lights {
             self.brdf.diffuse(smoothness, ns, -ray.dir)
         } else {
             Diffuse::LAMBERT

@@ -1,10 +1,12 @@
-//! Specular highlights: a glossy floor lit and seen from straight above, where each
-//! pipeline's formula reduces to a closed form (n·h = l·h = n·v = n·l = 1), and what the
-//! plan makes of materials that show only a highlight.
+//! Physically based shading: a glossy floor lit and seen from straight above, where each
+//! pipeline's highlight reduces to a closed form (n·h = l·h = n·v = n·l = 1), the diffuse
+//! term's share and the built-in pipeline's Disney shape, and what the plan makes of
+//! materials that show only a highlight.
 
 use crate::common::*;
 use formats::{Attenuation, ColorSpace, Material, Shadows};
 use glam::Vec3;
+use render::Rendered;
 use std::f32::consts::PI;
 
 pub(crate) const COLOUR: Vec3 = Vec3::new(0.8, 0.6, 0.4);
@@ -21,6 +23,11 @@ fn overhead(material: Material, pipeline: Attenuation, space: ColorSpace) -> Vec
     let mut s = SceneBuilder::new();
     s.soup.environment.color_space = space;
     let m = s.material(material);
+    overhead_in(s, m, pipeline).frame.pixel(4, 4)
+}
+
+/// [`overhead`] for material `m` of `s` (which may hold its textures), rendered at 8×8.
+pub(crate) fn overhead_in(mut s: SceneBuilder, m: u32, pipeline: Attenuation) -> Rendered {
     s.floor(0.0, 0.0, 0.0, 20.0, m);
     s.camera(top_down_camera(Vec3::new(0.0, 10.0, 0.0), 5.0));
     s.light(formats::Light {
@@ -28,8 +35,7 @@ fn overhead(material: Material, pipeline: Attenuation, space: ColorSpace) -> Vec
         ..directional_light(-Vec3::Y, 2.0, Shadows::Hard)
     });
     let (soup, kd) = s.build();
-    let (out, _) = render(&soup, &kd, &opts(8, 8));
-    out.frame.pixel(4, 4)
+    render(&soup, &kd, &opts(8, 8)).0
 }
 
 pub(crate) fn glossy(metallic: f32, smoothness: f32) -> Material {
@@ -287,11 +293,7 @@ fn smoothness_can_come_from_the_albedo_alpha() {
             }),
             ..glossy(0.0, 1.0)
         });
-        s.floor(0.0, 0.0, 0.0, 20.0, m);
-        s.camera(top_down_camera(Vec3::new(0.0, 10.0, 0.0), 5.0));
-        s.light(directional_light(-Vec3::Y, 2.0, Shadows::Hard));
-        let (soup, kd) = s.build();
-        render(&soup, &kd, &opts(8, 8)).0.frame.pixel(4, 4)
+        overhead_in(s, m, Attenuation::BuiltIn).frame.pixel(4, 4)
     };
     let want =
         |smoothness: f32| 2.0 * (COLOUR * DIFFUSE + Vec3::splat(0.04 * built_in_peak(smoothness)));

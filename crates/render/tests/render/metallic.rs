@@ -3,11 +3,23 @@
 //! mirror alike; the map is read only where one of them shows.
 
 use crate::common::*;
-use crate::highlights::{built_in_peak, glossy, urp_peak, COLOUR, DIFFUSE};
+use crate::highlights::{built_in_peak, glossy, overhead_in, urp_peak, COLOUR, DIFFUSE};
 use formats::texture::{TextureRef, Tiling, Wrap};
 use formats::{Attenuation, Material, MetallicMap, Shadows};
 use glam::Vec3;
 use render::RenderOptions;
+
+/// Material `m`'s metallic map: texture `t` over the whole surface, its alpha scaled by
+/// `smoothness`.
+fn metal_map(t: u32, smoothness: f32) -> Option<MetallicMap> {
+    Some(MetallicMap {
+        map: TextureRef {
+            texture: t,
+            tiling: Tiling::default(),
+        },
+        smoothness,
+    })
+}
 
 /// A floor of `material` whose metallic map is one texel of red `r` and alpha `a` with
 /// smoothness scale `scale`, under a directional light of intensity 2 straight down, seen
@@ -17,23 +29,10 @@ fn mapped(material: Material, r: u8, a: u8, scale: f32, pipeline: Attenuation) -
     let mut s = SceneBuilder::new();
     let t = s.texture(texture(1, 1, &[[r, 0, 0, a]], Wrap::Repeat));
     let m = s.material(Material {
-        metallic_map: Some(MetallicMap {
-            map: TextureRef {
-                texture: t,
-                tiling: Tiling::default(),
-            },
-            smoothness: scale,
-        }),
+        metallic_map: metal_map(t, scale),
         ..material
     });
-    s.floor(0.0, 0.0, 0.0, 20.0, m);
-    s.camera(top_down_camera(Vec3::new(0.0, 10.0, 0.0), 5.0));
-    s.light(formats::Light {
-        attenuation: pipeline,
-        ..directional_light(-Vec3::Y, 2.0, Shadows::Hard)
-    });
-    let (soup, kd) = s.build();
-    let (out, _) = render(&soup, &kd, &opts(8, 8));
+    let out = overhead_in(s, m, pipeline);
     (out.frame.pixel(4, 4), out.counts.metallic_lookups)
 }
 
@@ -72,28 +71,17 @@ fn with_smoothness_in_the_albedo_alpha_the_map_gives_metallic_alone() {
     let mut s = SceneBuilder::new();
     let albedo = s.texture(texture(1, 1, &[[255, 255, 255, 128]], Wrap::Repeat));
     let metal = s.texture(texture(1, 1, &[[255, 0, 0, 0]], Wrap::Repeat));
-    let whole = Tiling::default();
     let m = s.material(Material {
         smoothness: 1.0,
         smoothness_in_alpha: true,
         albedo_map: Some(TextureRef {
             texture: albedo,
-            tiling: whole,
+            tiling: Tiling::default(),
         }),
-        metallic_map: Some(MetallicMap {
-            map: TextureRef {
-                texture: metal,
-                tiling: whole,
-            },
-            smoothness: 0.25,
-        }),
+        metallic_map: metal_map(metal, 0.25),
         ..glossy(0.0, 1.0)
     });
-    s.floor(0.0, 0.0, 0.0, 20.0, m);
-    s.camera(top_down_camera(Vec3::new(0.0, 10.0, 0.0), 5.0));
-    s.light(directional_light(-Vec3::Y, 2.0, Shadows::Hard));
-    let (soup, kd) = s.build();
-    let got = render(&soup, &kd, &opts(8, 8)).0.frame.pixel(4, 4);
+    let got = overhead_in(s, m, Attenuation::BuiltIn).frame.pixel(4, 4);
     let want = 2.0 * COLOUR * built_in_peak(128.0 / 255.0);
     assert_close(got, want, 2e-4, "metal, smoothness from the albedo's alpha");
 }
@@ -103,18 +91,11 @@ fn with_smoothness_in_the_albedo_alpha_the_map_gives_metallic_alone() {
 /// is never read.
 #[test]
 fn a_mapped_metal_mirrors_and_an_unseen_map_is_not_read() {
-    let scene = |r: u8, lit: bool| {
+    let scene = |r: u8, lit: bool, depth: u32| {
         let mut s = SceneBuilder::new();
         let t = s.texture(texture(1, 1, &[[r, 0, 0, 255]], Wrap::Repeat));
         let floor = s.material(Material {
-            metallic_map: Some(MetallicMap {
-                map: TextureRef {
-                    texture: t,
-                    tiling: Tiling::default(),
-                },
-                smoothness: 1.0,
-            }),
-            highlights: false,
+            metallic_map: metal_map(t, 1.0),
             ..diffuse(Vec3::ONE)
         });
         s.floor(0.0, 0.0, 0.0, 20.0, floor);
@@ -132,10 +113,14 @@ fn a_mapped_metal_mirrors_and_an_unseen_map_is_not_read() {
             s.light(directional_light(-Vec3::Y, 1.0, Shadows::None));
         }
         let (soup, kd) = s.build();
-        let (out, plan) = render(&soup, &kd, &opts(4, 4));
+        let o = RenderOptions {
+            depth,
+            ..opts(4, 4)
+        };
+        let (out, plan) = render(&soup, &kd, &o);
         (out.frame.pixel(2, 2), out.counts.metallic_lookups, plan)
     };
-    let (metal, lookups, plan) = scene(255, false);
+    let (metal, lookups, plan) = scene(255, false, 4);
     assert!(plan.reflections.enabled, "{}", plan.reflections.reason);
     assert_close(
         metal,
@@ -144,35 +129,13 @@ fn a_mapped_metal_mirrors_and_an_unseen_map_is_not_read() {
         "the red ceiling, mirrored",
     );
     assert_eq!(lookups, 16);
-    let (dielectric, _, _) = scene(0, false);
+    let (dielectric, _, _) = scene(0, false, 4);
     assert_eq!(dielectric, Vec3::ZERO, "no light, no mirror: black");
-    let (lit, _, _) = scene(0, true);
+    let (lit, _, _) = scene(0, true, 4);
     assert_close(lit, Vec3::ONE, 1e-5, "diffuse white under light 1");
     // The same floor with no reflections asked for, no light and no ambient: nothing shows
     // what its map holds.
-    let (_, lookups, plan) = {
-        let mut s = SceneBuilder::new();
-        let t = s.texture(texture(1, 1, &[[255, 0, 0, 255]], Wrap::Repeat));
-        let floor = s.material(Material {
-            metallic_map: Some(MetallicMap {
-                map: TextureRef {
-                    texture: t,
-                    tiling: Tiling::default(),
-                },
-                smoothness: 1.0,
-            }),
-            ..diffuse(Vec3::ONE)
-        });
-        s.floor(0.0, 0.0, 0.0, 20.0, floor);
-        s.camera(top_down_camera(Vec3::new(0.0, 4.0, 0.0), 2.0));
-        let (soup, kd) = s.build();
-        let o = RenderOptions {
-            depth: 0,
-            ..opts(4, 4)
-        };
-        let (out, plan) = render(&soup, &kd, &o);
-        (out.frame.pixel(2, 2), out.counts.metallic_lookups, plan)
-    };
+    let (_, lookups, plan) = scene(255, false, 0);
     assert_eq!(lookups, 0);
     assert_eq!(plan.textures.textures, 0, "{}", plan.textures.reason);
 }

@@ -545,11 +545,7 @@ fn emission_maps_belong_to_glowing_materials() {
     assert!(t.srgb);
     assert_eq!(t.texels, QUADRANT_TEXELS);
 
-    let src = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/textures");
-    let dir = tempfile::tempdir().unwrap();
-    copy_dir(&src, dir.path());
-    let mat = dir.path().join("Assets/Materials/Glow.mat");
-    let text = std::fs::read_to_string(&mat).unwrap();
+    let (dir, mat, text) = glow_project();
     let guid = text
         .split("_EmissionMap:\n        m_Texture: {fileID: 2800000, guid: ")
         .nth(1)
@@ -579,11 +575,7 @@ fn emission_maps_belong_to_glowing_materials() {
 /// emission map that names the same file and import; a missing one is a warning.
 #[test]
 fn an_occlusion_map_is_read_with_its_strength() {
-    let src = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/textures");
-    let dir = tempfile::tempdir().unwrap();
-    copy_dir(&src, dir.path());
-    let mat = dir.path().join("Assets/Materials/Glow.mat");
-    let text = std::fs::read_to_string(&mat).unwrap();
+    let (dir, mat, text) = glow_project();
     let quadrants = "b9c15245bb706d4c19dc7f7ee351e73a";
     let with = |guid: &str| {
         text.replace(
@@ -624,11 +616,7 @@ fn an_occlusion_map_is_read_with_its_strength() {
 /// warning that leaves the material its `_Metallic` and `_Glossiness`.
 #[test]
 fn a_metallic_map_is_read_with_its_smoothness_scale_where_its_keyword_is_on() {
-    let src = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/textures");
-    let dir = tempfile::tempdir().unwrap();
-    copy_dir(&src, dir.path());
-    let mat = dir.path().join("Assets/Materials/Glow.mat");
-    let text = std::fs::read_to_string(&mat).unwrap();
+    let (dir, mat, text) = glow_project();
     let quadrants = "b9c15245bb706d4c19dc7f7ee351e73a";
     let with = |guid: &str, keyword: bool| {
         let t = text
@@ -674,4 +662,15 @@ fn a_metallic_map_is_read_with_its_smoothness_scale_where_its_keyword_is_on() {
                 .to_string()
         ]
     );
+}
+
+/// A copy of the bundled `textures` project, the path of its `Glow.mat` (the glowing quad of
+/// `EmissionMap.unity`) and that file's text, for a test to rewrite.
+fn glow_project() -> (tempfile::TempDir, PathBuf, String) {
+    let src = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/textures");
+    let dir = tempfile::tempdir().unwrap();
+    copy_dir(&src, dir.path());
+    let mat = dir.path().join("Assets/Materials/Glow.mat");
+    let text = std::fs::read_to_string(&mat).unwrap();
+    (dir, mat, text)
 }
