@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 pub const MAGIC: &[u8; 8] = b"UTSOUP\0\0";
-pub const VERSION: u32 = 13;
+pub const VERSION: u32 = 14;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Soup {
@@ -135,6 +135,11 @@ pub struct Material {
     /// The lights leave highlights on the surface: it is `pbs` and `_SpecularHighlights`
     /// is on.
     pub highlights: bool,
+    /// The skybox's reflection shows on the surface (where the scene has one, see
+    /// [`Environment::reflection`]): it is `pbs` and its shader's Reflections switch
+    /// (`_GlossyReflections`, URP's `_EnvironmentReflections`) is on. With the switch off,
+    /// Unity's shaders reflect one constant colour instead.
+    pub reflections: bool,
     /// `_Reflectivity` when the material sets it: overrides metallic·smoothness.
     pub reflectivity: Option<f32>,
     /// `_EmissionColor` when emission is enabled, linear RGB (HDR, may exceed 1).
@@ -259,6 +264,7 @@ impl Material {
             smoothness_in_alpha: false,
             pbs: true,
             highlights: true,
+            reflections: true,
             reflectivity: None,
             emission: Vec3::ZERO,
             cull: Cull::Back,
@@ -473,6 +479,11 @@ pub struct Environment {
     /// How far from the camera realtime shadows reach, where the project's pipeline limits
     /// them (None: at any distance).
     pub shadow_distance: Option<ShadowDistance>,
+    /// RenderSettings' Intensity Multiplier of the environment reflection, where the scene
+    /// reflects its skybox (`m_DefaultReflectionMode` 0, built-in or URP, and `sky` set):
+    /// physically based surfaces reflect the skybox as Unity's default reflection probe
+    /// holds it, times this. 0: no environment reflection.
+    pub reflection: f32,
 }
 
 /// URP's shadow distance: beyond `distance` from the camera no realtime shadow is drawn,
@@ -546,6 +557,7 @@ impl Default for Environment {
             sky: None,
             color_space: ColorSpace::Linear,
             shadow_distance: None,
+            reflection: 0.0,
         }
     }
 }
@@ -715,6 +727,10 @@ impl Soup {
                     d.distance, d.border
                 ));
             }
+        }
+        let r = self.environment.reflection;
+        if !(r.is_finite() && r >= 0.0) {
+            return Err(format!("environment reflection intensity {r}"));
         }
         if !self.environment.ambient.intensity.is_finite() {
             return Err(format!(

@@ -146,7 +146,7 @@ fn soup_round_trips_through_a_file() {
     assert_eq!(Soup::read(&path).unwrap(), s);
     let bytes = std::fs::read(&path).unwrap();
     assert_eq!(&bytes[..8], b"UTSOUP\0\0");
-    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 13);
+    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 14);
     // Nothing but the artifact is left in the folder (the temp file was renamed).
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     // A gamma-space project's soup says so.
@@ -163,6 +163,21 @@ fn soup_round_trips_through_a_file() {
     });
     u.write(&path).unwrap();
     assert_eq!(Soup::read(&path).unwrap(), u);
+    // And the environment reflection's intensity.
+    let mut r = sample_soup();
+    r.environment.reflection = 0.75;
+    r.write(&path).unwrap();
+    assert_eq!(Soup::read(&path).unwrap().environment.reflection, 0.75);
+}
+
+#[test]
+fn an_environment_reflection_must_be_a_finite_intensity() {
+    for r in [-0.5, f32::NAN, f32::INFINITY] {
+        refused(
+            &|s| s.environment.reflection = r,
+            &format!("environment reflection intensity {r}"),
+        );
+    }
 }
 
 #[test]
@@ -834,13 +849,13 @@ fn atomic_outputs_get_the_umask_permissions_not_the_temporary_files() {
 }
 
 #[test]
-fn a_version_12_soup_is_refused_with_the_versions_named() {
+fn a_version_13_soup_is_refused_with_the_versions_named() {
     let p = Path::new("old.soup");
     let mut b = sample_soup().to_bytes(p).unwrap();
-    b[8..12].copy_from_slice(&12u32.to_le_bytes());
+    b[8..12].copy_from_slice(&13u32.to_le_bytes());
     let msg = Soup::from_bytes(&b, p).unwrap_err().to_string();
     assert!(
-        msg.contains("soup format version 12, this build reads version 13"),
+        msg.contains("soup format version 13, this build reads version 14"),
         "{msg}"
     );
     assert!(msg.contains("re-run the stage that made it"), "{msg}");
@@ -874,14 +889,15 @@ fn draw_rule_fields_are_encoded_in_unitys_numbering() {
     assert_eq!(payload[o], 7);
     assert_eq!(&payload[o + 1..o + 5], &2u32.to_le_bytes(), "TwoSided is 2");
     assert_eq!(payload[o + 5], 0);
-    // Material: colour, metallic, smoothness, smoothness_in_alpha, pbs and highlights (a
-    // bool byte each), reflectivity (None: one byte), the 12-byte emission, then cull (u32
-    // variant).
+    // Material: colour, metallic, smoothness, smoothness_in_alpha, pbs, highlights and
+    // reflections (a bool byte each), reflectivity (None: one byte), the 12-byte emission,
+    // then cull (u32 variant).
     let m = find(b"builtin:Default-Material") + "builtin:Default-Material".len();
     assert_eq!(payload[m + 12 + 4 + 4], 0, "smoothness from _Glossiness");
     assert_eq!(payload[m + 12 + 4 + 4 + 1], 1, "physically based");
     assert_eq!(payload[m + 12 + 4 + 4 + 2], 1, "highlights on");
-    let cull = m + 12 + 4 + 4 + 1 + 1 + 1 + 1 + 12;
+    assert_eq!(payload[m + 12 + 4 + 4 + 3], 1, "reflections on");
+    let cull = m + 12 + 4 + 4 + 1 + 1 + 1 + 1 + 1 + 12;
     assert_eq!(&payload[cull..cull + 4], &1u32.to_le_bytes(), "Front is 1");
     assert_eq!(Soup::from_bytes(&b, p).unwrap(), s);
 }

@@ -64,6 +64,8 @@ fn write_project(root: &Path) -> std::path::PathBuf {
             ..LightDesc::point([1.0, 1.0, 1.0], 1.5, 6.0)
         },
     );
+    // The pixels follow from the light and the mirror alone: no sky reflection.
+    b.reflection(0.0);
     let project = b.finish("E2E", Ambient::Flat([0.0, 0.0, 0.0]));
     project.write(root).expect("write the test project");
     root.join("e2e/Assets/Scenes/E2E.unity")

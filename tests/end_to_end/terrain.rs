@@ -57,7 +57,8 @@ fn the_terrain_is_converted_with_a_layer_per_cell_and_its_trees_and_renders_them
     // Rock: the grey-brown texel (128, 118, 108) under a warm sun and the sky's light.
     let rock = |c: Vec3| c.x > c.y && c.y > c.z && c.y > 0.7 * c.x && c.x > 0.05;
     // The leaves' albedo (0.16, 0.42, 0.12) is greener than the grass (0.34, 0.55, 0.2).
-    let leaves = |c: Vec3| c.y > 4.0 * c.x && c.y > 4.0 * c.z;
+    // (They reflect a little of the sky.)
+    let leaves = |c: Vec3| c.y > 3.0 * c.x && c.y > 3.0 * c.z;
     // The foreground is grass, the trees stand in a band across the middle, the high
     // hill's top (right of centre, upper third) is rock, and the sky above it blue.
     for (x, y) in [(20, 28), (30, 31), (40, 16)] {

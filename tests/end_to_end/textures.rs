@@ -2,7 +2,7 @@
 //! (written by `scenegen`): each scene is a Quad whose every pixel follows from a texel.
 //!
 //! Every scene is lit by one white directional light of intensity 1 and has no ambient
-//! light, so a lit pixel is texel · tint times the Standard shader's diffuse term (smoothness
+//! light and no sky reflection (its intensity is 0), so a lit pixel is texel · tint times the Standard shader's diffuse term (smoothness
 //! 0, Specular Highlights off). The Quads face the camera; image x grows to the right and y
 //! downwards.
 

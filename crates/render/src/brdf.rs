@@ -70,6 +70,39 @@ impl Brdf {
         }
     }
 
+    /// What a point reflects of the environment (Unity's reflection probe), per unit of
+    /// the probe's radiance, where its colour (times its texel) is `base`, its metallic
+    /// value and smoothness `metallic` and `smoothness`, and `nv` the cosine between its
+    /// shading normal and the direction towards the eye: the surface reduction times
+    /// Fresnel's blend from f0 towards the grazing term, saturate(smoothness + 1 −
+    /// (1 − dielectric)(1 − metallic)), by (1 − n·v)⁵ in the built-in pipeline
+    /// (`BRDF1_Unity_PBS`) and (1 − n·v)⁴ in URP (`EnvironmentBRDFSpecular`).
+    pub fn environment(self, base: Vec3, metallic: f32, smoothness: f32, nv: f32) -> Vec3 {
+        let metallic = metallic.clamp(0.0, 1.0);
+        let smoothness = smoothness.clamp(0.0, 1.0);
+        let d = self.dielectric();
+        let f0 = Vec3::splat(d).lerp(base, metallic);
+        let grazing = (smoothness + 1.0 - (1.0 - d) * (1.0 - metallic)).min(1.0);
+        let pr = 1.0 - smoothness;
+        let (reduction, fresnel) = match self {
+            Brdf::BuiltIn { gamma } => {
+                let r = (pr * pr).max(0.002);
+                let reduction = if gamma {
+                    1.0 - 0.28 * r * pr
+                } else {
+                    1.0 / (r * r + 1.0)
+                };
+                (reduction, (1.0 - nv.abs().min(1.0)).powi(5))
+            }
+            Brdf::Universal => {
+                let r = (pr * pr).max(0.007_812_5);
+                let r2 = (r * r).max(6.103_515_6e-5);
+                (1.0 / (r2 + 1.0), (1.0 - nv.clamp(0.0, 1.0)).powi(4))
+            }
+        };
+        f0.lerp(Vec3::splat(grazing), fresnel) * reduction
+    }
+
     /// The glossy side of a point whose colour (times its texel) is `base` and whose
     /// metallic value and smoothness are `metallic` and `smoothness`, with unit shading
     /// normal `n`, seen along unit `view` (from the point towards the eye).
@@ -227,6 +260,43 @@ mod tests {
     use formats::texture::{TextureRef, Tiling};
     use formats::MetallicMap;
     use std::f32::consts::PI;
+
+    #[test]
+    fn environment_reflection_follows_each_pipelines_formula() {
+        let built_in = Brdf::BuiltIn { gamma: false };
+        let grey = Vec3::splat(0.5);
+        let near = |a: Vec3, b: f32| (a - Vec3::splat(b)).abs().max_element() < 1e-6;
+        // Smoothness 0.5: roughness 0.25, surface reduction 1/(0.25² + 1); grazing 0.54.
+        let reduction = 1.0 / 1.0625;
+        assert!(near(
+            built_in.environment(grey, 0.0, 0.5, 1.0),
+            0.04 * reduction
+        ));
+        let fifth = 0.5f32.powi(5);
+        let want = (0.04 + 0.5 * fifth) * reduction;
+        assert!(near(built_in.environment(grey, 0.0, 0.5, 0.5), want));
+        assert!(
+            near(built_in.environment(grey, 0.0, 0.5, -0.5), want),
+            "|n·v|"
+        );
+        let fourth = 0.5f32.powi(4);
+        let urp = Brdf::Universal.environment(grey, 0.0, 0.5, 0.5);
+        assert!(near(urp, (0.04 + 0.5 * fourth) * reduction));
+        assert!(near(
+            Brdf::Universal.environment(grey, 0.0, 0.5, -0.5),
+            0.54 * reduction
+        ));
+        // A smooth metal reflects its colour head-on, white at grazing angles.
+        let gold = Vec3::new(0.8, 0.6, 0.2);
+        // (Unity keeps the roughness at 0.002 or more.)
+        let smooth = 1.0 / (0.002f32 * 0.002 + 1.0);
+        let head_on = built_in.environment(gold, 1.0, 1.0, 1.0);
+        assert!((head_on - gold * smooth).abs().max_element() < 1e-6);
+        assert!(near(built_in.environment(gold, 1.0, 1.0, 0.0), smooth));
+        // A gamma project's shaders: the encoded dielectric and 1 − 0.28·r·p.
+        let gamma = Brdf::BuiltIn { gamma: true }.environment(grey, 0.0, 0.5, 1.0);
+        assert!(near(gamma, DIELECTRIC_GAMMA * (1.0 - 0.28 * 0.25 * 0.5)));
+    }
 
     /// A gloss on a surface facing +Y, seen along `view`.
     struct Seen {

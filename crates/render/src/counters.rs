@@ -38,6 +38,8 @@ pub struct RayCounts {
     pub occlusion_lookups: u64,
     /// Metallic map texels read.
     pub metallic_lookups: u64,
+    /// Reflection probe lookups: the skybox reflected by a physically based surface.
+    pub probe_lookups: u64,
     /// Alpha lookups: cut-out tests inside the traversals and blended surfaces' alpha where
     /// no albedo lookup gave it.
     pub alpha_lookups: u64,
@@ -65,6 +67,7 @@ impl RayCounts {
         self.emission_lookups += o.emission_lookups;
         self.occlusion_lookups += o.occlusion_lookups;
         self.metallic_lookups += o.metallic_lookups;
+        self.probe_lookups += o.probe_lookups;
         self.alpha_lookups += o.alpha_lookups;
         self.fogged += o.fogged;
         self.sanitized += o.sanitized;
@@ -92,6 +95,7 @@ pub struct SharedCounts {
     emission_lookups: AtomicU64,
     occlusion_lookups: AtomicU64,
     metallic_lookups: AtomicU64,
+    probe_lookups: AtomicU64,
     alpha_lookups: AtomicU64,
     fogged: AtomicU64,
     sanitized: AtomicU64,
@@ -117,6 +121,7 @@ impl SharedCounts {
         self.occlusion_lookups
             .fetch_add(c.occlusion_lookups, Relaxed);
         self.metallic_lookups.fetch_add(c.metallic_lookups, Relaxed);
+        self.probe_lookups.fetch_add(c.probe_lookups, Relaxed);
         self.alpha_lookups.fetch_add(c.alpha_lookups, Relaxed);
         self.fogged.fetch_add(c.fogged, Relaxed);
         self.sanitized.fetch_add(c.sanitized, Relaxed);
@@ -138,6 +143,7 @@ impl SharedCounts {
             emission_lookups: self.emission_lookups.load(Relaxed),
             occlusion_lookups: self.occlusion_lookups.load(Relaxed),
             metallic_lookups: self.metallic_lookups.load(Relaxed),
+            probe_lookups: self.probe_lookups.load(Relaxed),
             alpha_lookups: self.alpha_lookups.load(Relaxed),
             fogged: self.fogged.load(Relaxed),
             sanitized: self.sanitized.load(Relaxed),

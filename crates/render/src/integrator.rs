@@ -4,6 +4,7 @@
 //! L = emission + ambient(n)·diffuse colour
 //!   + Σ_lights visible · falloff · intensity·colour · (max(0, n·l) · diffuse colour · shape
 //!     + highlight)
+//!   + max(0, environment(n·v) − reflectance) · probe(r, smoothness)
 //!   + reflectance · L(mirror ray)        while bounce < depth and weight ≥ cutoff
 //! ```
 //!
@@ -14,7 +15,9 @@
 //! shader lights as diffuse, the shape 1 (URP) or the built-in pipeline's Disney term, and
 //! the highlight the specular term of the pipeline's shader for a punctual light (see
 //! [`crate::brdf`]); otherwise the diffuse colour is the albedo, the shape 1 and there is
-//! no highlight.
+//! no highlight. Where the scene reflects its skybox, a physically based surface also takes
+//! it from Unity's default reflection probe ([`crate::probe`]) along r, the view mirrored
+//! about n, by its pipeline's environment term, less what its traced mirror ray brings.
 //!
 //! Albedo is colour·texel·(1 − metallic) where the material has a map and the plan turns
 //! textures on: the texel is looked up at the hit's interpolated UV through the material's
@@ -45,6 +48,7 @@ use crate::offset::{
     hit_point, intersector_margin, offset_origin, SHADOW_TMAX_FRACTION, SPAWN_TMIN,
 };
 use crate::plan::{colour_mapped, Plan, ShadowMode};
+use crate::probe::Probe;
 use crate::sampling::{DiscSpiral, Rng};
 use crate::sky::{SkyAmbient, Skybox};
 use crate::soft::{probe_asked, probe_fits, SoftCone};
@@ -346,6 +350,9 @@ pub struct Integrator<'a> {
     shadow_fade: Option<ShadowFade>,
     /// The pipeline's formulas for physically based materials.
     brdf: Brdf,
+    /// The skybox as Unity's default reflection probe holds it, where the plan has
+    /// physically based surfaces reflect it.
+    probe: Option<Box<Probe>>,
 }
 
 /// [`Integrator::sides`] bits: camera and reflection rays that meet the triangle's front
@@ -383,6 +390,30 @@ fn sides(soup: &Soup) -> Vec<u8> {
             .fold(0, |b, &(on, bit)| if on { b | bit } else { b })
         })
         .collect()
+}
+
+/// The skybox's reflection probe, where the plan has surfaces reflect it.
+fn probe(soup: &Soup, plan: &Plan) -> Option<Probe> {
+    let env = &soup.environment;
+    let sky = env.sky.as_ref().filter(|_| plan.sky_reflections.enabled)?;
+    let sky = Skybox::new(sky, env.color_space);
+    // The smoothness each physically based material takes: one value, or from 0 to its
+    // scale where a map or the albedo's alpha gives it.
+    let ranges = soup
+        .materials
+        .iter()
+        .filter(|m| m.pbs && !m.unlit)
+        .map(|m| match (&m.metallic_map, m.smoothness_in_alpha) {
+            (_, true) => (0.0, m.smoothness),
+            (Some(map), false) => (0.0, map.smoothness),
+            (None, false) => (m.smoothness, m.smoothness),
+        });
+    let needed = Probe::levels_read(ranges);
+    Some(Probe::new(
+        |d, spread| sky.radiance(d, spread),
+        env.reflection,
+        needed,
+    ))
 }
 
 /// The skybox's ambient light, where the plan lights surfaces with skybox ambient.
@@ -527,7 +558,13 @@ impl<'a> Integrator<'a> {
             tangents,
             shadow_fade,
             brdf,
+            probe: probe(soup, plan).map(Box::new),
         }
+    }
+
+    /// Bytes of the reflection probe's levels (0 without one).
+    pub fn probe_bytes(&self) -> u64 {
+        self.probe.as_ref().map_or(0, |p| p.bytes())
     }
 
     /// Bytes of the mip levels this render built (the full-size images are the soup's).

@@ -36,6 +36,7 @@ pub mod offset;
 pub mod options;
 pub mod plan;
 pub mod preview;
+pub mod probe;
 pub mod render;
 pub mod sampling;
 pub mod sky;

@@ -145,6 +145,10 @@ pub struct Plan {
     pub alpha: AlphaPlan,
     pub reflections: ReflectionPlan,
     pub ambient: Effect,
+    /// The skybox reflected by physically based surfaces, as Unity's default reflection
+    /// probe holds it: on when the scene reflects its skybox and a used material is
+    /// physically based.
+    pub sky_reflections: Effect,
     pub emission: Effect,
     /// RenderSettings fog: on when the scene has fog that can thin a surface's colour.
     pub fog: Effect,
@@ -295,6 +299,8 @@ impl Plan {
             },
         };
 
+        let sky_reflections = sky_reflection_plan(soup, &mats);
+
         let glowing: Vec<&Material> = mats
             .iter()
             .filter(|m| m.emission.max_element() > 0.0)
@@ -362,6 +368,7 @@ impl Plan {
                     && (opts.aovs.normal
                         || (direct.enabled && shows_light(m))
                         || (diffuse_normal && m.albedo().max_element() > 0.0)
+                        || (sky_reflections.enabled && m.pbs)
                         || (reflections.enabled && mirror(m)))
             })
             .copied()
@@ -389,6 +396,7 @@ impl Plan {
                 m.occlusion_map.is_some()
                     && !m.unlit
                     && ((ambient.enabled && m.albedo().max_element() > 0.0)
+                        || (sky_reflections.enabled && m.pbs)
                         || (reflections.enabled && mirror(m)))
             })
             .copied()
@@ -411,6 +419,7 @@ impl Plan {
                     && (opts.aovs.albedo
                         || (direct.enabled && shows_light(m))
                         || (ambient.enabled && m.albedo().max_element() > 0.0)
+                        || (sky_reflections.enabled && m.pbs)
                         || (reflections.enabled && mirror(m)))
             })
             .copied()
@@ -457,6 +466,7 @@ impl Plan {
             alpha,
             reflections,
             ambient,
+            sky_reflections,
             emission,
             fog,
             anti_aliasing,
@@ -520,6 +530,11 @@ impl Plan {
             self.ambient.reason
         );
         s += &format!(
+            "  sky reflection {}  {}\n",
+            on(self.sky_reflections.enabled),
+            self.sky_reflections.reason
+        );
+        s += &format!(
             "  emission       {}  {}\n",
             on(self.emission.enabled),
             self.emission.reason
@@ -541,6 +556,44 @@ impl Plan {
 
     pub fn to_json(&self) -> serde_json::Value {
         serde_json::to_value(self).unwrap_or(serde_json::Value::Null)
+    }
+}
+
+/// Physically based surfaces reflect the skybox where the scene's default reflection
+/// probe holds it (a skybox the soup holds, and an intensity above 0).
+fn sky_reflection_plan(soup: &Soup, mats: &[&Material]) -> Effect {
+    let env = &soup.environment;
+    let pbs = mats.iter().filter(|m| m.pbs && !m.unlit).count();
+    let constant = mats
+        .iter()
+        .filter(|m| m.pbs && !m.unlit && !m.reflections)
+        .count();
+    let off = |reason: &str| Effect {
+        enabled: false,
+        reason: reason.into(),
+    };
+    if env.sky.is_none() {
+        off("the scene reflects no skybox the soup holds")
+    } else if env.reflection <= 0.0 {
+        off("the environment reflection's intensity is 0")
+    } else if pbs == 0 {
+        off("no material is physically based")
+    } else {
+        let size = crate::probe::RESOLUTION;
+        Effect {
+            enabled: true,
+            reason: format!(
+                "{pbs} physically based materials reflect the skybox as Unity's default \
+                 reflection probe holds it ({size}² a face, each level prefiltered for its \
+                 roughness), intensity {}{}",
+                env.reflection,
+                if constant > 0 {
+                    format!("; {constant} with Reflections off reflect its mean colour")
+                } else {
+                    String::new()
+                }
+            ),
+        }
     }
 }
 

@@ -195,12 +195,25 @@ pub fn emit(g: &Graph, scene_rel: &str, camera: Option<&str>) -> Result<Emitted,
                 .warnings
                 .push(format!("{scene_rel}: RenderSettings: {why}")),
         }
-        // The skybox shows behind a Skybox camera and lights Skybox ambient.
+        let reflection = match crate::environment::reflection(rs, hdrp) {
+            Ok(r) => r,
+            Err(why) => {
+                e.soup
+                    .warnings
+                    .push(format!("{scene_rel}: RenderSettings: {why}"));
+                0.0
+            }
+        };
+        // The skybox shows behind a Skybox camera, lights Skybox ambient and is what
+        // surfaces reflect.
         let env = &e.soup.environment;
-        if env.clear == formats::ClearFlags::Skybox
-            || env.ambient.mode == formats::AmbientMode::Skybox
-        {
-            e.sky(rs);
+        let seen = env.clear == formats::ClearFlags::Skybox
+            || env.ambient.mode == formats::AmbientMode::Skybox;
+        if seen || reflection > 0.0 {
+            e.sky(rs, seen);
+        }
+        if e.soup.environment.sky.is_some() {
+            e.soup.environment.reflection = reflection;
         }
     }
     let placements = std::mem::take(&mut e.placements);

@@ -35,6 +35,29 @@ pub fn ambient(rs: &Node, space: ColorSpace) -> Option<Ambient> {
     .then_some(amb)
 }
 
+/// The Intensity Multiplier of the environment reflection a RenderSettings body sets, where
+/// Unity's default reflection probe holds the skybox (`m_DefaultReflectionMode` 0, the
+/// default); `Err` with the reason where it holds something the soup cannot (a custom
+/// cubemap). HDRP has no such probe (its sky is a Volume override): 0.
+pub fn reflection(rs: &Node, hdrp: bool) -> Result<f32, String> {
+    if hdrp {
+        return Ok(0.0);
+    }
+    let intensity = rs.f32_at("m_ReflectionIntensity").unwrap_or(1.0);
+    match rs.i64_at("m_DefaultReflectionMode").unwrap_or(0) {
+        0 if intensity.is_finite() => Ok(intensity.max(0.0)),
+        0 => Err(format!(
+            "environment reflection intensity {intensity} is not finite; drawn without \
+             environment reflection"
+        )),
+        _ => Err(
+            "the environment reflection is a custom cubemap, which is not read; drawn \
+                  without environment reflection"
+                .into(),
+        ),
+    }
+}
+
 /// The fog a RenderSettings body turns on (`m_Fog: 1`), with Unity's defaults for what it
 /// does not say; `Err` with the reason when it cannot be drawn. HDRP draws its fog from a
 /// Volume override and ignores these settings.
@@ -90,6 +113,27 @@ mod tests {
     fn fog_of(fields: &str, hdrp: bool) -> Result<Option<Fog>, String> {
         let rs = parse(&format!("RenderSettings:\n  m_Fog: 1\n{fields}"));
         fog(rs.get("RenderSettings").unwrap(), hdrp, ColorSpace::Linear)
+    }
+
+    #[test]
+    fn reflection_reads_the_skybox_modes_intensity() {
+        let of = |fields: &str, hdrp: bool| {
+            let rs = parse(&format!("RenderSettings:\n  m_Fog: 0\n{fields}"));
+            reflection(rs.get("RenderSettings").unwrap(), hdrp)
+        };
+        assert_eq!(of("", false), Ok(1.0), "Unity's defaults: skybox, 1");
+        let half = "  m_DefaultReflectionMode: 0\n  m_ReflectionIntensity: 0.5\n";
+        assert_eq!(of(half, false), Ok(0.5));
+        assert_eq!(
+            of(half, true),
+            Ok(0.0),
+            "HDRP has no default reflection probe"
+        );
+        assert_eq!(of("  m_ReflectionIntensity: -2\n", false), Ok(0.0));
+        let custom = of("  m_DefaultReflectionMode: 1\n", false).unwrap_err();
+        assert!(custom.contains("custom cubemap"), "{custom}");
+        let nan = of("  m_ReflectionIntensity: 1e99\n", false).unwrap_err();
+        assert!(nan.contains("not finite"), "{nan}");
     }
 
     #[test]

@@ -157,6 +157,7 @@ pub fn convert(body: &Node, source: &str) -> (Material, Vec<String>) {
     m.alpha = alpha_mode(body, &float);
     m.pbs = pbs(body, &float);
     m.highlights = m.pbs && highlights_on(body, &float);
+    m.reflections = m.pbs && reflections_on(body, &float);
     if let Some(x) = float("_Reflectivity") {
         m.reflectivity = Some(x.clamp(0.0, 1.0));
     }
@@ -175,6 +176,7 @@ pub fn convert(body: &Node, source: &str) -> (Material, Vec<String>) {
         m.smoothness = 0.0;
         m.pbs = false;
         m.highlights = false;
+        m.reflections = false;
         m.reflectivity = None;
         m.emission = Vec3::ZERO;
         if u.two_sided {
@@ -276,6 +278,22 @@ fn highlights_on(body: &Node, float: &dyn Fn(&str) -> Option<f32>) -> bool {
     match keyword_on(body, "_SPECULARHIGHLIGHTS_OFF") {
         Some(off) => !off,
         None => float("_SpecularHighlights") != Some(0.0),
+    }
+}
+
+/// Whether a physically based shader's Reflections switch is on: Standard's
+/// `_GLOSSYREFLECTIONS_OFF` and URP Lit's `_ENVIRONMENTREFLECTIONS_OFF` keywords, or their
+/// floats `_GlossyReflections` and `_EnvironmentReflections` in a file without keywords.
+fn reflections_on(body: &Node, float: &dyn Fn(&str) -> Option<f32>) -> bool {
+    let keyword = keyword_on(body, "_GLOSSYREFLECTIONS_OFF")
+        .zip(keyword_on(body, "_ENVIRONMENTREFLECTIONS_OFF"))
+        .map(|(a, b)| a || b);
+    match keyword {
+        Some(off) => !off,
+        None => {
+            float("_GlossyReflections") != Some(0.0)
+                && float("_EnvironmentReflections") != Some(0.0)
+        }
     }
 }
 
@@ -879,6 +897,40 @@ mod tests {
         // URP Lit (a project shader, by GUID) with its smoothness.
         let urp = parse("Material:\n  m_Shader: {fileID: 4800000, guid: 933532a4fcc9baf4fa0491de14d08ed7, type: 3}\n  m_ValidKeywords: []\n  m_SavedProperties:\n    m_Floats:\n    - _Smoothness: 0.5\n    - _SpecularHighlights: 1\n");
         assert!(convert(urp.get("Material").unwrap(), "u.mat").0.highlights);
+    }
+
+    #[test]
+    fn reflections_follow_each_pipelines_switch() {
+        let on = |shader: &str, keywords: &str, floats: &str| {
+            let text = format!("Material:\n  m_Shader: {shader}\n{keywords}  m_SavedProperties:\n    m_Floats:\n    - _Glossiness: 0.5\n    - _Smoothness: 0.5\n{floats}    m_Colors: []\n");
+            convert(parse(&text).get("Material").unwrap(), "a.mat")
+                .0
+                .reflections
+        };
+        let standard = "{fileID: 46, guid: 0000000000000000f000000000000000, type: 0}";
+        let urp = "{fileID: 4800000, guid: 933532a4fcc9baf4fa0491de14d08ed7, type: 3}";
+        let legacy = "{fileID: 7, guid: 0000000000000000f000000000000000, type: 0}";
+        let unlit = "{fileID: 10752, guid: 0000000000000000f000000000000000, type: 0}";
+        assert!(on(standard, "  m_ShaderKeywords: \n", ""));
+        assert!(!on(
+            standard,
+            "  m_ShaderKeywords: _GLOSSYREFLECTIONS_OFF\n",
+            ""
+        ));
+        assert!(!on(standard, "", "    - _GlossyReflections: 0\n"));
+        // The keyword list is what the shader compiles by.
+        assert!(on(
+            standard,
+            "  m_ShaderKeywords: \n",
+            "    - _GlossyReflections: 0\n"
+        ));
+        assert!(on(urp, "  m_ValidKeywords: []\n", ""));
+        let urp_off = "  m_ValidKeywords:\n  - _ENVIRONMENTREFLECTIONS_OFF\n";
+        assert!(!on(urp, urp_off, ""));
+        assert!(!on(urp, "", "    - _EnvironmentReflections: 0\n"));
+        // Lambert's shaders and unlit ones reflect nothing.
+        assert!(!on(legacy, "", ""));
+        assert!(!on(unlit, "", ""));
     }
 
     fn alpha_of(text: &str) -> (Alpha, f32) {

@@ -486,7 +486,8 @@ pub fn aim(sky: &mut ProceduralSky, lights: &[Light], named: Option<usize>) {
 impl Emitter<'_, '_> {
     /// The procedural sky RenderSettings `rs` names, aimed at the scene's sun (the top
     /// scene's file is the graph's first).
-    pub(crate) fn sky(&mut self, rs: &Node) {
+    /// `seen`: a camera or the ambient light shows it, not only reflections.
+    pub(crate) fn sky(&mut self, rs: &Node, seen: bool) {
         let mut warnings = Vec::new();
         let sky = skybox(rs, self.g.project, &mut warnings);
         for w in warnings {
@@ -503,8 +504,13 @@ impl Emitter<'_, '_> {
             Ok(Some(sky)) => self.soup.environment.sky = Some(sky),
             Ok(None) => {}
             Err(why) => self.soup.warnings.push(format!(
-                "{}: RenderSettings: {why}; a sky gradient stands in",
-                self.scene_rel
+                "{}: RenderSettings: {why}; {}",
+                self.scene_rel,
+                if seen {
+                    "a sky gradient stands in"
+                } else {
+                    "surfaces reflect no sky"
+                }
             )),
         }
     }

@@ -181,6 +181,7 @@ fn build(large: Option<usize>) -> Project {
         ambient: Ambient::Flat([0.0, 0.0, 0.0]),
         fog: None,
         skybox: None,
+        reflection: 1.0,
         objects,
     };
     p.add_asset(path, unity::write_scene(key, &scene), meta::scene);

@@ -18,6 +18,7 @@ pub struct Builder {
     objects: Vec<Object>,
     fog: Option<FogDesc>,
     skybox: Option<String>,
+    reflection: f32,
 }
 
 impl Builder {
@@ -37,7 +38,15 @@ impl Builder {
             objects: Vec::new(),
             fog: None,
             skybox: None,
+            reflection: 1.0,
         }
+    }
+
+    /// Set the environment reflection's intensity of the scenes written next (0: surfaces
+    /// reflect no sky, as a scene whose pixels follow from its lights alone needs).
+    pub fn reflection(&mut self, intensity: f32) -> &mut Self {
+        self.reflection = intensity;
+        self
     }
 
     /// Turn on RenderSettings fog in the scene written next.
@@ -97,6 +106,7 @@ impl Builder {
             ambient,
             fog: self.fog.take(),
             skybox: self.skybox.clone(),
+            reflection: self.reflection,
             objects: std::mem::take(&mut self.objects),
         };
         self.project
@@ -148,6 +158,7 @@ impl Builder {
             ambient,
             fog: self.fog.take(),
             skybox: self.skybox.clone(),
+            reflection: self.reflection,
             objects: std::mem::take(&mut self.objects),
         };
         self.project

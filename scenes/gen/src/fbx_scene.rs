@@ -184,6 +184,7 @@ pub fn project(models: usize, instances: usize, compress: bool) -> Project {
         ambient: Ambient::Flat([0.1, 0.1, 0.12]),
         fog: None,
         skybox: None,
+        reflection: 1.0,
         objects,
     };
     p.add_asset(

@@ -91,6 +91,8 @@ pub fn project() -> Project {
             ..MatDesc::matte("Wall", [0.75, 0.75, 0.75])
         }],
     );
+    // Every pixel follows from a texel and the sun alone.
+    b.reflection(0.0);
     let quadrants = b.texture(
         "Assets/Textures/Quadrants.png",
         png(2, 2, &QUADRANTS),

@@ -157,6 +157,8 @@ pub struct SceneDesc {
     pub fog: Option<FogDesc>,
     /// GUID of the project's skybox material; Unity's Default-Skybox without one.
     pub skybox: Option<String>,
+    /// The environment reflection's Intensity Multiplier (Unity's default 1).
+    pub reflection: f32,
     pub objects: Vec<Object>,
 }
 
@@ -244,7 +246,7 @@ pub fn write_scene(scene_key: &str, scene: &SceneDesc) -> String {
     docs.sort_by_key(|(id, _)| *id);
     let mut s = String::from("%YAML 1.1\n%TAG !u! tag:unity3d.com,2011:\n");
     s += OCCLUSION_LIGHTMAP_NAVMESH_HEAD;
-    s += &render_settings(&scene.ambient, scene.fog.as_ref(), scene.skybox.as_deref());
+    s += &render_settings(scene);
     s += LIGHTMAP_NAVMESH;
     for (_, d) in docs {
         s += &d;
@@ -654,7 +656,8 @@ fn audio_listener(id: i64, go: i64) -> String {
     format!("--- !u!81 &{id}\nAudioListener:\n{PREFAB_FIELDS}  m_GameObject: {{fileID: {go}}}\n  m_Enabled: 1\n")
 }
 
-fn render_settings(ambient: &Ambient, fog: Option<&FogDesc>, skybox: Option<&str>) -> String {
+fn render_settings(scene: &SceneDesc) -> String {
+    let (ambient, fog, skybox) = (&scene.ambient, scene.fog.as_ref(), scene.skybox.as_deref());
     let black = [0.0, 0.0, 0.0];
     // Unity's new-scene fog settings, switched off, unless the scene asks for fog.
     let off = FogDesc {
@@ -700,7 +703,7 @@ RenderSettings:
   m_DefaultReflectionMode: 0
   m_DefaultReflectionResolution: 128
   m_ReflectionBounces: 1
-  m_ReflectionIntensity: 1
+  m_ReflectionIntensity: {reflection}
   m_CustomReflection: {{fileID: 0}}
   m_Sun: {{fileID: 0}}
   m_IndirectSpecularColor: {{r: 0, g: 0, b: 0, a: 1}}
@@ -715,6 +718,7 @@ RenderSettings:
         density = num(f.density),
         start = num(f.start),
         end = num(f.end),
+        reflection = num(scene.reflection),
     )
 }
 

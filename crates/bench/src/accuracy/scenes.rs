@@ -66,6 +66,7 @@ fn material(name: &str, color: Vec3, metallic: f32, smoothness: f32) -> Material
         smoothness_in_alpha: false,
         pbs: false,
         highlights: false,
+        reflections: false,
         reflectivity: None,
         emission: Vec3::ZERO,
         // Two-sided: the analytic references draw both faces.
@@ -113,6 +114,7 @@ fn environment(background: Vec3, ambient: Vec3) -> Environment {
         sky: None,
         color_space: formats::ColorSpace::Linear,
         shadow_distance: None,
+        reflection: 0.0,
     }
 }
 

@@ -324,6 +324,9 @@ fn run(a: RenderArgs) -> Result<()> {
             plan.textures.bytes as f64 / (1u64 << 20) as f64
         );
     }
+    if c.probe_lookups > 0 {
+        eprintln!("kd2exr: reflection probe lookups {}", c.probe_lookups);
+    }
     if c.sanitized > 0 {
         eprintln!(
             "kd2exr: warning: {} samples were NaN or infinite and were set to 0 (check the scene's materials and lights)",

@@ -323,6 +323,7 @@ mod tests {
             smoothness_in_alpha: false,
             pbs: false,
             highlights: false,
+            reflections: false,
             reflectivity: None,
             emission: Vec3::ZERO,
             cull,

@@ -157,11 +157,13 @@ impl Integrator<'_> {
             Diffuse::LAMBERT
         };
         let mut reflectance = mat.reflectance_at(metallic, smoothness);
+        let probe = self.probe.as_deref().filter(|_| pbs);
         // The share of ambient light and reflection the occlusion map leaves (1 without
         // one: a product with 1 leaves every other pixel's bits as they were).
         let occlusion = match surfacing.and_then(|s| s.occlusion) {
             Some((i, tiling, strength))
                 if (lit && self.ambient)
+                    || probe.is_some()
                     || (self.max_depth > 0 && reflectance.max_element() > 0.0) =>
             {
                 counts.occlusion_lookups += 1;
@@ -176,6 +178,22 @@ impl Integrator<'_> {
                 None => environment::ambient(&self.soup.environment, ns),
             };
             l += ambient * diffuse_colour * occlusion;
+        }
+        if let Some(probe) = probe {
+            // Unity's reflection of the probe, less what the traced mirror ray brings.
+            let view = -ray.dir;
+            let nv = ns.dot(view);
+            let w = self.brdf.environment(base, metallic, smoothness, nv) * occlusion;
+            let w = (w - reflectance).max(Vec3::ZERO);
+            if w.max_element() > 0.0 {
+                let seen = if mat.reflections {
+                    counts.probe_lookups += 1;
+                    probe.at(ns * (2.0 * nv) - view, smoothness)
+                } else {
+                    probe.mean
+                };
+                l += w * seen;
+            }
         }
         Some(Lit {
             fade: self.shadow_fade.map_or(0.0, |f| f.at(surf.p)),

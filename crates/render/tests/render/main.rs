@@ -11,5 +11,6 @@ mod highlights;
 mod lighting;
 mod metallic;
 mod plan;
+mod reflections;
 mod robustness;
 mod textures;

@@ -247,22 +247,49 @@ fn the_default_skybox_is_a_procedural_sky_aimed_at_the_sun() {
         soup.lights[0].color * soup.lights[0].intensity
     );
 
-    // A solid-colour camera still needs the sky for Skybox ambient (mode 0), not for flat.
-    let solid = |mode: u8| {
+    // A solid-colour camera still needs the sky for Skybox ambient (mode 0) and for the
+    // default reflection probe (intensity 1 unless the file says otherwise), not for flat
+    // ambient without reflection.
+    let solid = |mode: u8, reflection: &str| {
         let text = skybox("{fileID: 10304, guid: 0000000000000000f000000000000000, type: 0}")
             .replace("  m_ClearFlags: 1\n", "  m_ClearFlags: 2\n")
             .replace(
                 "  m_Sun: {fileID: 0}\n",
                 &format!(
-                    "  m_Sun: {{fileID: 0}}\n  m_AmbientMode: {mode}\n  m_AmbientIntensity: 0.5\n"
+                    "  m_Sun: {{fileID: 0}}\n  m_AmbientMode: {mode}\n  m_AmbientIntensity: 0.5\n{reflection}"
                 ),
             );
         convert_scene(&text).environment
     };
-    let env = solid(0);
+    let none = "  m_ReflectionIntensity: 0\n";
+    let env = solid(0, none);
     assert!(env.sky.is_some());
     assert_eq!(env.ambient.intensity, 0.5);
-    assert!(solid(3).sky.is_none());
+    assert_eq!(env.reflection, 0.0);
+    assert!(solid(3, none).sky.is_none());
+    let reflecting = solid(3, "");
+    assert!(reflecting.sky.is_some());
+    assert_eq!(reflecting.reflection, 1.0, "Unity's default intensity");
+    let half = solid(
+        3,
+        "  m_DefaultReflectionMode: 0\n  m_ReflectionIntensity: 0.5\n",
+    );
+    assert_eq!(half.reflection, 0.5);
+    // A custom cubemap is not read: no reflection, and a warning says so.
+    let text = skybox("{fileID: 10304, guid: 0000000000000000f000000000000000, type: 0}").replace(
+        "  m_Sun: {fileID: 0}\n",
+        "  m_Sun: {fileID: 0}\n  m_DefaultReflectionMode: 1\n",
+    );
+    let custom = convert_scene(&text);
+    assert_eq!(custom.environment.reflection, 0.0);
+    assert!(
+        custom
+            .warnings
+            .iter()
+            .any(|w| w.contains("custom cubemap, which is not read")),
+        "{:?}",
+        custom.warnings
+    );
 
     let cubemap =
         "--- !u!21 &2100000\nMaterial:\n  m_Shader: {fileID: 103, guid: 0000000000000000f000000000000000, type: 0}\n";
