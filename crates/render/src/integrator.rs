@@ -562,11 +562,6 @@ impl<'a> Integrator<'a> {
         }
     }
 
-    /// Bytes of the reflection probe's levels (0 without one).
-    pub fn probe_bytes(&self) -> u64 {
-        self.probe.as_ref().map_or(0, |p| p.bytes())
-    }
-
     /// Bytes of the mip levels this render built (the full-size images are the soup's).
     pub fn texture_bytes(&self) -> u64 {
         self.samplers.iter().flatten().map(Sampler::bytes).sum()

@@ -43,32 +43,35 @@ pub struct Probe {
 struct Cube {
     size: usize,
     texels: Vec<Vec3>,
+    /// Each face again with a border of one texel from its neighbours ((size + 2)² a face),
+    /// so that a bilinear lookup never leaves its face.
+    bordered: Vec<Vec3>,
 }
 
-/// The axis a direction leaves the cube through, its face, and its (u, v) on that face.
+/// The face a direction leaves the cube through, and its (u, v) on that face.
+#[inline(always)]
 fn locate(d: Vec3) -> (usize, f32, f32) {
     let a = d.abs();
-    let axis = if a.x >= a.y && a.x >= a.z {
-        0
+    // (axis, the component along it, then those along axis + 1 and axis + 2, mod 3)
+    let (axis, major, u, v) = if a.x >= a.y && a.x >= a.z {
+        (0, d.x, d.y, d.z)
     } else if a.y >= a.z {
-        1
+        (1, d.y, d.z, d.x)
     } else {
-        2
+        (2, d.z, d.x, d.y)
     };
-    let major = d[axis];
-    let face = 2 * axis + (major < 0.0) as usize;
     let inv = 1.0 / major.abs();
-    (face, d[(axis + 1) % 3] * inv, d[(axis + 2) % 3] * inv)
+    (2 * axis + (major < 0.0) as usize, u * inv, v * inv)
 }
 
 /// The (unnormalised) direction through (u, v) of `face`; u and v may lie beyond ±1.
 fn direction(face: usize, u: f32, v: f32) -> Vec3 {
-    let axis = face / 2;
-    let mut d = Vec3::ZERO;
-    d[axis] = if face.is_multiple_of(2) { 1.0 } else { -1.0 };
-    d[(axis + 1) % 3] = u;
-    d[(axis + 2) % 3] = v;
-    d
+    let major = if face.is_multiple_of(2) { 1.0 } else { -1.0 };
+    match face / 2 {
+        0 => Vec3::new(major, u, v),
+        1 => Vec3::new(v, major, u),
+        _ => Vec3::new(u, v, major),
+    }
 }
 
 impl Cube {
@@ -85,7 +88,31 @@ impl Cube {
                     *t = texel(direction(face, centre(i, size), v).normalize());
                 }
             });
-        Cube { size, texels }
+        Cube::new(size, texels)
+    }
+
+    /// A level of these texels, with its faces' borders.
+    fn new(size: usize, texels: Vec<Vec3>) -> Cube {
+        let mut cube = Cube {
+            size,
+            texels,
+            bordered: Vec::new(),
+        };
+        let n = size as isize;
+        cube.bordered = (0..6)
+            .flat_map(|face| (-1..=n).flat_map(move |j| (-1..=n).map(move |i| (face, i, j))))
+            .map(|(face, i, j)| cube.fetch(face, i, j))
+            .collect();
+        cube
+    }
+
+    /// No level: one no surface reads.
+    fn none() -> Cube {
+        Cube {
+            size: 0,
+            texels: Vec::new(),
+            bordered: Vec::new(),
+        }
     }
 
     /// The next box-filtered halving.
@@ -102,7 +129,7 @@ impl Cube {
                 }
             }
         }
-        Cube { size: h, texels }
+        Cube::new(h, texels)
     }
 
     /// Texel (i, j) of `face`, where i or j may lie one beyond the face: then the texel of
@@ -119,22 +146,20 @@ impl Cube {
     }
 
     /// The level's bilinear value along `d` (any length but zero).
+    #[inline]
     fn bilinear(&self, d: Vec3) -> Vec3 {
         let (face, u, v) = locate(d);
         let n = self.size as f32;
         let x = ((u + 1.0) * 0.5 * n - 0.5).clamp(-0.5, n - 0.5);
         let y = ((v + 1.0) * 0.5 * n - 0.5).clamp(-0.5, n - 0.5);
-        // Floors by truncation: x and y are at least −0.5.
-        let (i, j) = ((x + 1.0) as isize - 1, (y + 1.0) as isize - 1);
-        let (fx, fy) = (x - i as f32, y - j as f32);
-        let last = self.size as isize - 1;
-        let [a, b, c, d] = if i >= 0 && j >= 0 && i < last && j < last {
-            let at = face * self.size * self.size + j as usize * self.size + i as usize;
-            let t = &self.texels;
-            [t[at], t[at + 1], t[at + self.size], t[at + self.size + 1]]
-        } else {
-            [(0, 0), (1, 0), (0, 1), (1, 1)].map(|(di, dj)| self.fetch(face, i + di, j + dj))
-        };
+        // Floors by truncation: x and y are at least −0.5, so i and j at least −1, which
+        // is the border's first texel.
+        let (i, j) = ((x + 1.0) as usize, (y + 1.0) as usize);
+        let (fx, fy) = (x + 1.0 - i as f32, y + 1.0 - j as f32);
+        let side = self.size + 2;
+        let at = face * side * side + j * side + i;
+        let t = &self.bordered;
+        let [a, b, c, d] = [t[at], t[at + 1], t[at + side], t[at + side + 1]];
         a.lerp(b, fx).lerp(c.lerp(d, fx), fy)
     }
 }
@@ -253,24 +278,22 @@ impl Probe {
         }
         let mean = mean(&halvings[0]);
         let top = (halvings.len() - 1) as f32;
-        let levels = (0..LEVELS)
+        let mut levels = (0..LEVELS)
             .map(|m| match m {
-                _ if !needed[m] => Cube {
-                    size: 0,
-                    texels: Vec::new(),
-                },
+                _ if !needed[m] => Cube::none(),
                 // Level 1's lobe (α ≈ 0.01, about 1.2° wide) is narrower than its texels
                 // (1.4°): its box halving is the convolution, within its texels.
-                0 | 1 => Cube {
-                    size: halvings[m].size,
-                    texels: halvings[m].texels.clone(),
-                },
+                0 | 1 => Cube::new(halvings[m].size, halvings[m].texels.clone()),
                 _ => {
                     let taps = taps(alpha_of_level(m), source, top);
                     Cube::from_fn(RESOLUTION >> m, |n| prefiltered(&halvings, n, &taps))
                 }
             })
-            .collect();
+            .collect::<Vec<_>>();
+        // Lookups read the bordered faces alone.
+        for level in &mut levels {
+            level.texels = Vec::new();
+        }
         Probe { levels, mean }
     }
 
@@ -310,12 +333,6 @@ impl Probe {
             .find(built)
             .or_else(|| (0..m).rev().find(built))
             .map_or(&self.levels[0], |k| &self.levels[k])
-    }
-
-    /// Bytes of its texels.
-    pub fn bytes(&self) -> u64 {
-        let texels: usize = self.levels.iter().map(|c| c.texels.len()).sum();
-        (texels * std::mem::size_of::<Vec3>()) as u64
     }
 }
 
@@ -377,7 +394,8 @@ mod tests {
             Probe::new(sky, 1.0, [true; LEVELS]),
             Probe::new(sky, 1.0, half),
         );
-        assert!(part.levels[0].texels.is_empty() && part.levels[6].texels.is_empty());
+        assert!(part.levels[0].bordered.is_empty() && part.levels[6].bordered.is_empty());
+        assert!(!part.levels[4].bordered.is_empty());
         for d in [Vec3::Y, Vec3::new(0.3, 0.2, -0.9).normalize(), -Vec3::X] {
             let (a, b) = (full.at(d, 0.5), part.at(d, 0.5));
             assert!(close(a, b, 0.01 * a.max_element()), "{d}: {a} {b}");

@@ -210,7 +210,7 @@ pub fn emit(g: &Graph, scene_rel: &str, camera: Option<&str>) -> Result<Emitted,
         let seen = env.clear == formats::ClearFlags::Skybox
             || env.ambient.mode == formats::AmbientMode::Skybox;
         if seen || reflection > 0.0 {
-            e.sky(rs, seen);
+            e.sky(rs, seen, reflection > 0.0);
         }
         if e.soup.environment.sky.is_some() {
             e.soup.environment.reflection = reflection;

@@ -486,8 +486,8 @@ pub fn aim(sky: &mut ProceduralSky, lights: &[Light], named: Option<usize>) {
 impl Emitter<'_, '_> {
     /// The procedural sky RenderSettings `rs` names, aimed at the scene's sun (the top
     /// scene's file is the graph's first).
-    /// `seen`: a camera or the ambient light shows it, not only reflections.
-    pub(crate) fn sky(&mut self, rs: &Node, seen: bool) {
+    /// `seen`: a camera or the ambient light shows it; `reflected`: surfaces reflect it.
+    pub(crate) fn sky(&mut self, rs: &Node, seen: bool, reflected: bool) {
         let mut warnings = Vec::new();
         let sky = skybox(rs, self.g.project, &mut warnings);
         for w in warnings {
@@ -506,10 +506,10 @@ impl Emitter<'_, '_> {
             Err(why) => self.soup.warnings.push(format!(
                 "{}: RenderSettings: {why}; {}",
                 self.scene_rel,
-                if seen {
-                    "a sky gradient stands in"
-                } else {
-                    "surfaces reflect no sky"
+                match (seen, reflected) {
+                    (true, false) => "a sky gradient stands in",
+                    (true, true) => "a sky gradient stands in, and surfaces reflect no sky",
+                    _ => "surfaces reflect no sky",
                 }
             )),
         }

@@ -319,8 +319,9 @@ fn the_default_skybox_is_a_procedural_sky_aimed_at_the_sun() {
     assert!(
         soup.warnings.iter().any(|w| {
             w.contains(
-            "RenderSettings: skybox Assets/Sky.mat: _Tex names no texture; a sky gradient stands in"
-        )
+                "RenderSettings: skybox Assets/Sky.mat: _Tex names no texture; a sky gradient \
+             stands in, and surfaces reflect no sky",
+            )
         }),
         "{:?}",
         soup.warnings
