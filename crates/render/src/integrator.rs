@@ -835,10 +835,14 @@ impl<'a> Integrator<'a> {
         counts: &mut RayCounts,
         primary: &mut [Option<&mut Primary>; LANES],
     ) -> [Option<(Vec3, f32)>; LANES] {
-        let mut lit: [Option<Lit>; LANES] = std::array::from_fn(|l| {
-            let hit = first[l]?;
-            self.surface(&rays[l], &hit, cones[l], counts, &mut primary[l])
-        });
+        // A loop, not `array::from_fn`: with the surface inlined into its closure, the
+        // compiler kept `from_fn` as a call of its own.
+        let mut lit: [Option<Lit>; LANES] = [None, None, None, None];
+        for l in 0..LANES {
+            if let Some(hit) = first[l] {
+                lit[l] = self.surface(&rays[l], &hit, cones[l], counts, &mut primary[l]);
+            }
+        }
         for al in &self.lights {
             let mut shadow = [no_ray(); LANES];
             let mut hard = [None; LANES];
