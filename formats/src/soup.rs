@@ -242,6 +242,16 @@ impl Material {
             || self.metallic_map.is_some()
     }
 
+    /// The least and greatest smoothness anywhere on the surface: from 0 to its scale where
+    /// the albedo map's alpha or a metallic map gives it, else its one value.
+    pub fn smoothness_range(&self) -> (f32, f32) {
+        match (&self.metallic_map, self.smoothness_in_alpha) {
+            (_, true) => (0.0, self.smoothness),
+            (Some(map), false) => (0.0, map.smoothness),
+            (None, false) => (self.smoothness, self.smoothness),
+        }
+    }
+
     /// The smallest metallic value anywhere on the surface: a metallic map may hold 0.
     pub fn least_metallic(&self) -> f32 {
         if self.metallic_map.is_some() {

@@ -397,22 +397,10 @@ fn probe(soup: &Soup, plan: &Plan) -> Option<Probe> {
     let env = &soup.environment;
     let sky = env.sky.as_ref().filter(|_| plan.sky_reflections.enabled)?;
     let sky = Skybox::new(sky, env.color_space);
-    // The smoothness each physically based material takes: one value, or from 0 to its
-    // scale where a map or the albedo's alpha gives it.
-    let ranges = soup
-        .materials
-        .iter()
-        .filter(|m| m.pbs && !m.unlit)
-        .map(|m| match (&m.metallic_map, m.smoothness_in_alpha) {
-            (_, true) => (0.0, m.smoothness),
-            (Some(map), false) => (0.0, map.smoothness),
-            (None, false) => (m.smoothness, m.smoothness),
-        });
-    let needed = Probe::levels_read(ranges);
     Some(Probe::new(
         |d, spread| sky.radiance(d, spread),
         env.reflection,
-        needed,
+        plan.sky_reflections.levels,
     ))
 }
 

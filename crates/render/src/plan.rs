@@ -4,6 +4,7 @@
 
 use crate::alpha::{alpha_use, min_alphas, AlphaUse};
 use crate::brdf::shows_light;
+use crate::probe::{Probe, LEVELS, RESOLUTION};
 use crate::{RenderOptions, TextureFilter};
 use formats::{
     AmbientMode, Attenuation, CastShadows, ClearFlags, Cull, Fog, FogMode, LightKind, Material,
@@ -46,6 +47,17 @@ pub struct ReflectionPlan {
     pub cutoff: f32,
     pub reflective_materials: usize,
     pub reason: String,
+}
+
+/// The skybox reflected by physically based surfaces, as Unity's default reflection probe
+/// holds it: on when the scene reflects its skybox and a used material is physically based.
+#[derive(Clone, Debug, Serialize)]
+pub struct SkyReflectionPlan {
+    pub enabled: bool,
+    pub reason: String,
+    /// The probe's levels the used materials read: the renderer builds these alone.
+    #[serde(skip)]
+    pub levels: [bool; LEVELS],
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -145,10 +157,7 @@ pub struct Plan {
     pub alpha: AlphaPlan,
     pub reflections: ReflectionPlan,
     pub ambient: Effect,
-    /// The skybox reflected by physically based surfaces, as Unity's default reflection
-    /// probe holds it: on when the scene reflects its skybox and a used material is
-    /// physically based.
-    pub sky_reflections: Effect,
+    pub sky_reflections: SkyReflectionPlan,
     pub emission: Effect,
     /// RenderSettings fog: on when the scene has fog that can thin a surface's colour.
     pub fog: Effect,
@@ -561,31 +570,29 @@ impl Plan {
 
 /// Physically based surfaces reflect the skybox where the scene's default reflection
 /// probe holds it (a skybox the soup holds, and an intensity above 0).
-fn sky_reflection_plan(soup: &Soup, mats: &[&Material]) -> Effect {
+fn sky_reflection_plan(soup: &Soup, mats: &[&Material]) -> SkyReflectionPlan {
     let env = &soup.environment;
-    let pbs = mats.iter().filter(|m| m.pbs && !m.unlit).count();
-    let constant = mats
-        .iter()
-        .filter(|m| m.pbs && !m.unlit && !m.reflections)
-        .count();
-    let off = |reason: &str| Effect {
+    let pbs: Vec<&Material> = mats.iter().filter(|m| m.pbs && !m.unlit).copied().collect();
+    let constant = pbs.iter().filter(|m| !m.reflections).count();
+    let off = |reason: &str| SkyReflectionPlan {
         enabled: false,
         reason: reason.into(),
+        levels: [false; LEVELS],
     };
     if env.sky.is_none() {
         off("the scene reflects no skybox the soup holds")
     } else if env.reflection <= 0.0 {
         off("the environment reflection's intensity is 0")
-    } else if pbs == 0 {
+    } else if pbs.is_empty() {
         off("no material is physically based")
     } else {
-        let size = crate::probe::RESOLUTION;
-        Effect {
+        SkyReflectionPlan {
             enabled: true,
             reason: format!(
-                "{pbs} physically based materials reflect the skybox as Unity's default \
-                 reflection probe holds it ({size}² a face, each level prefiltered for its \
-                 roughness), intensity {}{}",
+                "{} physically based materials reflect the skybox as Unity's default \
+                 reflection probe holds it ({RESOLUTION}² a face, each level prefiltered for \
+                 its roughness), intensity {}{}",
+                pbs.len(),
                 env.reflection,
                 if constant > 0 {
                     format!("; {constant} with Reflections off reflect its mean colour")
@@ -593,6 +600,7 @@ fn sky_reflection_plan(soup: &Soup, mats: &[&Material]) -> Effect {
                     String::new()
                 }
             ),
+            levels: Probe::levels_read(pbs.iter().map(|m| m.smoothness_range())),
         }
     }
 }

@@ -278,18 +278,24 @@ impl Probe {
         }
         let mean = mean(&halvings[0]);
         let top = (halvings.len() - 1) as f32;
-        let mut levels = (0..LEVELS)
-            .map(|m| match m {
-                _ if !needed[m] => Cube::none(),
-                // Level 1's lobe (α ≈ 0.01, about 1.2° wide) is narrower than its texels
-                // (1.4°): its box halving is the convolution, within its texels.
-                0 | 1 => Cube::new(halvings[m].size, halvings[m].texels.clone()),
-                _ => {
+        let mut levels: Vec<Cube> = (0..LEVELS)
+            .map(|m| {
+                if needed[m] && m >= 2 {
                     let taps = taps(alpha_of_level(m), source, top);
                     Cube::from_fn(RESOLUTION >> m, |n| prefiltered(&halvings, n, &taps))
+                } else {
+                    Cube::none()
                 }
             })
-            .collect::<Vec<_>>();
+            .collect();
+        // Levels 0 and 1 are the sky and its first halving: level 1's lobe (α ≈ 0.01,
+        // about 1.2° wide) is narrower than its texels (1.4°), so the halving is the
+        // convolution, within its texels.
+        for m in 0..2 {
+            if needed[m] {
+                levels[m] = std::mem::replace(&mut halvings[m], Cube::none());
+            }
+        }
         // Lookups read the bordered faces alone.
         for level in &mut levels {
             level.texels = Vec::new();

@@ -86,6 +86,18 @@ fn scene(
     render(&soup, &kd, &opts(8, 8))
 }
 
+/// [`scene`] under [`half_sky`] at intensity 1, built-in pipeline, black background.
+fn under_half_sky(material: Material, ceiling: bool) -> (Rendered, Plan) {
+    scene(
+        material,
+        half_sky(),
+        1.0,
+        Attenuation::BuiltIn,
+        ceiling,
+        ClearFlags::SolidColor,
+    )
+}
+
 fn reflecting(metallic: f32, smoothness: f32) -> Material {
     Material {
         reflections: true,
@@ -160,37 +172,13 @@ fn surfaces_reflect_the_sky_above_and_the_dark_below() {
     // A mirror-smooth dielectric floor reflects the bright upper half (75° off the normal
     // the reflected ray rises 15° above the horizon; the lower half is black), a ceiling
     // the black lower half.
-    let floor = scene(
-        reflecting(0.0, 1.0),
-        half_sky(),
-        1.0,
-        Attenuation::BuiltIn,
-        false,
-        ClearFlags::SolidColor,
-    )
-    .0;
+    let floor = under_half_sky(reflecting(0.0, 1.0), false).0;
     let w = unity_environment(Vec3::splat(0.04), 0.0, 1.0, NV, false);
     assert_close(floor.frame.pixel(4, 4), w * SKY, 1e-3, "floor");
-    let ceiling = scene(
-        reflecting(0.0, 1.0),
-        half_sky(),
-        1.0,
-        Attenuation::BuiltIn,
-        true,
-        ClearFlags::SolidColor,
-    )
-    .0;
+    let ceiling = under_half_sky(reflecting(0.0, 1.0), true).0;
     assert_close(ceiling.frame.pixel(4, 4), Vec3::ZERO, 1e-3, "ceiling");
     // The roughest floor sees the two halves blurred together, still mostly the upper.
-    let rough = scene(
-        reflecting(0.0, 0.0),
-        half_sky(),
-        1.0,
-        Attenuation::BuiltIn,
-        false,
-        ClearFlags::SolidColor,
-    )
-    .0;
+    let rough = under_half_sky(reflecting(0.0, 0.0), false).0;
     let full = unity_environment(Vec3::splat(0.04), 0.0, 0.0, NV, false) * SKY;
     let got = rough.frame.pixel(4, 4);
     assert!(
@@ -205,14 +193,7 @@ fn reflections_off_take_the_skys_mean_without_a_lookup() {
         reflections: false,
         ..glossy(0.0, 1.0)
     };
-    let (out, plan) = scene(
-        off,
-        half_sky(),
-        1.0,
-        Attenuation::BuiltIn,
-        false,
-        ClearFlags::SolidColor,
-    );
+    let (out, plan) = under_half_sky(off, false);
     assert!(
         plan.sky_reflections
             .reason
